@@ -1,0 +1,8 @@
+"""cam_fmu: cam motion laws and an electromechanical cam drive as an FMI 2.0 FMU.
+
+Kept light on purpose: importing the package imports no submodule.  Use
+``from cam_fmu.motion_law import MotionLaw``, ``from cam_fmu.presets import law``,
+``from cam_fmu.cam_program import CamProgram, paper_program``.
+"""
+
+__version__ = "0.1.0"
