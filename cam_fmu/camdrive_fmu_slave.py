@@ -1,0 +1,203 @@
+"""The FMI 2.0 co-simulation slave of cam.fmu (pythonfmu 0.7.0).
+
+Thin by design: it registers the FMI variables (inputs ``u`` and ``omega_ref``,
+the outputs of ``simulator.OUTPUTS`` and every parameter of
+``parameters.PARAMETERS`` under the same name and unit) and maps the FMI calls
+onto ``simulator.DriveSimulator``, the same physics code the reference uses.
+
+The module name ``camdrive_fmu_slave`` is deliberately unique: pythonfmu imports
+the slave script as a *top-level* module of the host process, and module names
+are process-global (two FMUs whose scripts share a module name cannot both load
+in one process).
+
+Imports at run time: pythonfmu, ``cam_fmu.parameters`` and ``cam_fmu.simulator``
+(numpy at most). Never scipy: it crashes native hosts at Py_Finalize.
+
+Errors. pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
+an FMI call (fmi2SetReal/Boolean/String, fmi2EnterInitializationMode,
+fmi2ExitInitializationMode, fmi2DoStep, fmi2Get*, state calls) into
+``pythonfmu::fatal_error``: the call returns **fmi2Fatal** and the wrapper logs
+``"Fatal py exception encountered: [doStep] PyObject_CallMethod\\nunknown error"``
+(without the exception text) through the host's logger callback. There is no
+way from Python to obtain plain fmi2Error (only a C++ ``std::exception`` that is not ``fatal_error`` gives it),
+and the only other non-OK status reachable from Python is fmi2Discard (a falsy
+``do_step`` return), which fmpy treats as a silent early stop WITHOUT raising.
+fmi2Fatal is therefore the best available status that makes every importer
+stop: fmpy raises ``FMICallException`` (status 4). Our message (naming the
+variable and its allowed range) reaches the log as an fmi2Error-status message
+queued with ``self.log`` just before the exception, which the wrapper flushes
+before its own fatal line; both only with logging on (fmpy:
+``debug_logging=True``). The message is also printed to stderr.
+
+Values are checked where they enter: a parameter in its setter (fmi2SetReal /
+fmi2SetString / fmi2SetBoolean fails), the angle sum when the simulator is
+built (fmi2ExitInitializationMode fails), an input in its setter and again in
+do_step, the simulator's own errors in do_step (fmi2DoStep fails). Outputs are
+checked to be finite before they are published: never NaN outputs.
+"""
+from __future__ import annotations
+
+import copy
+import math
+import sys
+from typing import Any, Dict
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
+from pythonfmu.enums import Fmi2Status
+from pythonfmu.default_experiment import DefaultExperiment
+
+from cam_fmu import parameters as _parameters
+from cam_fmu import simulator as _simulator
+
+MODEL_NAME = "cam"
+DESCRIPTION = (
+    "Electromechanical cam drive: DC motor (R, L, c_e, c_m) driving a disc cam with an "
+    "in-line roller follower (friction, gravity, backlash); voltage or speed drive. "
+    "Default experiment: the paper's fig. 6 scene (u = 3.5 V, horizontal mounting)."
+)
+# The paper's fig. 6 scene: 0..2 s, 1 ms communication step.
+DEFAULT_EXPERIMENT = DefaultExperiment(start_time=0.0, stop_time=2.0, step_size=1e-3)
+
+
+class FmuError(RuntimeError):
+    """An error reported to the importer; the message names the variable and the allowed range."""
+
+
+class CamDriveSlave(Fmi2Slave):
+    """cam.fmu: the cam drive as an FMI 2.0 co-simulation slave."""
+
+    author = "cam_fmu"
+    description = DESCRIPTION
+    default_experiment = DEFAULT_EXPERIMENT
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.modelName = MODEL_NAME
+        self._params: Dict[str, Any] = _parameters.defaults()
+        self._inputs: Dict[str, float] = {name: float(start) for name, _u, start, _d in _simulator.INPUTS}
+        self._outputs: Dict[str, float] = {name: 0.0 for name, _u, _d in _simulator.OUTPUTS}
+        self._sim = None  # DriveSimulator, built at exit_initialization_mode or on first use
+        self._initialized = False  # True after exit_initialization_mode: parameters are fixed
+
+        for name, _unit, _start, desc in _simulator.INPUTS:
+            self.register_variable(Real(
+                name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
+                description=desc, getter=self._input_getter(name), setter=self._input_setter(name)))
+        for name, _unit, desc in _simulator.OUTPUTS:
+            self.register_variable(Real(
+                name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
+                initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(name)))
+        kinds = {"real": Real, "boolean": Boolean, "string": String}
+        for spec in _parameters.PARAMETERS:
+            self.register_variable(kinds[spec.kind](
+                spec.name, causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                initial=Fmi2Initial.exact, description=spec.description,
+                getter=self._param_getter(spec.name), setter=self._param_setter(spec.name)))
+
+    # ----------------------------------------------------------------- variables
+    def _input_getter(self, name: str):
+        return lambda: self._inputs[name]
+
+    def _input_setter(self, name: str):
+        unit = {n: u for n, u, _s, _d in _simulator.INPUTS}[name]
+
+        def setter(value: Any) -> None:
+            number = float(value)
+            if not math.isfinite(number):
+                self._fail(f"input {name!r} = {number!r} [{unit}] is not finite: allowed any finite value (-inf, inf) {unit}")
+            self._inputs[name] = number
+        return setter
+
+    def _output_getter(self, name: str):
+        def getter() -> float:
+            if self._sim is None:
+                self._build()  # outputs are 'calculated' from the parameters at start time
+            return self._outputs[name]
+        return getter
+
+    def _param_getter(self, name: str):
+        return lambda: self._params[name]
+
+    def _param_setter(self, name: str):
+        spec = _parameters.BY_NAME[name]
+
+        def setter(value: Any) -> None:
+            if self._initialized:
+                self._fail(f"parameter {name!r} has variability 'fixed': it can only be set before "
+                           f"fmi2ExitInitializationMode (allowed {spec.allowed()})")
+            try:
+                self._params[name] = spec.check(value)
+            except _parameters.ParameterError as exc:
+                self._fail(str(exc))
+            self._sim = None  # rebuilt from the new values on first use
+        return setter
+
+    # ----------------------------------------------------------------- helpers
+    def _fail(self, message: str) -> None:
+        """Report an error: log it, print it to stderr, raise (pythonfmu returns fmi2Fatal).
+
+        pythonfmu 0.7.0 forwards the queued ``self.log`` message (status fmi2Error,
+        category logStatusError) followed by its own fmi2Fatal line, but only when
+        the importer turned logging on (fmpy: ``debug_logging=True``); its fatal
+        line does not contain the exception text. stderr is the fallback a user
+        sees when logging is off.
+        """
+        self.log(message, Fmi2Status.error)
+        print(f"[cam.fmu {self.instance_name}] error: {message}", file=sys.stderr, flush=True)
+        raise FmuError(message)
+
+    def _build(self) -> None:
+        try:
+            sim = _simulator.DriveSimulator(self._params)
+        except (_parameters.ParameterError, _simulator.SimulationError) as exc:
+            self._fail(str(exc))
+        self._publish(sim, sim.outputs())
+        self._sim = sim
+
+    def _publish(self, sim: Any, values: Dict[str, float]) -> None:
+        for name in self._outputs:
+            value = float(values[name])
+            if not math.isfinite(value):
+                self._fail(f"output {name!r} = {value!r} at t = {sim.time!r} s is not finite "
+                           "(check the solver settings 'solver', 'h_max', 'rtol', 'atol')")
+        self._outputs.update({name: float(values[name]) for name in self._outputs})
+
+    # ----------------------------------------------------------------- FMI calls
+    def exit_initialization_mode(self) -> None:
+        self._build()
+        self._initialized = True
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._sim is None:
+            self._build()
+            self._initialized = True
+        for name, value in self._inputs.items():
+            if not math.isfinite(value):
+                self._fail(f"input {name!r} = {value!r} is not finite: allowed any finite value")
+        try:
+            self._sim.do_step(current_time, step_size, self._inputs["u"], self._inputs["omega_ref"])
+        except (_parameters.ParameterError, _simulator.SimulationError) as exc:
+            self._fail(f"at t = {current_time!r} s: {exc}")
+        self._publish(self._sim, self._sim.outputs())
+        return True  # a falsy return would become a silent fmi2Discard
+
+    def _get_fmu_state(self) -> Dict[str, Any]:
+        return {
+            "params": dict(self._params),
+            "inputs": dict(self._inputs),
+            "outputs": dict(self._outputs),
+            "initialized": self._initialized,
+            "sim": None if self._sim is None else copy.deepcopy(self._sim.get_state()),
+        }
+
+    def _set_fmu_state(self, state: Dict[str, Any]) -> None:
+        self._params = dict(state["params"])
+        self._inputs = {k: float(v) for k, v in state["inputs"].items()}
+        self._outputs = {k: float(v) for k, v in state["outputs"].items()}
+        self._initialized = bool(state["initialized"])
+        if state["sim"] is None:
+            self._sim = None
+        else:
+            sim = _simulator.DriveSimulator(self._params)
+            sim.set_state(copy.deepcopy(state["sim"]))
+            self._sim = sim

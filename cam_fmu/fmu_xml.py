@@ -1,0 +1,203 @@
+"""Post-processing of cam.fmu's modelDescription.xml (build time only, not bundled).
+
+pythonfmu 0.7.0 writes names, causality, variability, initial, start and the
+Outputs list, but no units, no min/max, no InitialUnknowns and Real starts with
+only 16 significant digits. ``postprocess`` adds what the Reference FMUs have:
+
+- a model description, the DefaultExperiment of the paper's fig. 6 scene;
+- ``<UnitDefinitions>`` (with SI base-unit exponents where known) and ``unit=``
+  on every Real that has a unit;
+- explicit causality, variability and initial on every variable (FMI 2.0 forbids
+  ``initial`` on inputs, so inputs carry causality, variability and start);
+- ``min``/``max`` on parameters with finite bounds, exact (repr) start values;
+- complete ``<Outputs>`` and ``<InitialUnknowns>`` (every output is 'calculated').
+
+The same table (``variable_rows``) generates the README's variable table
+(``markdown_table``), so the documentation cannot drift from the FMU.
+"""
+from __future__ import annotations
+
+import math
+import zipfile
+from pathlib import Path
+from typing import Any, Dict, List, Optional
+from xml.dom.minidom import parseString
+from xml.etree import ElementTree as ET
+
+from . import parameters
+
+# SI base-unit exponents of the units used by the model (FMI 2.0 BaseUnit attributes).
+BASE_UNITS: Dict[str, Dict[str, int]] = {
+    "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
+    "A": {"A": 1},
+    "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
+    "H": {"kg": 1, "m": 2, "s": -2, "A": -2},
+    "V/(rad/s)": {"kg": 1, "m": 2, "s": -2, "A": -1, "rad": -1},
+    "N.m/A": {"kg": 1, "m": 2, "s": -2, "A": -1},
+    "kg.m2": {"kg": 1, "m": 2},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "kg": {"kg": 1},
+    "m": {"m": 1},
+    "m/s": {"m": 1, "s": -1},
+    "m/s2": {"m": 1, "s": -2},
+    "s": {"s": 1},
+    "rad": {"rad": 1},
+    "rad/s": {"rad": 1, "s": -1},
+    "rad/s2": {"rad": 1, "s": -2},
+    "1": {},
+}
+BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+
+
+def _simulator():
+    from . import simulator  # imported lazily: the build needs it, the README table too
+    return simulator
+
+
+def variable_rows() -> List[Dict[str, Any]]:
+    """Every FMU variable in value-reference order (the slave registers inputs, outputs, parameters)."""
+    sim = _simulator()
+    rows: List[Dict[str, Any]] = []
+    for name, unit, start, desc in sim.INPUTS:
+        rows.append(dict(name=name, type="Real", causality="input", variability="continuous", initial=None,
+                         unit=unit, start=float(start), min=None, max=None, description=desc,
+                         allowed="any finite value"))
+    for name, unit, desc in sim.OUTPUTS:
+        rows.append(dict(name=name, type="Real", causality="output", variability="continuous",
+                         initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
+                         allowed="(output)"))
+    for spec in parameters.PARAMETERS:
+        kind = {"real": "Real", "boolean": "Boolean", "string": "String"}[spec.kind]
+        row = dict(name=spec.name, type=kind, causality="parameter", variability="fixed", initial="exact",
+                   unit=spec.unit if spec.kind == "real" else "", start=spec.default,
+                   min=None, max=None, description=spec.description, allowed=spec.allowed())
+        if spec.kind == "real":
+            row["min"] = spec.low if math.isfinite(spec.low) else None
+            row["max"] = spec.high if math.isfinite(spec.high) else None
+        rows.append(row)
+    return rows
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)  # shortest string that round-trips exactly
+    return str(value)
+
+
+def postprocess(xml_bytes: bytes, description: Optional[str] = None,
+                default_experiment: tuple = (0.0, 2.0, 1e-3)) -> bytes:
+    """Return the completed modelDescription.xml."""
+    root = ET.fromstring(xml_bytes)
+    for element in root.iter():  # drop pythonfmu's pretty-printing whitespace before re-indenting
+        if element.text is not None and not element.text.strip():
+            element.text = None
+        if element.tail is not None and not element.tail.strip():
+            element.tail = None
+    if description:
+        root.set("description", description)
+    rows = {row["name"]: row for row in variable_rows()}
+
+    # UnitDefinitions right after CoSimulation (schema order).
+    for old in root.findall("UnitDefinitions"):
+        root.remove(old)
+    units = sorted({row["unit"] for row in rows.values() if row["type"] == "Real" and row["unit"]})
+    unit_defs = ET.Element("UnitDefinitions")
+    for unit in units:
+        node = ET.SubElement(unit_defs, "Unit", name=unit)
+        exps = BASE_UNITS.get(unit)
+        if exps:
+            ET.SubElement(node, "BaseUnit", {k: str(exps[k]) for k in BASE_UNIT_ORDER if k in exps})
+    children = list(root)
+    cosim_index = next(i for i, c in enumerate(children) if c.tag == "CoSimulation")
+    root.insert(cosim_index + 1, unit_defs)
+
+    # DefaultExperiment before ModelVariables.
+    for old in root.findall("DefaultExperiment"):
+        root.remove(old)
+    start, stop, step = default_experiment
+    experiment = ET.Element("DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
+                            stepSize=_fmt(float(step)))
+    root.insert(list(root).index(root.find("ModelVariables")), experiment)
+
+    # Variables.
+    variables = root.find("ModelVariables")
+    index_of: Dict[str, int] = {}
+    for index, sv in enumerate(variables.findall("ScalarVariable"), start=1):
+        name = sv.get("name")
+        if name not in rows:
+            raise ValueError(f"FMU variable {name!r} is not in the variable table")
+        row = rows[name]
+        index_of[name] = index
+        for key in ("causality", "variability"):
+            sv.set(key, row[key])
+        if row["initial"] is None:
+            sv.attrib.pop("initial", None)
+        else:
+            sv.set("initial", row["initial"])
+        if row["description"]:
+            sv.set("description", row["description"])
+        typed = sv.find(row["type"])
+        if typed is None:
+            raise ValueError(f"FMU variable {name!r} is not of type {row['type']}")
+        typed.attrib.clear()
+        if row["type"] == "Real" and row["unit"]:
+            typed.set("unit", row["unit"])
+        if row["min"] is not None:
+            typed.set("min", _fmt(float(row["min"])))
+        if row["max"] is not None:
+            typed.set("max", _fmt(float(row["max"])))
+        if row["start"] is not None:
+            typed.set("start", _fmt(float(row["start"]) if row["type"] == "Real" else row["start"]))
+    missing = set(rows) - set(index_of)
+    if missing:
+        raise ValueError(f"variables missing from the FMU: {sorted(missing)}")
+
+    # ModelStructure: every output in Outputs and InitialUnknowns (all are 'calculated').
+    structure = root.find("ModelStructure")
+    for child in list(structure):
+        structure.remove(child)
+    outputs = [name for name, row in rows.items() if row["causality"] == "output"]
+    out_node = ET.SubElement(structure, "Outputs")
+    init_node = ET.SubElement(structure, "InitialUnknowns")
+    for name in sorted(outputs, key=index_of.get):
+        ET.SubElement(out_node, "Unknown", index=str(index_of[name]))
+        ET.SubElement(init_node, "Unknown", index=str(index_of[name]))
+
+    text = ET.tostring(root, encoding="UTF-8")
+    return parseString(text).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+def rewrite_fmu(fmu_path: Path, **kwargs: Any) -> None:
+    """Replace modelDescription.xml inside ``fmu_path`` by its post-processed version."""
+    fmu_path = Path(fmu_path)
+    with zipfile.ZipFile(fmu_path) as zin:
+        entries = [(info, zin.read(info.filename)) for info in zin.infolist()]
+    tmp = fmu_path.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zout:
+        for info, data in entries:
+            if info.filename == "modelDescription.xml":
+                data = postprocess(data, **kwargs)
+            zout.writestr(info.filename, data)
+    tmp.replace(fmu_path)
+
+
+def markdown_table() -> str:
+    """The README's table of every FMU variable: name, causality, type, unit, default, allowed range."""
+    lines = ["| name | causality | type | unit | default | allowed | description |",
+             "|---|---|---|---|---|---|---|"]
+    for row in variable_rows():
+        default = "" if row["start"] is None else _fmt(row["start"] if row["type"] != "Real" else float(row["start"]))
+        if row["type"] == "Real" and row["start"] is not None:
+            default = f"{float(row['start']):.6g}"
+        lines.append("| `{name}` | {causality} | {type} | {unit} | {default} | {allowed} | {description} |".format(
+            name=row["name"], causality=row["causality"], type=row["type"], unit=row["unit"] or "",
+            default=default, allowed=row["allowed"].replace("|", "\\|"),
+            description=row["description"].replace("|", "\\|")))
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":  # python -m cam_fmu.fmu_xml: print the README table
+    print(markdown_table())
