@@ -91,7 +91,10 @@ def _program(args, rise_law):
         ret = rise_law
     lower = args.lower_dwell_deg
     if lower is None:
-        lower = 360.0 - args.rise_deg - args.upper_dwell_deg - args.return_deg
+        used = args.rise_deg + args.upper_dwell_deg + args.return_deg
+        if used > 360.0 + 1e-9:
+            raise ValueError(f"rise + upper dwell + return = {used:g} deg exceeds 2*pi (360 deg)")
+        lower = max(0.0, 360.0 - used)
     return CamProgram(rise_law, ret, lift=args.lift_mm * 1e-3,
                       rise_angle=math.radians(args.rise_deg), upper_dwell=math.radians(args.upper_dwell_deg),
                       return_angle=math.radians(args.return_deg), lower_dwell=math.radians(lower))

@@ -147,8 +147,12 @@ class MotionLaw:
         # validation and det > 0 (the deceleration's centroid lies right of the
         # acceleration's), so this never divides by zero.
         det = sp * vm - sm * vp
-        Amp = vm / det
-        Amm = vp / det
+        Amp = vm / det if det > 0.0 else math.inf
+        Amm = vp / det if det > 0.0 else math.inf
+        if not (math.isfinite(Amp) and math.isfinite(Amm)):
+            raise ValueError(
+                f"split points {values!r} are too close to make a finite curve "
+                f"(acceleration or deceleration phase of length ~0)")
         V0 = tuple(Amp * a - Amm * b for a, b in zip(Vp, Vm))
         S0 = tuple(Amp * a - Amm * b for a, b in zip(Sp, Sm))
         coef = [Amp if s > 0 else (-Amm if s < 0 else 0.0) for s in _SIDE]
