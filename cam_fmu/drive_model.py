@@ -1,0 +1,170 @@
+"""Physics of the cam drive: follower forces, load torque, inertia, motor.
+
+Plain functions of plain floats (``math`` only), shared by the reference
+integration, the FMU and the tests. Equations and corrections: MODEL.md
+sections 3-6. Sign conventions: X is the rise direction, theta and omega are
+positive in the cam's forward sense, v = ds/dt and a = d2s/dt2 are signed.
+
+Switching an effect off sets its coefficients to zero once, at construction:
+the hot path then carries no test for it (``follower`` False skips all
+follower terms).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+from .cam_program import CamProgram
+from .parameters import law_spec, resolve
+
+
+def _sign(x: float) -> float:
+    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_support: float) -> float:
+    """Guide friction force f >= 0 [N] solving f = mu (|n0 + sigma kappa f| + n_support).
+
+    The side force N_r = n0 + sigma kappa f depends on f itself (through the
+    contact force): solved exactly on its two linear branches instead of lagging
+    f by a step (MODEL.md section 5). Unique because mu |kappa| < 1.
+    """
+    if mu == 0.0:
+        return 0.0
+    sk = sigma * kappa
+    f = mu * (n0 + n_support) / (1.0 - mu * sk)
+    if f >= 0.0 and n0 + sk * f >= 0.0:
+        return f
+    return mu * (n_support - n0) / (1.0 + mu * sk)
+
+
+@dataclass
+class LoadState:
+    """Everything the drive equation produces at one instant (SI units)."""
+
+    omega_dot: float  # rad/s2
+    M: float  # N m, total load torque on the shaft: M_f sgn(omega) + M_l
+    J: float  # kg m2, equivalent inertia
+    f: float  # N, guide friction force
+    v: float  # m/s, follower velocity
+    a: float  # m/s2, follower acceleration
+    alpha: float  # rad, pressure angle
+
+
+class DriveModel:
+    """The cam drive with one parameter set (see parameters.PARAMETERS)."""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        p = resolve(params)
+        self.params = p
+        self.program = CamProgram(
+            law_spec(p, "rise"), law_spec(p, "return"), p["lift"],
+            p["rise_angle"], p["upper_dwell"], p["return_angle"], p["lower_dwell"],
+        )
+        self.R = p["R"]
+        self.L = p["L"] if p["inductance"] else 0.0
+        self.c_e = p["c_e"]
+        self.c_m = p["c_m"]
+        self.J_m = p["J_m"]
+        self.M_f = p["M_f"] if p["shaft_friction"] else 0.0
+        self.m = p["m"] if p["follower_inertia"] else 0.0
+        G = p["G"] if p["gravity"] else 0.0
+        self.F_gx = G * math.sin(p["gamma"]) * math.cos(p["beta"])  # N, gravity along X
+        self.G_y = G * math.sin(p["gamma"]) * math.sin(p["beta"])  # N, gravity along Y
+        self.N_g = abs(G * math.cos(p["gamma"]))  # N, guide support |N_g|
+        self.mu = p["mu"] if p["guide_friction"] else 0.0
+        self.r_b = p["r_b"]
+        self.c = p["c"] if p["backlash"] else 0.0
+        self.formulation = p["formulation"]
+        self.drive = p["drive"]
+        # Does the follower load the shaft at all? (inertia, gravity or friction)
+        self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
+
+    # ----------------------------------------------------------------- motor
+    def current(self, u: float, omega: float) -> float:
+        """Armature current [A] with L = 0: i = (u - c_e omega) / R."""
+        return (u - self.c_e * omega) / self.R
+
+    def current_rate(self, u: float, omega: float, i: float) -> float:
+        """di/dt [A/s] with L > 0: (u - R i - c_e omega) / L."""
+        return (u - self.R * i - self.c_e * omega) / self.L
+
+    # ----------------------------------------------------------- mechanics
+    def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True) -> float:
+        """Angular acceleration [rad/s2], consistent formulation (MODEL.md section 5).
+
+        ``torque`` is the motor torque c_m i [N m]; ``direction`` is sgn(omega),
+        or the trial direction of motion when omega = 0 (stiction); ``engaged``
+        False means the follower is free in the backlash gap (J = J_m, no load).
+        """
+        drive = torque - self.M_f * direction
+        if not (engaged and self.follower):
+            return drive / self.J_m
+        s, s1, s2, _ = self.program.derivatives(theta)
+        m = self.m
+        J = self.J_m + m * s1 * s1
+        w2 = omega * omega
+        x0 = (drive - (m * s2 * w2 - self.F_gx) * s1) / J
+        if self.mu == 0.0:
+            return x0
+        sigma = _sign(s1 * direction)
+        tan_a = s1 / (self.r_b + s)
+        n0 = (m * s2 * w2 - self.F_gx + m * s1 * x0) * tan_a + self.G_y
+        f = solve_guide_friction(n0, self.J_m / J * tan_a, sigma, self.mu, self.N_g)
+        return x0 - sigma * f * s1 / J
+
+    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
+        """Load torque, inertia and follower motion for a known omega_dot."""
+        s, s1, s2, _ = self.program.derivatives(theta)
+        tan_a = s1 / (self.r_b + s)
+        shaft = self.M_f * direction
+        if not engaged:
+            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, math.atan(tan_a))
+        v = s1 * omega
+        a = s2 * omega * omega + s1 * omega_dot
+        sigma = _sign(s1 * direction)
+        push = self.m * a - self.F_gx  # N, axial force without friction
+        f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g)
+        M_l = (push + sigma * f) * s1
+        return LoadState(omega_dot, shaft + M_l, self.J_m + self.m * s1 * s1, f, v, a, math.atan(tan_a))
+
+    def breakaway_direction(self, theta: float, torque: float, engaged: bool = True) -> float:
+        """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).
+
+        At rest, friction opposes the motion that would start: the shaft moves
+        forward only if it accelerates forward with friction against it, and so
+        on. With no friction and zero net torque it stays at rest.
+        """
+        if self.omega_dot(theta, 0.0, torque, 1.0, engaged) > 0.0:
+            return 1.0
+        if self.omega_dot(theta, 0.0, torque, -1.0, engaged) < 0.0:
+            return -1.0
+        return 0.0
+
+    def energy(self, theta: float, omega: float, i: float, engaged: bool = True) -> float:
+        """Stored energy [J]: kinetic + gravity potential (along X) + magnetic."""
+        s, s1, _, _ = self.program.derivatives(theta)
+        J = self.J_m + (self.m * s1 * s1 if engaged else 0.0)
+        return 0.5 * J * omega * omega - self.F_gx * s + 0.5 * self.L * i * i
+
+
+def break_away_voltage(model: DriveModel, theta: float = 0.0) -> float:
+    """Smallest constant voltage [V] that starts the shaft from rest at ``theta``.
+
+    With L = 0 the motor torque at rest is c_m u / R; the shaft starts once it
+    beats the static resistance, found by bisection on the stiction test.
+    """
+    hi = 1.0
+    while model.breakaway_direction(theta, model.c_m * hi / model.R) <= 0.0:
+        hi *= 2.0
+        if hi > 1e9:
+            raise ValueError("the shaft does not start for any voltage up to 1e9 V")
+    lo = 0.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if model.breakaway_direction(theta, model.c_m * mid / model.R) > 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return hi

@@ -1,0 +1,207 @@
+"""The consistent cam drive as a hybrid system: continuous states, modes, events.
+
+Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A].
+Discrete mode: stuck (shaft held by static friction), direction of motion,
+backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
+gap) and the follower's position while free. Both the FMU stepper and the
+scipy reference integrate ``derivative`` and stop at the zeros of
+``event_values``: one physics code, two integrators (MODEL.md sections 5-6).
+
+Events are functions that are > 0 while nothing happens; a crossing to <= 0
+triggers ``apply_event`` with the index of the function.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from .drive_model import DriveModel, LoadState
+
+STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY = "stop", "contact", "engage_up", "engage_down", "break_away"
+
+
+@dataclass
+class Mode:
+    """Discrete state. ``contact`` is +1 with no backlash (always engaged)."""
+
+    stuck: bool = False
+    direction: float = 1.0  # sgn(omega) while moving
+    contact: int = 1
+    s_free: float = 0.0  # m, follower position while contact == 0
+
+    def copy(self) -> "Mode":
+        return Mode(self.stuck, self.direction, self.contact, self.s_free)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+class HybridDrive:
+    """Consistent formulation of the drive under a voltage input u [V]."""
+
+    def __init__(self, model: DriveModel) -> None:
+        self.model = model
+        self.has_current = model.L > 0.0
+        self.backlash = model.c > 0.0
+        self.size = 3 if self.has_current else 2
+
+    # ------------------------------------------------------------ set-up
+    def initial(self, theta0: float, omega0: float, i0: float) -> tuple[list[float], Mode]:
+        """Initial state and mode (from rest: stuck until ``settle`` lets it go)."""
+        y = [theta0, omega0, i0][: self.size]
+        mode = Mode(stuck=omega0 == 0.0, direction=1.0 if omega0 >= 0.0 else -1.0)
+        if self.backlash:
+            # The paper's step 1: the follower starts where the cam is, centred in the gap.
+            mode.contact = 0
+            mode.s_free = self.model.program.derivatives(theta0)[0]
+        return y, mode
+
+    def torque(self, y, u: float) -> float:
+        """Motor torque c_m i [N m]."""
+        m = self.model
+        if self.has_current:
+            return m.c_m * y[2]
+        return m.c_m * (u - m.c_e * y[1]) / m.R
+
+    def current(self, y, u: float) -> float:
+        m = self.model
+        return y[2] if self.has_current else (u - m.c_e * y[1]) / m.R
+
+    # -------------------------------------------------------- continuous
+    def derivative(self, y, u: float, mode: Mode) -> tuple[float, ...]:
+        """dy/dt. While moving, friction opposes mode.direction (fixed over a step)."""
+        model = self.model
+        omega = y[1]
+        if self.has_current:
+            i = y[2]
+            di = (u - model.R * i - model.c_e * omega) / model.L
+            if mode.stuck:
+                return (0.0, 0.0, di)
+            return (omega, model.omega_dot(y[0], omega, model.c_m * i, mode.direction, mode.contact != 0), di)
+        if mode.stuck:
+            return (0.0, 0.0)
+        torque = model.c_m * (u - model.c_e * omega) / model.R
+        return (omega, model.omega_dot(y[0], omega, torque, mode.direction, mode.contact != 0))
+
+    # ------------------------------------------------------------ events
+    def event_names(self, mode: Mode) -> tuple[str, ...]:
+        if mode.stuck:
+            return (BREAK_AWAY,) if self.has_current else ()
+        if not self.backlash:
+            return (STOP,)
+        if mode.contact == 0:
+            return (STOP, ENGAGE_UP, ENGAGE_DOWN)
+        return (STOP, CONTACT)
+
+    def event_values(self, y, u: float, mode: Mode) -> tuple[float, ...]:
+        """Values of the active event functions (> 0: nothing happens)."""
+        if mode.stuck:
+            if not self.has_current:
+                return ()
+            return (-self._breakaway_margin(y, u, mode),)
+        stop = y[1] * mode.direction
+        if not self.backlash:
+            return (stop,)
+        s, s1, _, _ = self.model.program.derivatives(y[0])
+        c = self.model.c
+        if mode.contact == 0:
+            return (stop, mode.s_free - (s - c), (s + c) - mode.s_free)
+        return (stop, mode.contact * s1 * y[1])
+
+    def _breakaway_margin(self, y, u: float, mode: Mode) -> float:
+        """> 0 when the shaft would start moving from rest [rad/s2]."""
+        model, torque, engaged = self.model, self.torque(y, u), mode.contact != 0
+        forward = model.omega_dot(y[0], 0.0, torque, 1.0, engaged)
+        backward = -model.omega_dot(y[0], 0.0, torque, -1.0, engaged)
+        return max(forward, backward)
+
+    def apply_event(self, y, u: float, mode: Mode, name: str) -> None:
+        """The transition of event ``name``, in place on y and mode."""
+        model = self.model
+        if name == STOP:
+            y[1] = 0.0
+            mode.stuck = True
+            self.settle(y, u, mode)
+        elif name == BREAK_AWAY:
+            self.settle(y, u, mode)
+        elif name == CONTACT:
+            s = model.program.derivatives(y[0])[0]
+            mode.s_free = s - model.c * mode.contact
+            mode.contact = 0
+        else:
+            mode.contact = 1 if name == ENGAGE_UP else -1
+            s1 = model.program.derivatives(y[0])[1]
+            # Plastic impact: generalised momentum J_m omega (+ m s' v = 0 before) is kept.
+            y[1] = model.J_m * y[1] / (model.J_m + model.m * s1 * s1)
+
+    def settle(self, y, u: float, mode: Mode) -> None:
+        """At rest: stay stuck or start in the direction the torques allow."""
+        if not mode.stuck:
+            return
+        model = self.model
+        direction = model.breakaway_direction(y[0], self.torque(y, u), mode.contact != 0)
+        if direction == 0.0:
+            return
+        mode.stuck = False
+        mode.direction = direction
+        if self.backlash and mode.contact != 0:
+            s, s1, _, _ = model.program.derivatives(y[0])
+            if mode.contact * s1 * direction < 0.0:  # the cam leaves the follower
+                mode.s_free = s - model.c * mode.contact
+                mode.contact = 0
+
+    # ----------------------------------------------------------- outputs
+    def outputs(self, y, u: float, mode: Mode) -> dict[str, float]:
+        """Every output of the drive at state y (SI units)."""
+        model = self.model
+        theta, omega = y[0], y[1]
+        i = self.current(y, u)
+        engaged = mode.contact != 0
+        s_cam = model.program.derivatives(theta)[0]
+        if mode.stuck:
+            load = model.load(theta, 0.0, 0.0, 0.0, engaged)
+            load.M = model.c_m * i  # static friction takes whatever the motor applies
+            load.v = load.a = 0.0
+        else:
+            omega_dot = self.derivative(y, u, mode)[1]
+            load = model.load(theta, omega, omega_dot, mode.direction, engaged)
+        s = s_cam - model.c * mode.contact if engaged else mode.s_free
+        return _outputs(theta, omega, i, s, s_cam, load, u)
+
+
+def _outputs(theta: float, omega: float, i: float, s: float, s_cam: float, load: LoadState, voltage: float) -> dict[str, float]:
+    return {
+        "omega": omega, "theta": theta, "s": s, "i": i, "M": load.M, "J": load.J,
+        "v": load.v, "a": load.a, "alpha": load.alpha, "s_cam": s_cam, "voltage": voltage,
+    }
+
+
+def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot: float, s: float, engaged: bool) -> dict[str, float]:
+    """Speed drive: torque, inertia, current and voltage needed for a given motion.
+
+    c_m i = J_m omega_dot + M (consistent formulation); the voltage adds
+    L di/dt, with di/dt = omega dM/dtheta at constant speed (central difference,
+    1e-6 rad).
+    """
+    direction = 1.0 if omega > 0.0 else (-1.0 if omega < 0.0 else 0.0)
+    load = model.load(theta, omega, omega_dot, direction, engaged)
+    i = (model.J_m * omega_dot + load.M) / model.c_m
+    voltage = model.R * i + model.c_e * omega
+    if model.L > 0.0 and omega != 0.0:
+        d = 1e-6
+        dM = (model.load(theta + d, omega, omega_dot, direction, engaged).M
+              - model.load(theta - d, omega, omega_dot, direction, engaged).M) / (2 * d)
+        voltage += model.L * omega * dM / model.c_m
+    s_cam = model.program.derivatives(theta)[0]
+    return _outputs(theta, omega, i, s, s_cam, load, voltage)
+
+
+def play(s_cam: float, s_prev: float, c: float) -> float:
+    """Backlash play operator (paper eqs. 6-8, continuous form): follower position [m]."""
+    if s_cam > s_prev + c:
+        return s_cam - c
+    if s_cam < s_prev - c:
+        return s_cam + c
+    return s_prev
+
+

@@ -1,0 +1,150 @@
+"""The paper's discrete simulation algorithm (section 3, steps 1-9), reproduced.
+
+Reproduced as printed, except for the OCR errors MODEL.md corrects: step 3 sums
+omega (not alpha), eq. (1) keeps its mu, c_m is in N m/A, and v/omega is taken
+as ds/dtheta from the profile (undefined at omega = 0 otherwise). Signed v and
+a on a fixed X axis replace the paper's unsigned values and beta flip.
+
+What makes it differ from the consistent formulation (MODEL.md section 5):
+eq. (12) divides by J = J_m + m s'^2 and subtracts an M_l that holds m a s'
+with a = s'' omega^2 + s' omega_dot taken from backward differences, so the
+follower's inertia m s'^2 omega_dot is counted twice, one step late. The lag
+also gives a step-to-step oscillation of ratio -m s'^2 / J (about -0.98 at
+the paper's peak s' = 70 mm/rad), which the fig. 6 comparison shows.
+
+Stiction, which the paper leaves out: at omega = 0 the shaft stays at rest
+while |c_m i - M_l| <= M_f, and a step that would reverse omega stops it at 0.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .drive_model import DriveModel, _sign, solve_guide_friction
+from .hybrid import play
+
+
+class PaperScheme:
+    """State of steps 1-9 between two calls of ``step`` (SI units)."""
+
+    FIELDS = ("theta", "omega", "i", "M", "J", "s", "v", "a", "alpha", "voltage")
+
+    def __init__(self, model: DriveModel, theta0: float, omega0: float, i0: float) -> None:
+        self.model = model
+        # Step 1: initial values.
+        self.theta = theta0
+        self.omega = omega0
+        self.i = i0 if model.L > 0.0 else 0.0
+        self.J = model.J_m
+        self.M = model.M_f if omega0 >= 0.0 else -model.M_f
+        self.s = model.program.derivatives(theta0)[0]
+        self.v = 0.0
+        self.a = 0.0
+        self.alpha = 0.0
+        self.voltage = 0.0
+        self.M_l = 0.0
+
+    def get_state(self) -> dict[str, Any]:
+        return {name: getattr(self, name) for name in self.FIELDS + ("M_l",)}
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        for name, value in state.items():
+            setattr(self, name, float(value))
+
+    def _shaft_friction(self, drive_torque: float) -> float | None:
+        """M_f with its sign, or None when the shaft stays stuck this step."""
+        model = self.model
+        if self.omega != 0.0:
+            return model.M_f * _sign(self.omega)
+        net = drive_torque - self.M_l
+        if abs(net) <= model.M_f:
+            return None
+        return model.M_f * _sign(net)
+
+    def step(self, T: float, u: float) -> None:
+        """Steps 2-8 for one calculation step T [s] under the voltage u [V]."""
+        model = self.model
+        self.voltage = u
+        L = model.L
+        drive = model.c_m * (self.i if L > 0.0 else (u - model.c_e * self.omega) / model.R)
+        shaft = self._shaft_friction(drive)
+        omega_old = self.omega
+        if shaft is not None:
+            self.M = shaft + self.M_l
+            # Step 2: RK4 on eq. (12) with M and J frozen over the step.
+            if L > 0.0:
+                self.omega, self.i = _rk4_motor_inductive(model, self.omega, self.i, self.M, self.J, u, T)
+            else:
+                self.omega = _rk4_motor(model, self.omega, self.M, self.J, u, T)
+            if omega_old != 0.0 and self.omega * omega_old < 0.0:
+                self.omega = 0.0  # friction cannot reverse the motion
+            elif omega_old == 0.0 and self.omega * shaft < 0.0:
+                self.omega = 0.0
+        elif L > 0.0:
+            self.i = u / model.R + (self.i - u / model.R) * math.exp(-T * model.R / L)
+        if L == 0.0:
+            self.i = (u - model.c_e * self.omega) / model.R
+        # Step 3: theta by summation of omega (printed as alpha: an OCR error).
+        self.theta += self.omega * T
+        # Step 4: profile and backlash law (eqs. 6-8).
+        s_cam, s1, _, _ = model.program.derivatives(self.theta)
+        s_new = play(s_cam, self.s, model.c) if model.c > 0.0 else s_cam
+        # Steps 5-6: backward differences.
+        v_new = (s_new - self.s) / T
+        self.a = (v_new - self.v) / T
+        self.v = v_new
+        moved = s_new != self.s or model.c == 0.0
+        self.s = s_new
+        # Step 7: eqs. (1) and (3). X = ds/dtheta of the follower: the profile's while it follows.
+        X = s1 if moved else 0.0
+        tan_a = s1 / (model.r_b + s_cam)
+        self.alpha = math.atan(tan_a)
+        push = model.m * self.a - model.F_gx
+        sigma = _sign(self.v)
+        f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g)
+        self.M_l = (push + sigma * f) * X
+        # Step 8: eq. (4).
+        self.J = model.J_m + model.m * X * X
+        self.M = model.M_f * _sign(self.omega) + self.M_l
+
+    def outputs(self) -> dict[str, float]:
+        s_cam = self.model.program.derivatives(self.theta)[0]
+        return {
+            "omega": self.omega, "theta": self.theta, "s": self.s, "i": self.i, "M": self.M,
+            "J": self.J, "v": self.v, "a": self.a, "alpha": self.alpha, "s_cam": s_cam,
+            "voltage": self.voltage,
+        }
+
+
+def _rk4_motor(model: DriveModel, omega: float, M: float, J: float, u: float, T: float) -> float:
+    """RK4 on eq. (12): omega_dot = (c_m u - R M - c_e c_m omega) / (R J)."""
+    R, cm, ce = model.R, model.c_m, model.c_e
+
+    def f(w: float) -> float:
+        return (cm * u - R * M - ce * cm * w) / (R * J)
+
+    k1 = f(omega)
+    k2 = f(omega + 0.5 * T * k1)
+    k3 = f(omega + 0.5 * T * k2)
+    k4 = f(omega + T * k3)
+    return omega + T / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J: float, u: float, T: float) -> tuple[float, float]:
+    """RK4 on eqs. (9)-(10) with L > 0, sub-stepped inside RK4's stability limit."""
+    R, L, cm, ce = model.R, model.L, model.c_m, model.c_e
+    rate = R / L + math.sqrt(cm * ce / (J * L))
+    n = max(1, math.ceil(T * rate / 2.0))
+    h = T / n
+
+    def f(w: float, c: float) -> tuple[float, float]:
+        return (cm * c - M) / J, (u - R * c - ce * w) / L
+
+    for _ in range(n):
+        a1, b1 = f(omega, i)
+        a2, b2 = f(omega + 0.5 * h * a1, i + 0.5 * h * b1)
+        a3, b3 = f(omega + 0.5 * h * a2, i + 0.5 * h * b2)
+        a4, b4 = f(omega + h * a3, i + h * b3)
+        omega += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+        i += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
+    return omega, i

@@ -1,0 +1,161 @@
+"""Every parameter of the cam drive: name, SI unit, default, allowed range, meaning.
+
+This table is the single source of truth: the scene files, the reference
+integration, the FMU variables and the README all use these names and units.
+Only ``math`` is imported here: the module is bundled into the FMU.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+KGF = 9.80665  # N per kgf: the paper's c_m = 0.015 is in kgf m/A (MODEL.md section 3)
+PAPER_A = 0.035  # m, the paper's profile constant A
+
+
+class ParameterError(ValueError):
+    """A parameter value outside its allowed range; the message names both."""
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One parameter. ``kind`` is 'real', 'boolean' or 'string'."""
+
+    name: str
+    unit: str
+    default: Any
+    description: str
+    kind: str = "real"
+    low: float = -math.inf
+    high: float = math.inf
+    low_open: bool = False  # True: the lower bound itself is not allowed
+    choices: tuple[str, ...] = ()
+
+    def allowed(self) -> str:
+        """Human-readable allowed range, as used in error messages."""
+        if self.kind == "boolean":
+            return "true or false"
+        if self.kind == "string":
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        left = "(" if self.low_open else "["
+        return f"{left}{self.low:g}, {self.high:g}]" + (f" {self.unit}" if self.unit not in ("", "1") else "")
+
+    def check(self, value: Any) -> Any:
+        """Return the value converted to its kind, or raise ParameterError."""
+        if self.kind == "boolean":
+            if isinstance(value, str):
+                if value.lower() in ("true", "1", "yes", "on"):
+                    return True
+                if value.lower() in ("false", "0", "no", "off"):
+                    return False
+                raise ParameterError(f"parameter {self.name!r} = {value!r}: allowed {self.allowed()}")
+            return bool(value)
+        if self.kind == "string":
+            text = str(value)
+            if self.choices and text not in self.choices:
+                raise ParameterError(f"parameter {self.name!r} = {value!r}: allowed {self.allowed()}")
+            return text
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"parameter {self.name!r} = {value!r} is not a number: allowed {self.allowed()}") from None
+        too_low = number <= self.low if self.low_open else number < self.low
+        if not math.isfinite(number) or too_low or number > self.high:
+            raise ParameterError(f"parameter {self.name!r} = {number!r} [{self.unit}] is outside the allowed range {self.allowed()}")
+        return number
+
+
+LAW_CHOICES = (
+    "paper", "cycloidal", "modified_sine", "modified_trapezoid", "simple_harmonic",
+    "constant_acceleration", "mcv50", "custom",
+)
+FORMULATIONS = ("consistent", "paper")
+DRIVES = ("voltage", "speed")
+SOLVERS = ("euler", "rk4", "rk45", "etdrk4")
+EFFECTS = ("shaft_friction", "guide_friction", "gravity", "follower_inertia", "backlash", "inductance")
+
+_P = ParameterSpec
+_MODEL = (
+    _P("R", "Ohm", 19.0, "armature resistance", low=0.0, high=1e4, low_open=True),
+    _P("L", "H", 0.0, "armature inductance (0: neglected, as in the paper)", low=0.0, high=10.0),
+    _P("c_e", "V/(rad/s)", 0.146, "back-EMF constant", low=0.0, high=100.0, low_open=True),
+    _P("c_m", "N.m/A", 0.015 * KGF, "torque constant (the paper's 0.015 is kgf m/A)", low=0.0, high=100.0, low_open=True),
+    _P("J_m", "kg.m2", 4.41e-5, "motor, encoder and cam inertia", low=0.0, high=100.0, low_open=True),
+    _P("M_f", "N.m", 0.012, "shaft friction torque (Coulomb)", low=0.0, high=1e3),
+    _P("m", "kg", 0.4, "follower mass", low=0.0, high=1e4),
+    _P("G", "N", 4.0, "follower weight", low=0.0, high=1e5),
+    _P("mu", "1", 0.001, "guide friction coefficient", low=0.0, high=0.5),
+    _P("gamma", "rad", math.pi, "angle of gravity to Z (pi: horizontal mounting)", low=-2 * math.pi, high=2 * math.pi),
+    _P("beta", "rad", 0.0, "angle of gravity's XY component to the rise direction X", low=-2 * math.pi, high=2 * math.pi),
+    _P("r_b", "m", 0.1, "base-circle radius (keeps the paper profile's pressure angle under 30 deg)", low=0.0, high=10.0, low_open=True),
+    _P("c", "m", 0.0, "clearance of the follower (backlash half-width, paper eqs. 6-8)", low=0.0, high=0.1),
+    _P("theta0", "rad", 0.0, "initial cam angle", low=-1e6, high=1e6),
+    _P("omega0", "rad/s", 0.0, "initial angular velocity", low=-1e4, high=1e4),
+    _P("i0", "A", 0.0, "initial armature current (used only with L > 0)", low=-1e3, high=1e3),
+)
+
+_PROGRAM = (
+    _P("rise_law", "", "paper", "motion law of the rise: a preset name or 'custom' (then rise_T1..rise_T6)", kind="string", choices=LAW_CHOICES),
+    *(_P(f"rise_T{k}", "1", v, f"split point T{k} of a custom rise law", low=0.0, high=1.0)
+      for k, v in enumerate((0.125, 0.125, 0.25, 0.75, 0.875, 0.875), start=1)),
+    _P("return_law", "", "paper", "motion law of the return: a preset name or 'custom' (then return_T1..return_T6)", kind="string", choices=LAW_CHOICES),
+    *(_P(f"return_T{k}", "1", v, f"split point T{k} of a custom return law", low=0.0, high=1.0)
+      for k, v in enumerate((0.125, 0.125, 0.25, 0.75, 0.875, 0.875), start=1)),
+    _P("lift", "m", 1.5 * math.pi * PAPER_A, "lift h (paper: 3 pi A / 2 with A = 35 mm)", low=0.0, high=10.0, low_open=True),
+    _P("rise_angle", "rad", math.pi, "cam angle of the rise", low=0.0, high=2 * math.pi, low_open=True),
+    _P("upper_dwell", "rad", 0.0, "cam angle of the upper dwell", low=0.0, high=2 * math.pi),
+    _P("return_angle", "rad", math.pi, "cam angle of the return", low=0.0, high=2 * math.pi, low_open=True),
+    _P("lower_dwell", "rad", 0.0, "cam angle of the lower dwell", low=0.0, high=2 * math.pi),
+)
+
+_MODE = (
+    _P("formulation", "", "consistent", "'consistent' (energy-consistent, MODEL.md section 5) or 'paper' (published steps 1-9)", kind="string", choices=FORMULATIONS),
+    _P("drive", "", "voltage", "'voltage': u(t) is the input; 'speed': omega_ref(t) is imposed", kind="string", choices=DRIVES),
+    *(_P(name, "", True, f"model the {name.replace('_', ' ')} (false: the effect is off and costs nothing)", kind="boolean")
+      for name in EFFECTS),
+)
+
+_SOLVER = (
+    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole)", kind="string", choices=SOLVERS),
+    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step)", low=0.0, high=10.0, low_open=True),
+    _P("rtol", "1", 1e-10, "relative tolerance of 'rk45'", low=1e-14, high=0.1),
+    _P("atol", "1", 1e-12, "absolute tolerance of 'rk45' (on rad, rad/s, A)", low=1e-16, high=1.0),
+    _P("max_steps", "1", 100000.0, "most internal steps in one communication step before an error is reported", low=1.0, high=1e9),
+)
+
+PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER
+BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
+
+
+def defaults() -> dict[str, Any]:
+    """All parameters at their default values."""
+    return {p.name: p.default for p in PARAMETERS}
+
+
+def resolve(overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """Defaults updated with ``overrides``, every value checked.
+
+    Raises ParameterError for an unknown name, a value outside its range, or
+    program angles that do not sum to 2 pi.
+    """
+    values = defaults()
+    for name, value in (overrides or {}).items():
+        if name not in BY_NAME:
+            raise ParameterError(f"unknown parameter {name!r}; known: {', '.join(sorted(BY_NAME))}")
+        values[name] = BY_NAME[name].check(value)
+    total = values["rise_angle"] + values["upper_dwell"] + values["return_angle"] + values["lower_dwell"]
+    if abs(total - 2 * math.pi) > 1e-9:
+        raise ParameterError(
+            "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' "
+            f"= {total!r} rad must equal 2 pi = {2 * math.pi!r} rad (to 1e-9 rad)"
+        )
+    return values
+
+
+def law_spec(values: Mapping[str, Any], stroke: str) -> str | tuple[float, ...]:
+    """The law of 'rise' or 'return' as a preset name or a 6-tuple of split points."""
+    name = values[f"{stroke}_law"]
+    if name == "custom":
+        return tuple(float(values[f"{stroke}_T{k}"]) for k in range(1, 7))
+    return name

@@ -1,0 +1,341 @@
+"""The drive stepped from one communication point to the next (the FMU's engine).
+
+``DriveSimulator`` owns the model, the solver and every piece of internal state;
+the FMU class only maps FMI variables onto it. numpy is not imported here: the
+FMU's run-time path is ``math`` only (FMI_NOTES: scipy in an FMU crashes ecos).
+
+Solvers (consistent formulation, voltage drive):
+- ``euler``, ``rk4``: fixed internal step min(h_max, stability limit): a step
+  beyond the explicit method's stability limit is split, never taken.
+- ``rk45``: Dormand-Prince 5(4) with error control (rtol, atol); its step size
+  is carried across communication steps; failing to meet the tolerance within
+  ``max_steps`` or above the smallest step raises SimulationError.
+- ``etdrk4``: exponential RK4, exact on the electrical pole -R/L: stable and
+  accurate with L > 0 at steps far above L/R.
+Every solver stops at the hybrid events (stick, backlash contact) by re-stepping
+to the located zero, and applies the transition there.
+
+The paper formulation runs its own fixed-step algorithm (paper_scheme.py) with
+T = the largest step <= h_max that divides the communication step.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+from .drive_model import DriveModel
+from .hybrid import HybridDrive, Mode, play, speed_drive_outputs
+from .integrators import EtdCoefficients, dopri_step, etdrk4_step, euler_step, rk4_step
+from .paper_scheme import PaperScheme
+
+INPUTS: tuple[tuple[str, str, float, str], ...] = (
+    ("u", "V", 3.5, "armature voltage (voltage drive)"),
+    ("omega_ref", "rad/s", 1.0, "imposed cam speed (speed drive)"),
+)
+OUTPUTS: tuple[tuple[str, str, str], ...] = (
+    ("omega", "rad/s", "cam angular velocity"),
+    ("theta", "rad", "cam angle (unbounded; the profile uses theta mod 2 pi)"),
+    ("s", "m", "follower position (after backlash)"),
+    ("i", "A", "armature current"),
+    ("M", "N.m", "total load torque on the shaft: M_f sgn(omega) + M_l"),
+    ("J", "kg.m2", "equivalent inertia J_m + m (ds/dtheta)^2 (J_m while free in the gap)"),
+    ("v", "m/s", "follower velocity"),
+    ("a", "m/s2", "follower acceleration"),
+    ("alpha", "rad", "pressure angle"),
+    ("s_cam", "m", "cam profile lift at the contact (before backlash)"),
+    ("voltage", "V", "armature voltage: u (voltage drive) or the voltage needed (speed drive)"),
+)
+
+_STABILITY = {"euler": 1.0, "rk4": 2.5, "etdrk4": 2.5}  # h * |lambda| allowed
+_EVENT_ITERATIONS = 60
+
+
+class SimulationError(RuntimeError):
+    """The simulation cannot go on correctly; the message names the setting."""
+
+
+class DriveSimulator:
+    """One cam drive, advanced by ``do_step`` (times in s, SI units throughout)."""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        self.model = model = DriveModel(params)
+        p = model.params
+        self.solver = p["solver"]
+        self.h_max = p["h_max"]
+        self.rtol = p["rtol"]
+        self.atol = p["atol"]
+        self.max_steps = int(p["max_steps"])
+        self.time = 0.0
+        self.u = INPUTS[0][2]
+        self.omega_ref = INPUTS[1][2]
+        self.h_next = min(self.h_max, 1e-4)  # rk45's first trial step [s]
+        self.steps_taken = 0  # internal steps, for benchmarks
+        self._etd: EtdCoefficients | None = None
+        theta0, omega0, i0 = p["theta0"], p["omega0"], p["i0"]
+        self.kind = "speed" if model.drive == "speed" else model.formulation
+        if self.kind == "speed":
+            self.theta = theta0
+            self.s = model.program.derivatives(theta0)[0]
+        elif self.kind == "paper":
+            self.scheme = PaperScheme(model, theta0, omega0, i0)
+        else:
+            self.hybrid = HybridDrive(model)
+            self.y, self.mode = self.hybrid.initial(theta0, omega0, i0)
+
+    # ------------------------------------------------------------ public
+    def set_inputs(self, u: float, omega_ref: float) -> None:
+        """Inputs used by ``outputs`` before the first step [V, rad/s]."""
+        self.u = _finite("u", u)
+        self.omega_ref = _finite("omega_ref", omega_ref)
+
+    def do_step(self, t: float, h: float, u: float, omega_ref: float) -> None:
+        """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation)."""
+        if not (math.isfinite(h) and h > 0.0):
+            raise SimulationError(f"communication step size = {h!r} s: allowed (0, inf)")
+        self.set_inputs(u, omega_ref)
+        if self.kind == "speed":
+            self._step_speed(h)
+        elif self.kind == "paper":
+            n = max(1, math.ceil(h / self.h_max - 1e-9))
+            for _ in range(n):
+                self.scheme.step(h / n, u)
+            self.steps_taken += n
+        else:
+            self._step_hybrid(h, u)
+        self.time = t + h
+        for name, value in self.outputs().items():
+            if not math.isfinite(value):
+                raise SimulationError(
+                    f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
+                    f"{self.solver!r}, h_max = {self.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
+
+    def outputs(self) -> dict[str, float]:
+        """Current value of every output in OUTPUTS."""
+        if self.kind == "speed":
+            return speed_drive_outputs(self.model, self.theta, self.omega_ref, 0.0, self.s, self._speed_engaged())
+        if self.kind == "paper":
+            return self.scheme.outputs()
+        return self.hybrid.outputs(self.y, self.u, self.mode)
+
+    def get_state(self) -> dict[str, Any]:
+        """Complete internal state, JSON-serialisable."""
+        state: dict[str, Any] = {
+            "time": self.time, "u": self.u, "omega_ref": self.omega_ref,
+            "h_next": self.h_next, "steps_taken": self.steps_taken,
+        }
+        if self.kind == "speed":
+            state.update(theta=self.theta, s=self.s)
+        elif self.kind == "paper":
+            state["scheme"] = self.scheme.get_state()
+        else:
+            state.update(y=list(self.y), mode=self.mode.to_dict())
+        return state
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        self.time = float(state["time"])
+        self.u = float(state["u"])
+        self.omega_ref = float(state["omega_ref"])
+        self.h_next = float(state["h_next"])
+        self.steps_taken = int(state["steps_taken"])
+        if self.kind == "speed":
+            self.theta = float(state["theta"])
+            self.s = float(state["s"])
+        elif self.kind == "paper":
+            self.scheme.set_state(state["scheme"])
+        else:
+            self.y = [float(x) for x in state["y"]]
+            self.mode = Mode(**state["mode"])
+
+    # ------------------------------------------------------ speed drive
+    def _step_speed(self, h: float) -> None:
+        """theta advances at omega_ref (held); the play operator sees every extremum of s_cam."""
+        model = self.model
+        start, end = self.theta, self.theta + self.omega_ref * h
+        if model.c > 0.0:
+            for angle in _crossed(model.program.breakpoints(), start, end):
+                self.s = play(model.program.derivatives(angle)[0], self.s, model.c)
+            self.s = play(model.program.derivatives(end)[0], self.s, model.c)
+        else:
+            self.s = model.program.derivatives(end)[0]
+        self.theta = end
+        self.steps_taken += 1
+
+    def _speed_engaged(self) -> bool:
+        model = self.model
+        if model.c == 0.0:
+            return True
+        s_cam, s1, _, _ = model.program.derivatives(self.theta)
+        gap = s_cam - self.s
+        return abs(gap) >= model.c * (1.0 - 1e-9) and gap * s1 * self.omega_ref > 0.0
+
+    # ---------------------------------------------- consistent, voltage
+    def _step_hybrid(self, h: float, u: float) -> None:
+        hybrid, mode = self.hybrid, self.mode
+        y = self.y
+        t = 0.0
+        steps = 0
+        hybrid.settle(y, u, mode)
+        k1 = None  # FSAL derivative of rk45, valid while mode and u are unchanged
+        while h - t > 1e-12 * h:
+            if mode.stuck and not hybrid.has_current:
+                break  # nothing evolves until the input changes
+            steps += 1
+            if steps > self.max_steps:
+                raise SimulationError(
+                    f"solver {self.solver!r} needed more than max_steps = {self.max_steps} internal steps "
+                    f"in one communication step of {h:g} s at t = {self.time + t:g} s: raise max_steps, "
+                    "loosen rtol/atol or use 'etdrk4' for a stiff electrical pole")
+
+            def f(state, _mode=mode):
+                return hybrid.derivative(state, u, _mode)
+
+            remaining = h - t
+            if mode.stuck:
+                dt = remaining
+                y_new = self._stuck_current(y, u, dt)
+            elif self.solver == "rk45":
+                dt, y_new, k1 = self._adaptive_step(f, y, remaining, k1)
+            else:
+                dt = min(remaining, self._fixed_step_size(y, mode))
+                y_new = self._fixed_step(f, y, dt)
+            hit = self._first_event(f, y, y_new, dt, u, mode)
+            if hit is None:
+                y, t = y_new, t + dt
+                continue
+            name, tau, y_event = hit
+            y, t = y_event, t + tau
+            hybrid.apply_event(y, u, mode, name)
+            k1 = None
+        self.y = y
+        self.steps_taken += steps
+
+    def _stuck_current(self, y, u: float, dt: float) -> list[float]:
+        """While stuck, only i moves: exact exponential approach to u / R."""
+        model = self.model
+        target = u / model.R
+        return [y[0], 0.0, target + (y[2] - target) * math.exp(-dt * model.R / model.L)]
+
+    def _fixed_step_size(self, y, mode: Mode) -> float:
+        """h_max, cut to the explicit method's stability limit at this state [s]."""
+        model = self.model
+        s, s1, s2, _ = model.program.derivatives(y[0])
+        engaged = mode.contact != 0
+        J = model.J_m + (model.m * s1 * s1 if engaged else 0.0)
+        rate = 2.0 * model.m * abs(s1 * s2 * y[1]) / J if engaged else 0.0
+        if model.L > 0.0:
+            if self.solver != "etdrk4":
+                rate += model.R / model.L + math.sqrt(model.c_e * model.c_m / (J * model.L))
+        else:
+            rate += model.c_e * model.c_m / (model.R * J)
+        limit = _STABILITY[self.solver] / rate if rate > 0.0 else math.inf
+        return min(self.h_max, limit)
+
+    def _fixed_step(self, f, y, dt: float) -> list[float]:
+        if self.solver == "euler":
+            return euler_step(f, y, dt)
+        if self.solver == "rk4":
+            return rk4_step(f, y, dt)
+        if self.solver == "rk45":
+            return dopri_step(f, y, dt)[0]
+        coef = self._etd
+        if coef is None or coef.h != dt:
+            rates = (0.0, 0.0, -self.model.R / self.model.L) if self.hybrid.has_current else (0.0, 0.0)
+            coef = self._etd = EtdCoefficients(rates, dt)
+        return etdrk4_step(f, y, coef)
+
+    def _adaptive_step(self, f, y, remaining: float, k1):
+        """One accepted Dormand-Prince step: (dt, y_new, f(y_new))."""
+        dt = min(self.h_next, remaining)
+        floor = 1e-14 * max(1.0, self.time)
+        while True:
+            y5, err, k7 = dopri_step(f, y, dt, k1)
+            total = 0.0
+            for e, a, b in zip(err, y, y5):
+                scale = self.atol + self.rtol * max(abs(a), abs(b))
+                total += (e / scale) ** 2
+            norm = math.sqrt(total / len(y))
+            if norm <= 1.0:
+                factor = 5.0 if norm == 0.0 else min(5.0, 0.9 * norm ** -0.2)
+                if dt < remaining or factor < 1.0:
+                    self.h_next = min(dt * factor, 1e3)
+                else:
+                    self.h_next = max(self.h_next, dt * min(factor, 1.0))
+                return dt, y5, k7
+            if not math.isfinite(norm):
+                norm = 1e10
+            dt *= max(0.1, 0.9 * norm ** -0.2)
+            if dt < floor:
+                raise SimulationError(
+                    f"solver 'rk45' cannot meet rtol = {self.rtol:g}, atol = {self.atol:g}: its step fell "
+                    f"below {floor:g} s at t = {self.time:g} s")
+
+    def _first_event(self, f, y, y_new, dt: float, u: float, mode: Mode):
+        """Earliest event in (0, dt]: (name, time from step start, state there), or None."""
+        hybrid = self.hybrid
+        before = hybrid.event_values(y, u, mode)
+        if not before:
+            return None
+        after = hybrid.event_values(y_new, u, mode)
+        names = hybrid.event_names(mode)
+        fired = [k for k, (g0, g1) in enumerate(zip(before, after)) if g0 > 0.0 and g1 <= 0.0]
+        if not fired:
+            return None
+        advance = (lambda tau: self._stuck_current(y, u, tau)) if mode.stuck else (lambda tau: self._fixed_step(f, y, tau))
+        best = None
+        for k in fired:
+            tau, y_root = _locate(lambda s: hybrid.event_values(s, u, mode)[k], advance, before[k], after[k], dt, y_new)
+            if best is None or tau < best[1]:
+                best = (names[k], tau, y_root)
+        return best
+
+
+def _locate(g, advance, g_lo: float, g_hi: float, dt: float, y_hi):
+    """Illinois false position for the zero of g(advance(tau)) in (0, dt].
+
+    Returns the time and the state just past the zero (g <= 0 there), so the
+    transition is applied on the far side of the event.
+    """
+    lo, hi = 0.0, dt
+    side = 0
+    for _ in range(_EVENT_ITERATIONS):
+        if hi - lo <= 1e-13 * max(dt, 1e-300) + 1e-15:
+            break
+        tau = hi - g_hi * (hi - lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
+        if not lo < tau < hi:
+            tau = 0.5 * (lo + hi)
+        y_tau = advance(tau)
+        g_tau = g(y_tau)
+        if g_tau <= 0.0:
+            hi, g_hi, y_hi = tau, g_tau, y_tau
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        else:
+            lo, g_lo = tau, g_tau
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+    return hi, list(y_hi)
+
+
+def _crossed(points, start: float, end: float) -> list[float]:
+    """Angles of the periodic points (in [0, 2 pi)) passed going from start to end, in order."""
+    two_pi = 2.0 * math.pi
+    lo, hi = min(start, end), max(start, end)
+    out = []
+    for p in points:
+        k = math.ceil((lo - p) / two_pi)
+        angle = p + k * two_pi
+        while angle < hi:
+            if angle > lo:
+                out.append(angle)
+            angle += two_pi
+    out.sort(reverse=end < start)
+    return out
+
+
+def _finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise SimulationError(f"input {name!r} = {value!r}: allowed any finite value")
+    return value
