@@ -10,7 +10,8 @@ Vm, Am and Jm follow from the structure of the curve (V rises while A >= 0 and
 falls after, so Vm = V(T3); Amp is reached at T1 and Amm at T5; |J| peaks at
 the sine ends: Amp/F1 at 0, Amp/F3 at T3, Amm/F5 at T4, Amm/F7 at 1).  Qm is
 found numerically per segment (dense sampling, then golden-section search on
-the exact scalar evaluation, to ~1e-12 in T).
+the exact scalar evaluation: Qm to ~1e-15 relative, its T to ~1e-8,
+since the maximum is flat).
 """
 
 from __future__ import annotations
