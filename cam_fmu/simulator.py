@@ -71,6 +71,7 @@ class DriveSimulator:
         self.h_next = min(self.h_max, 1e-4)  # rk45's first trial step [s]
         self.steps_taken = 0  # internal steps, for benchmarks
         self._etd: EtdCoefficients | None = None
+        self._outputs: dict[str, float] | None = None
         theta0, omega0, i0 = p["theta0"], p["omega0"], p["i0"]
         self.kind = "speed" if model.drive == "speed" else model.formulation
         if self.kind == "speed":
@@ -87,6 +88,7 @@ class DriveSimulator:
         """Inputs used by ``outputs`` before the first step [V, rad/s]."""
         self.u = _finite("u", u)
         self.omega_ref = _finite("omega_ref", omega_ref)
+        self._outputs = None
 
     def do_step(self, t: float, h: float, u: float, omega_ref: float) -> None:
         """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation)."""
@@ -103,6 +105,7 @@ class DriveSimulator:
         else:
             self._step_hybrid(h, u)
         self.time = t + h
+        self._outputs = None
         for name, value in self.outputs().items():
             if not math.isfinite(value):
                 raise SimulationError(
@@ -110,12 +113,16 @@ class DriveSimulator:
                     f"{self.solver!r}, h_max = {self.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
 
     def outputs(self) -> dict[str, float]:
-        """Current value of every output in OUTPUTS."""
-        if self.kind == "speed":
-            return speed_drive_outputs(self.model, self.theta, self.omega_ref, 0.0, self.s, self._speed_engaged())
-        if self.kind == "paper":
-            return self.scheme.outputs()
-        return self.hybrid.outputs(self.y, self.u, self.mode)
+        """Current value of every output in OUTPUTS (computed once per state)."""
+        if self._outputs is None:
+            if self.kind == "speed":
+                out = speed_drive_outputs(self.model, self.theta, self.omega_ref, 0.0, self.s, self._speed_engaged())
+            elif self.kind == "paper":
+                out = self.scheme.outputs()
+            else:
+                out = self.hybrid.outputs(self.y, self.u, self.mode)
+            self._outputs = out
+        return self._outputs
 
     def get_state(self) -> dict[str, Any]:
         """Complete internal state, JSON-serialisable."""
@@ -132,6 +139,7 @@ class DriveSimulator:
         return state
 
     def set_state(self, state: Mapping[str, Any]) -> None:
+        self._outputs = None
         self.time = float(state["time"])
         self.u = float(state["u"])
         self.omega_ref = float(state["omega_ref"])
@@ -218,10 +226,15 @@ class DriveSimulator:
     def _fixed_step_size(self, y, mode: Mode) -> float:
         """h_max, cut to the explicit method's stability limit at this state [s]."""
         model = self.model
-        s, s1, s2, _ = model.program.derivatives(y[0])
+        s, s1, s2, s3 = model.program.derivatives(y[0])
         engaged = mode.contact != 0
         J = model.J_m + (model.m * s1 * s1 if engaged else 0.0)
-        rate = 2.0 * model.m * abs(s1 * s2 * y[1]) / J if engaged else 0.0
+        rate = 0.0
+        if engaged:
+            # d(omega_dot)/d(omega), and the theta-omega oscillation that the
+            # profile's curvature makes: frequency |omega| sqrt(m (s2^2 + |s1 s3|) / J).
+            rate = (2.0 * model.m * abs(s1 * s2 * y[1])
+                    + abs(y[1]) * math.sqrt(model.m * J * (s2 * s2 + abs(s1 * s3)))) / J
         if model.L > 0.0:
             if self.solver != "etdrk4":
                 rate += model.R / model.L + math.sqrt(model.c_e * model.c_m / (J * model.L))
