@@ -24,6 +24,7 @@ from typing import Sequence
 SUBCOMMAND_MODULES: list[str] = [
     "cam_fmu.cli",          # curve
     "cam_fmu.host_env",     # host-env (environment line for native FMU hosts)
+    "cam_fmu.simulate_cli", # simulate (run a scene file: CSV + figure)
 ]
 
 

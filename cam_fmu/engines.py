@@ -1,0 +1,131 @@
+"""Run a scene's runs on an engine: the scipy reference or the FMU (through fmpy).
+
+``run_scene(scene, engine)`` returns ``{label: {"time": array, <output>: array, ...}}``
+in the order of the scene's runs (the first is the primary run). Every result
+holds 'time' and every name of simulator.OUTPUTS, in SI units.
+
+- ``reference``: reference.simulate_reference with the run's parameters and the
+  scene's input signals (continuous in time, breaks located exactly).
+- ``fmu``: models/cam.fmu (built with build_fmu.build() first when missing)
+  simulated by fmpy.simulate_fmu: start values = the run's parameter overrides,
+  input = the scene's signals as a table (fmpy applies them at each
+  communication point and the FMU holds them over the step), communication
+  step = the scene's output interval. A run that stops before stop_time (fmpy
+  treats an fmi2Discard as a silent early stop) raises EngineError.
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .scenes import Run, Scene
+from .signals import Signal, as_table
+from .simulator import OUTPUTS
+
+ENGINES = ("reference", "fmu")
+REPO_ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_FMU = REPO_ROOT / "models" / "cam.fmu"
+OUTPUT_NAMES = tuple(name for name, _unit, _desc in OUTPUTS)
+
+
+class EngineError(RuntimeError):
+    """A run that did not complete; the message names the scene, the run and the engine."""
+
+
+def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | None = None) -> dict[str, dict[str, np.ndarray]]:
+    """Every run of ``scene`` on ``engine`` ('reference' or 'fmu'), keyed by run label."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine {engine!r}: allowed {', '.join(map(repr, ENGINES))}")
+    if engine == "reference":
+        return {run.label: _reference(scene, run) for run in scene.runs}
+    fmu = ensure_fmu(fmu_path)
+    return {run.label: _fmu(scene, run, fmu) for run in scene.runs}
+
+
+# ------------------------------------------------------------------ reference
+def _reference(scene: Scene, run: Run) -> dict[str, np.ndarray]:
+    from .reference import simulate_reference  # scipy: only on this path
+
+    try:
+        return simulate_reference(run.overrides, scene.stop_time, scene.output_interval,
+                                  u=scene.u, omega_ref=scene.omega_ref)
+    except Exception as exc:  # noqa: BLE001 - re-raised with the scene and run named
+        raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'reference': {exc}") from exc
+
+
+# ------------------------------------------------------------------------ fmu
+def ensure_fmu(fmu_path: str | Path | None = None) -> Path:
+    """Path of the FMU; the default models/cam.fmu is built with build_fmu.build() when missing."""
+    path = Path(fmu_path) if fmu_path else DEFAULT_FMU
+    if path.is_file():
+        return path
+    if fmu_path:
+        raise EngineError(f"FMU {str(path)!r} does not exist")
+    script = REPO_ROOT / "build_fmu.py"
+    if not script.is_file():
+        raise EngineError(f"{path} is missing and there is no {script} to build it")
+    spec = importlib.util.spec_from_file_location("build_fmu", script)
+    module = importlib.util.module_from_spec(spec)
+    assert spec.loader is not None
+    spec.loader.exec_module(module)
+    return Path(module.build(path))
+
+
+def input_table(scene: Scene) -> np.ndarray | None:
+    """The scene's input signals as fmpy's structured input array (time, u, omega_ref).
+
+    Jumps are repeated time stamps (left value, then right value), as fmpy reads them.
+    """
+    signals = {name: sig for name, sig in (("u", scene.u), ("omega_ref", scene.omega_ref)) if sig is not None}
+    if not signals:
+        return None
+    stop = scene.stop_time
+    times: set[float] = {0.0, stop}
+    for sig in signals.values():
+        times.update(t for t in as_table(sig, stop)[0] if 0.0 <= t <= stop)
+    rows: list[tuple[float, ...]] = []
+    for t in sorted(times):
+        jump = any(_jumps_at(sig, t) for sig in signals.values())
+        if jump and t > 0.0:
+            rows.append((t, *(_left_value(sig, t) for sig in signals.values())))
+        rows.append((t, *(sig.value(t) for sig in signals.values())))
+    dtype = [("time", np.float64)] + [(name, np.float64) for name in signals]
+    return np.array(rows, dtype=dtype)
+
+
+def _jumps_at(sig: Signal, t: float) -> bool:
+    return sig.hold and t in sig.times or sig.times.count(t) > 1
+
+
+def _left_value(sig: Signal, t: float) -> float:
+    k = sig.times.index(t)
+    if sig.hold:
+        return sig.values[k - 1] if k else sig.values[0]
+    return sig.values[k]  # first of the repeated stamps: the value before the jump
+
+
+def _fmu(scene: Scene, run: Run, fmu: Path) -> dict[str, np.ndarray]:
+    from fmpy import simulate_fmu  # heavy: only on this path
+
+    reached = [0.0]
+
+    def step_finished(time: float, _recorder: Any) -> bool:
+        reached[0] = time
+        return True
+
+    try:
+        result = simulate_fmu(
+            str(fmu), start_time=0.0, stop_time=scene.stop_time, output_interval=scene.output_interval,
+            start_values=run.start_values(), input=input_table(scene), output=list(OUTPUT_NAMES),
+            step_finished=step_finished,
+        )
+    except Exception as exc:  # noqa: BLE001 - re-raised with the scene and run named
+        raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu' ({fmu}): {exc}") from exc
+    if not math.isclose(reached[0], scene.stop_time, rel_tol=1e-9, abs_tol=1e-12):
+        raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu': the FMU stopped at "
+                          f"t = {reached[0]:g} s before stop_time = {scene.stop_time:g} s")
+    return {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}
