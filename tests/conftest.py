@@ -1,0 +1,63 @@
+"""Shared fixtures. Others may append fixtures below; keep existing ones intact."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+# --------------------------------------------------------------------------- cam.fmu
+def _build_fmu(dest: Path) -> Path:
+    """Build cam.fmu with build_fmu.py in a subprocess.
+
+    A subprocess, because building imports the slave script as a top-level module
+    (``camdrive_fmu_slave``) and pythonfmu inserts folders into sys.path: neither
+    may leak into the test process.
+    """
+    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--dest", str(dest)]
+    package_dir = os.environ.get("CAM_FMU_BUILD_PACKAGE_DIR")  # developers only: build from another tree
+    if package_dir:
+        cmd += ["--package-dir", package_dir]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
+    if proc.returncode != 0 or not dest.is_file():
+        pytest.fail(f"build_fmu.py failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+    return dest
+
+
+@pytest.fixture(scope="session")
+def cam_fmu_path(tmp_path_factory) -> Path:
+    """cam.fmu built once per test session from this checkout (into a temporary folder).
+
+    Load it only in subprocesses (see ``run_fmu_script``): an FMU loaded into the
+    pytest process puts its extraction folder on sys.path and may bind the
+    top-level name ``cam_fmu`` to its bundled copy, which hides bugs in the bundle
+    and breaks later imports of unbundled modules in other tests.
+    """
+    return _build_fmu(tmp_path_factory.mktemp("cam_fmu_build") / "cam.fmu")
+
+
+def run_fmu_script(script: Path, *args: str, cwd: Path | None = None, timeout: float = 300,
+                   python_args: tuple[str, ...] = ()) -> dict:
+    """Run ``python [python_args] script args...`` and return the JSON object it prints last.
+
+    Fails the test (with the child's output) on a non-zero exit status: a crash of
+    the host process is a failure, not a skip.
+    """
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    proc = subprocess.run([sys.executable, *python_args, str(script), *args], capture_output=True, text=True,
+                          cwd=cwd, env=env, timeout=timeout)
+    if proc.returncode != 0:
+        pytest.fail(f"{script.name} {' '.join(args)} exited with {proc.returncode}\n"
+                    f"--- stdout\n{proc.stdout[-4000:]}\n--- stderr\n{proc.stderr[-4000:]}")
+    lines = [line for line in proc.stdout.splitlines() if line.startswith("{")]
+    if not lines:
+        pytest.fail(f"{script.name} printed no JSON result\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    result = json.loads(lines[-1])
+    result["_stderr"] = proc.stderr
+    return result
