@@ -1,0 +1,153 @@
+"""cam.fmu as built by build_fmu.py: model description, bundle, run without cam_fmu installed."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import zipfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import pytest
+
+from cam_fmu import parameters  # the pytest process may import cam_fmu: it never loads the FMU
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def md_root(cam_fmu_path):
+    with zipfile.ZipFile(cam_fmu_path) as z:
+        return ET.fromstring(z.read("modelDescription.xml"))
+
+
+def test_validate_fmu_reports_no_problem(cam_fmu_path):
+    from fmpy.validation import validate_fmu  # reads the XML only; does not load the binary
+    assert validate_fmu(str(cam_fmu_path)) == []
+
+
+def test_default_build_target_is_models_cam_fmu():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("build_fmu_under_test", ROOT / "build_fmu.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.DEFAULT_DEST == ROOT / "models" / "cam.fmu"
+
+
+def test_model_description_complete(md_root):
+    assert md_root.get("modelName") == "cam" and md_root.get("description")
+    cs = md_root.find("CoSimulation")
+    assert cs.get("modelIdentifier") == "cam"
+    assert cs.get("canGetAndSetFMUstate") == "true" and cs.get("canSerializeFMUstate") == "true"
+    exp = md_root.find("DefaultExperiment")
+    assert (float(exp.get("startTime")), float(exp.get("stopTime")), float(exp.get("stepSize"))) == (0.0, 2.0, 1e-3)
+    units = {u.get("name") for u in md_root.find("UnitDefinitions")}
+    variables = md_root.find("ModelVariables").findall("ScalarVariable")
+    by_name = {v.get("name"): v for v in variables}
+    for index, v in enumerate(variables, start=1):
+        assert v.get("causality") and v.get("variability"), v.get("name")
+        if v.get("causality") != "input":  # FMI 2.0 forbids 'initial' on inputs
+            assert v.get("initial"), v.get("name")
+        real = v.find("Real")
+        if real is not None and real.get("unit"):
+            assert real.get("unit") in units
+    # every parameter under its own name, unit, start and kind
+    for spec in parameters.PARAMETERS:
+        v = by_name[spec.name]
+        assert v.get("causality") == "parameter" and v.get("variability") == "fixed"
+        kind = {"real": "Real", "boolean": "Boolean", "string": "String"}[spec.kind]
+        typed = v.find(kind)
+        assert typed is not None, spec.name
+        if spec.kind == "real":
+            assert float(typed.get("start")) == spec.default  # exact: written with repr
+            if spec.unit:
+                assert typed.get("unit") == spec.unit
+        elif spec.kind == "boolean":
+            assert typed.get("start") == ("true" if spec.default else "false")
+        else:
+            assert typed.get("start") == spec.default
+    # inputs and outputs
+    assert by_name["u"].get("causality") == "input" and float(by_name["u"].find("Real").get("start")) == 3.5
+    assert by_name["u"].find("Real").get("unit") == "V"
+    assert by_name["omega_ref"].get("causality") == "input"
+    index_of = {v.get("name"): k for k, v in enumerate(variables, start=1)}
+    outputs = {n for n, v in by_name.items() if v.get("causality") == "output"}
+    assert {"omega", "theta", "s", "i", "M", "J", "v", "a", "alpha", "s_cam"} <= outputs
+    structure = md_root.find("ModelStructure")
+    listed = {int(u.get("index")) for u in structure.find("Outputs")}
+    initial = {int(u.get("index")) for u in structure.find("InitialUnknowns")}
+    assert listed == initial == {index_of[n] for n in outputs}
+    assert by_name["omega"].find("Real").get("unit") == "rad/s"
+
+
+def test_bundle_holds_only_numpy_only_modules(cam_fmu_path):
+    with zipfile.ZipFile(cam_fmu_path) as z:
+        names = z.namelist()
+        bundled = {n for n in names if n.startswith("resources/cam_fmu/")}
+        sources = {n: z.read(n).decode("utf-8") for n in bundled if n.endswith(".py")}
+    assert "resources/camdrive_fmu_slave.py" in names
+    assert {"resources/cam_fmu/parameters.py", "resources/cam_fmu/simulator.py"} <= bundled
+    for unwanted in ("reference.py", "cli.py", "curve_plots.py", "fmu_xml.py", "ecos_host.py", "host_env.py"):
+        assert f"resources/cam_fmu/{unwanted}" not in bundled
+    for name, text in sources.items():
+        for heavy in ("scipy", "matplotlib"):
+            assert f"import {heavy}" not in text and f"from {heavy}" not in text, (name, heavy)
+
+
+ISOLATED_RUN = r"""
+import json, sys
+sys.path.extend(json.loads(sys.argv[1]))       # site-packages only: no .pth files, no editable cam_fmu
+try:
+    import cam_fmu
+    importable = cam_fmu.__file__
+except ImportError:
+    importable = None
+from fmpy import simulate_fmu
+import numpy as np
+res = simulate_fmu("cam.fmu", output_interval=1e-3)
+mod = sys.modules.get("cam_fmu")
+print(json.dumps({
+    "importable_before": importable,
+    "stop": float(res["time"][-1]),
+    "finite": bool(all(np.all(np.isfinite(res[n])) for n in res.dtype.names)),
+    "omega_end": float(res["omega"][-1]),
+    "cam_fmu_file": getattr(mod, "__file__", None),
+    "scipy_loaded": any(m.split(".")[0] == "scipy" for m in sys.modules),
+}))
+"""
+
+
+def test_fmu_runs_where_cam_fmu_is_not_importable(cam_fmu_path, tmp_path):
+    shutil.copyfile(cam_fmu_path, tmp_path / "cam.fmu")
+    site_dirs = [p for p in {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}]
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    # -I: no PYTHONPATH, no cwd/script dir, no user site; -S: no site-packages .pth (the editable install)
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", ISOLATED_RUN, json.dumps(site_dirs)],
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    r = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert r["importable_before"] is None, f"cam_fmu importable in the isolated process: {r['importable_before']}"
+    assert r["stop"] == pytest.approx(2.0, abs=1e-12), "the run stopped before its stop time"
+    assert r["finite"] and r["omega_end"] > 0.5
+    # the FMU ran its bundled copy (extracted by fmpy into a temporary folder), not a checkout
+    assert r["cam_fmu_file"] and not r["cam_fmu_file"].startswith(str(ROOT))
+    assert "resources" in r["cam_fmu_file"]
+    assert not r["scipy_loaded"]
+
+
+def test_build_refuses_scipy_in_the_bundle(tmp_path):
+    """The import closure check is live: a bundled module importing scipy fails the build."""
+    pkg = tmp_path / "cam_fmu"
+    shutil.copytree(ROOT / "cam_fmu", pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    sim = pkg / "simulator.py"
+    sim.write_text(sim.read_text(encoding="utf-8") + "\nimport scipy.integrate  # noqa\n", encoding="utf-8")
+    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--package-dir", str(pkg),
+                           "--dest", str(tmp_path / "out" / "cam.fmu")], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=300)
+    assert proc.returncode != 0
+    assert "scipy" in proc.stderr
+    assert not (tmp_path / "out" / "cam.fmu").exists()
