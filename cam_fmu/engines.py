@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from .scenes import Run, Scene
-from .signals import Signal, as_table
-from .simulator import OUTPUTS
+from .signals import Signal, as_table, constant
+from .simulator import INPUTS, OUTPUTS
 
 ENGINES = ("reference", "fmu")
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -75,14 +75,14 @@ def ensure_fmu(fmu_path: str | Path | None = None) -> Path:
     return Path(module.build(path))
 
 
-def input_table(scene: Scene) -> np.ndarray | None:
+def input_table(scene: Scene) -> np.ndarray:
     """The scene's input signals as fmpy's structured input array (time, u, omega_ref).
 
     Jumps are repeated time stamps (left value, then right value), as fmpy reads them.
     """
-    signals = {name: sig for name, sig in (("u", scene.u), ("omega_ref", scene.omega_ref)) if sig is not None}
-    if not signals:
-        return None
+    given = {"u": scene.u, "omega_ref": scene.omega_ref}
+    # An input the scene does not give is held at the FMU's start value (the drive ignores it).
+    signals = {name: given[name] or constant(start) for name, _unit, start, _desc in INPUTS}
     stop = scene.stop_time
     times: set[float] = {0.0, stop}
     for sig in signals.values():
@@ -102,6 +102,9 @@ def _jumps_at(sig: Signal, t: float) -> bool:
 
 
 def _left_value(sig: Signal, t: float) -> float:
+    """The value just before t (t > 0)."""
+    if not _jumps_at(sig, t):
+        return sig.value(t)
     k = sig.times.index(t)
     if sig.hold:
         return sig.values[k - 1] if k else sig.values[0]
