@@ -42,6 +42,7 @@ ERROR_CASES = {
     "unknown_solver": ({"solver": "bogus"}, None, "'solver'", "'rk45'"),
     "unknown_drive": ({"drive": "torque"}, None, "'drive'", "'speed'"),
     "angles_not_2pi": ({"rise_angle": 2.0}, None, "'rise_angle'", "2 pi"),
+    "max_steps_exceeded": ({"solver": "rk4", "h_max": 1e-5, "max_steps": 1.0}, None, "max_steps", "max_steps = 1"),
     "u_nan": ({}, ("u", float("nan")), "'u'", "finite"),
     "u_inf": ({}, ("u", float("inf")), "'u'", "finite"),
     "omega_ref_nan": ({"drive": "speed"}, ("omega_ref", float("nan")), "'omega_ref'", "finite"),
