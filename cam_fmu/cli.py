@@ -25,6 +25,7 @@ SUBCOMMAND_MODULES: list[str] = [
     "cam_fmu.cli",          # curve
     "cam_fmu.host_env",     # host-env (environment line for native FMU hosts)
     "cam_fmu.simulate_cli", # simulate (run a scene file: CSV + figure)
+    "cam_fmu.bench",        # bench (speed-accuracy benchmark of cam.fmu through fmpy)
 ]
 
 

@@ -1,0 +1,114 @@
+"""`python -m cam_fmu.bench --quick`: the CSV it writes, and physics it must show.
+
+The bench runs in a child process (it loads two pythonfmu FMUs, whose module
+names are process-global; the pytest process never loads an FMU). No wall-clock
+limits are asserted: timing on a shared machine is noisy. Only ratios measured
+in the same run are compared, and only where the margin is structural (a model
+that integrates a cam drive costs more than a do_step that returns at once).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
+           "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
+           "floor_us_per_step", "cost_ratio", "repeats", "error")
+QUICK_FMU_ROWS = {("euler", "h=0.001"), ("rk4", "h=0.001"), ("etdrk4", "h=0.001"),
+                  ("rk45", "rtol=1e-06"), ("rk45", "rtol=1e-10")}
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory, cam_fmu_path):
+    out = tmp_path_factory.mktemp("bench")
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env["MPLBACKEND"] = "Agg"
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.bench", "--quick", "--out", str(out),
+                           "--fmu", str(cam_fmu_path)],
+                          capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
+    if proc.returncode != 0:
+        pytest.fail(f"bench --quick exited with {proc.returncode}\n--- stdout\n{proc.stdout[-4000:]}\n"
+                    f"--- stderr\n{proc.stderr[-4000:]}")
+    with open(out / "bench.csv", newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        header = reader.fieldnames
+        rows = list(reader)
+    return {"out": out, "header": header, "rows": rows, "stdout": proc.stdout}
+
+
+def _num(row, key):
+    return float(row[key])
+
+
+def _fmu(rows, solver, setting):
+    found = [r for r in rows if r["kind"] == "fmu" and r["solver"] == solver and r["setting"] == setting]
+    assert len(found) == 1, (solver, setting, found)
+    return found[0]
+
+
+def test_csv_columns_and_rows(quick):
+    assert tuple(quick["header"]) == COLUMNS
+    rows = quick["rows"]
+    kinds = sorted(r["kind"] for r in rows)
+    assert kinds.count("floor") == 1 and kinds.count("ref") == 1 and kinds.count("fmu") == len(QUICK_FMU_ROWS)
+    assert {(r["solver"], r["setting"]) for r in rows if r["kind"] == "fmu"} == QUICK_FMU_ROWS
+    assert {r["case"] for r in rows} == {"fig6"}
+    assert {float(r["comm_step"]) for r in rows} == {1e-3}
+    for r in rows:
+        for key in ("us_per_step", "rtf", "cost_ratio", "wall_s"):
+            assert math.isfinite(_num(r, key)) and _num(r, key) > 0.0, (r, key)
+    assert (quick["out"] / "bench.png").stat().st_size > 10_000
+    assert (quick["out"] / "choices.csv").is_file()
+    # one printed row per run
+    printed = [line for line in quick["stdout"].splitlines() if re.match(r"fig6\s+(floor|ref|fmu)\s", line)]
+    assert len(printed) == len(rows)
+
+
+def test_every_run_reached_stop_time(quick):
+    for r in quick["rows"]:
+        assert r["status"] == "ok" and r["error"] == "", r
+        assert r["reached_stop"] == "True", r
+        assert math.isclose(_num(r, "t_end"), 2.0, rel_tol=1e-9), r
+        assert int(r["n_steps"]) == 2000
+
+
+def test_floor_ratio_is_one_and_models_cost_more(quick):
+    rows = quick["rows"]
+    floor = next(r for r in rows if r["kind"] == "floor")
+    assert _num(floor, "cost_ratio") == 1.0
+    assert _num(floor, "us_per_step") == _num(floor, "floor_us_per_step")
+    for r in rows:
+        if r["kind"] == "fmu":
+            assert _num(r, "floor_us_per_step") == _num(floor, "us_per_step")
+            assert math.isclose(_num(r, "cost_ratio"), _num(r, "us_per_step") / _num(floor, "us_per_step"),
+                                rel_tol=1e-9)
+            assert _num(r, "cost_ratio") > 1.0, r  # integrating a drive is more than returning True
+
+
+def test_rk45_error_falls_as_rtol_tightens(quick):
+    loose = _fmu(quick["rows"], "rk45", "rtol=1e-06")
+    tight = _fmu(quick["rows"], "rk45", "rtol=1e-10")
+    assert _num(tight, "theta_err") < 0.1 * _num(loose, "theta_err")
+    assert _num(tight, "omega_err") < _num(loose, "omega_err")
+
+
+def test_default_settings_meet_the_accuracy_target(quick):
+    default = [r for r in quick["rows"] if r["default"] == "True"]
+    assert len(default) == 1 and default[0]["solver"] == "rk45" and default[0]["setting"] == "rtol=1e-10"
+    assert _num(default[0], "theta_err") < 1e-6
+
+
+def test_euler_is_less_accurate_than_rk4(quick):
+    euler = _fmu(quick["rows"], "euler", "h=0.001")
+    rk4 = _fmu(quick["rows"], "rk4", "h=0.001")
+    assert _num(euler, "theta_err") > 10.0 * _num(rk4, "theta_err")
+    # both are finite, bounded errors: a run over 2 s turns the cam ~13 rad
+    assert _num(euler, "theta_err") < 13.0
