@@ -43,7 +43,7 @@ def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | No
     if engine == "reference":
         return {run.label: _reference(scene, run) for run in scene.runs}
     fmu = ensure_fmu(fmu_path)
-    return {run.label: _fmu(scene, run, fmu) for run in scene.runs}
+    return _fmu_runs(scene, fmu)
 
 
 # ------------------------------------------------------------------ reference
@@ -111,7 +111,39 @@ def _left_value(sig: Signal, t: float) -> float:
     return sig.values[k]  # first of the repeated stamps: the value before the jump
 
 
-def _fmu(scene: Scene, run: Run, fmu: Path) -> dict[str, np.ndarray]:
+def _fmu_runs(scene: Scene, fmu: Path) -> dict[str, dict[str, np.ndarray]]:
+    """All runs on one instance of the FMU, reset between runs.
+
+    The FMU is extracted and its library loaded once per scene (fmpy's default
+    path instantiates and frees an instance per run).
+    """
+    import shutil
+    import tempfile
+
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(fmu))
+    workdir = tempfile.mkdtemp(prefix="cam_fmu_scene_")
+    try:
+        unzipdir = extract(str(fmu), unzipdir=workdir)
+        instance = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=scene.name)
+        instance.instantiate()
+        results = {}
+        for k, run in enumerate(scene.runs):
+            if k:
+                instance.reset()
+            results[run.label] = _fmu(scene, run, fmu, unzipdir, md, instance)
+        # No fmi2FreeInstance: with it, the process aborted at exit in about half of the
+        # runs under pytest ("corrupted double-linked list"); without it, never. The
+        # instance goes with the process.
+        return results
+    finally:
+        shutil.rmtree(workdir, ignore_errors=True)
+
+
+def _fmu(scene: Scene, run: Run, fmu: Path, unzipdir: str, md: Any, instance: Any) -> dict[str, np.ndarray]:
     from fmpy import simulate_fmu  # heavy: only on this path
 
     reached = [0.0]
@@ -122,7 +154,8 @@ def _fmu(scene: Scene, run: Run, fmu: Path) -> dict[str, np.ndarray]:
 
     try:
         result = simulate_fmu(
-            str(fmu), start_time=0.0, stop_time=scene.stop_time, output_interval=scene.output_interval,
+            unzipdir, model_description=md, fmu_instance=instance, start_time=0.0,
+            stop_time=scene.stop_time, output_interval=scene.output_interval,
             start_values=run.start_values(), input=input_table(scene), output=list(OUTPUT_NAMES),
             step_finished=step_finished,
         )

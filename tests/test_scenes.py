@@ -227,7 +227,7 @@ def test_cli_fmu_engine_matches_reference(tmp_path, cam_fmu_path):
         cmd = [sys.executable, "-m", "cam_fmu.cli", "simulate", str(SCENES["paper_fig6"]), "--engine", engine,
                "--fmu", str(cam_fmu_path), "--out", str(out), "--stop-time", "0.3", "--no-plot"]
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
-        assert proc.returncode == 0, proc.stderr[-3000:]
+        assert proc.returncode == 0, (engine, proc.stderr[-3000:])
         outs[engine] = {name: _read_csv(out / name) for name in ("paper_fig6.csv", "paper_fig6__paper.csv")}
     for name in ("paper_fig6.csv", "paper_fig6__paper.csv"):
         (h_fmu, fmu), (h_ref, ref) = outs["fmu"][name], outs["reference"][name]
