@@ -235,3 +235,15 @@ def test_cli_fmu_engine_matches_reference(tmp_path, cam_fmu_path):
         omega = h_ref.index("omega")
         assert np.allclose(fmu[:, 0], ref[:, 0], atol=1e-12)
         assert np.max(np.abs(fmu[:, omega] - ref[:, omega])) < 1e-4 * np.max(np.abs(ref[:, omega])), name
+
+
+def test_readme_documents_every_parameter_and_scene():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## The drive model", 1)[1].split("\n## ", 1)[0]
+    from cam_fmu.parameters import PARAMETERS
+    for p in PARAMETERS:
+        unit = p.unit if p.unit else "-"
+        assert f"| `{p.name}` | {unit} |" in section, f"README parameter table lacks {p.name} [{unit}]"
+    scenes = text.split("## Scenes and the simulate command", 1)[1].split("\n## ", 1)[0]
+    for name in SCENES:
+        assert f"| `{name}` |" in scenes, f"README scene table lacks {name}"
