@@ -27,11 +27,23 @@ DEFAULTS = dict(R=19.0, c_e=0.146, c_m=0.015 * 9.80665, J_m=4.41e-5, M_f=0.012, 
                 mu=0.001, r_b=0.1)
 
 
+def _x_minus_sin(x: float) -> float:
+    """x - sin(x) without cancellation for small x (series to x^15 below 0.5)."""
+    if abs(x) >= 0.5:
+        return x - math.sin(x)
+    total, term, k = 0.0, x, 1
+    while k < 15:
+        term *= -x * x / ((k + 1) * (k + 2))
+        total -= term
+        k += 2
+    return total
+
+
 def _rise(t: float) -> tuple[float, float, float]:
     """(s, s', s'') of the rise on [0, pi]."""
     q = math.pi / 4
     if t <= q:
-        return A * (t - math.sin(4 * t) / 4), A * (1 - math.cos(4 * t)), 4 * A * math.sin(4 * t)
+        return A * _x_minus_sin(4 * t) / 4, 2 * A * math.sin(2 * t) ** 2, 4 * A * math.sin(4 * t)
     if t <= 3 * q:
         return 2 * A * t - math.pi * A / 4, 2 * A, 0.0
     return A * (t - math.sin(4 * t) / 4) + math.pi * A / 2, A * (1 - math.cos(4 * t)), 4 * A * math.sin(4 * t)
@@ -77,6 +89,9 @@ def test_closed_form_profile_is_continuous_and_periodic():
         assert lo[1] == pytest.approx(hi[1], abs=1e-8)
     assert paper_profile(math.pi)[0] == pytest.approx(H, abs=1e-15)
     assert paper_profile(math.pi / 2)[1] == 2 * A  # peak ds/dtheta = 2 A
+    x = 0.3
+    assert _x_minus_sin(x) == pytest.approx(x - math.sin(x), rel=1e-14)
+    assert _x_minus_sin(1e-4) == pytest.approx(1e-12 / 6 - 1e-20 / 120, rel=1e-15)
 
 
 def test_cam_program_matches_the_paper_profile():
