@@ -66,63 +66,83 @@ def dopri_step(f: Derivative, y: Vector, h: float, k1: tuple | None = None) -> t
     return y5, err, k7
 
 
-def phi_functions(z: float) -> tuple[float, float, float, float]:
-    """(e^z, phi1, phi2, phi3) with phi_k(z) = sum_n z^n / (n + k)!, stable near 0."""
-    if abs(z) < 0.5:
-        p1 = p2 = p3 = 0.0
+def phi_functions(z: float) -> tuple[float, float, float, float, float]:
+    """(e^z, phi1, phi2, phi3, phi4) with phi_k(z) = sum_n z^n / (n + k)!, stable near 0."""
+    if abs(z) < 1.0:
+        p = [0.0, 0.0, 0.0, 0.0]
         term = 1.0  # z^n / n!
-        for n in range(25):
-            p1 += term / (n + 1)
-            p2 += term / ((n + 1) * (n + 2))
-            p3 += term / ((n + 1) * (n + 2) * (n + 3))
+        for n in range(30):
+            denom = 1.0
+            for k in range(4):
+                denom *= n + k + 1
+                p[k] += term / denom
             term *= z / (n + 1)
-        return math.exp(z), p1, p2, p3
+        return (math.exp(z), *p)
     ez = math.exp(z)
     p1 = (ez - 1.0) / z
-    p2 = (ez - 1.0 - z) / (z * z)
-    p3 = (ez - 1.0 - z - 0.5 * z * z) / (z * z * z)
-    return ez, p1, p2, p3
+    p2 = (p1 - 1.0) / z
+    p3 = (p2 - 0.5) / z
+    p4 = (p3 - 1.0 / 6.0) / z
+    return ez, p1, p2, p3, p4
 
 
-class EtdCoefficients:
-    """Cox-Matthews ETDRK4 weights for a diagonal linear part c [1/s] and step h [s]."""
+class MotorEtdCoefficients:
+    """ETDRK4 weights for the motor's linear part on (omega, e) and step h [s].
 
-    def __init__(self, rates: Sequence[float], h: float) -> None:
-        self.h = h
-        self.rates = tuple(rates)
-        self.e_half, self.phi_half, self.e_full, self.f1, self.f2, self.f3 = [], [], [], [], [], []
-        for c in self.rates:
-            eh, p1h, _, _ = phi_functions(0.5 * c * h)
-            ez, p1, p2, p3 = phi_functions(c * h)
-            self.e_half.append(eh)
-            self.phi_half.append(p1h)
-            self.e_full.append(ez)
-            self.f1.append(p1 - 3.0 * p2 + 4.0 * p3)
-            self.f2.append(p2 - 2.0 * p3)
-            self.f3.append(-p2 + 4.0 * p3)
-
-
-def etdrk4_step(f: Derivative, y: Vector, coef: EtdCoefficients) -> list[float]:
-    """Exponential RK4 (Cox and Matthews 2002): the linear part c y is exact.
-
-    ``f`` is the full derivative; the nonlinear part is N(y) = f(y) - c y.
-    With every rate 0 this is the classical RK4.
+    The linear part is [[0, a], [0, c]]: e is the current's deviation from its
+    quasi-static value, c = -R/L [1/s] its decay rate and a = c_m / J [1/(A s2)]
+    its torque on omega (a changes every step, c and h do not). A function F
+    of h[[0, a], [0, c]] is [[F(0), a h (F(ch) - F(0)) / (ch)], [0, F(ch)]];
+    the divided differences of phi_k are phi_(k+1).
     """
-    h, rates = coef.h, coef.rates
+
+    def __init__(self, c: float, h: float) -> None:
+        self.h = h
+        self.c = c
+        ez, p1, p2, p3, p4 = phi_functions(c * h)
+        eh, q1, q2, _, _ = phi_functions(0.5 * c * h)
+        self.e_full, self.e_half = ez, eh
+        self.dd_e_full, self.dd_e_half = p1, q1  # divided differences of exp
+        self.phi_half, self.dd_phi_half = q1, q2
+        self.f = (p1 - 3.0 * p2 + 4.0 * p3, p2 - 2.0 * p3, -p2 + 4.0 * p3)
+        self.dd_f = (p2 - 3.0 * p3 + 4.0 * p4, p3 - 2.0 * p4, -p3 + 4.0 * p4)
+
+
+def etdrk4_motor_step(f: Derivative, y: Vector, coef: MotorEtdCoefficients, a: float) -> list[float]:
+    """Exponential RK4 (Cox and Matthews 2002) on (theta, omega, e).
+
+    The linear part [[0, a], [0, c]] on (omega, e) is integrated exactly, so the
+    electrical pole c = -R/L and the torque of the decaying current transient
+    on omega stay exact at any step; theta is plain RK4.
+    """
+    h, c = coef.h, coef.c
     hh = 0.5 * h
+    a_half = a * hh
+    a_full = a * h
 
     def nonlinear(v):
-        return [d - c * x for d, c, x in zip(f(v), rates, v)]
+        d = f(v)
+        return (d[0], d[1] - a * v[2], d[2] - c * v[2])
+
+    def half(v, n):  # e^(M/2) v + (h/2) phi1(M/2) n on the block, RK4 stage on theta
+        return (
+            v[0] + hh * n[0],
+            v[1] + a_half * coef.dd_e_half * v[2] + hh * (n[1] + a_half * coef.dd_phi_half * n[2]),
+            coef.e_half * v[2] + hh * coef.phi_half * n[2],
+        )
 
     n_y = nonlinear(y)
-    a = [eh * x + hh * p * n for eh, p, x, n in zip(coef.e_half, coef.phi_half, y, n_y)]
-    n_a = nonlinear(a)
-    b = [eh * x + hh * p * n for eh, p, x, n in zip(coef.e_half, coef.phi_half, y, n_a)]
-    n_b = nonlinear(b)
-    cc = [eh * x + hh * p * (2.0 * nb - ny) for eh, p, x, nb, ny in zip(coef.e_half, coef.phi_half, a, n_b, n_y)]
-    n_c = nonlinear(cc)
-    return [
-        e * x + h * (w1 * ny + 2.0 * w2 * (na + nb) + w3 * nc)
-        for e, w1, w2, w3, x, ny, na, nb, nc in zip(
-            coef.e_full, coef.f1, coef.f2, coef.f3, y, n_y, n_a, n_b, n_c)
-    ]
+    st_a = half(y, n_y)
+    n_a = nonlinear(st_a)
+    st_b = half(y, n_a)
+    n_b = nonlinear(st_b)
+    st_c = half(st_a, tuple(2.0 * p - q for p, q in zip(n_b, n_y)))
+    n_c = nonlinear(st_c)
+    (f1, f2, f3), (g1, g2, g3) = coef.f, coef.dd_f
+    w = 1.0 / 6.0  # F(0) of f1, f2, f3
+    theta = y[0] + h * (w * n_y[0] + 2.0 * w * (n_a[0] + n_b[0]) + w * n_c[0])
+    omega = (y[1] + a_full * coef.dd_e_full * y[2]
+             + h * (w * n_y[1] + 2.0 * w * (n_a[1] + n_b[1]) + w * n_c[1])
+             + h * a_full * (g1 * n_y[2] + 2.0 * g2 * (n_a[2] + n_b[2]) + g3 * n_c[2]))
+    e = coef.e_full * y[2] + h * (f1 * n_y[2] + 2.0 * f2 * (n_a[2] + n_b[2]) + f3 * n_c[2])
+    return [theta, omega, e]

@@ -25,7 +25,7 @@ from typing import Any, Mapping
 
 from .drive_model import DriveModel
 from .hybrid import HybridDrive, Mode, play, speed_drive_outputs
-from .integrators import EtdCoefficients, dopri_step, etdrk4_step, euler_step, rk4_step
+from .integrators import MotorEtdCoefficients, dopri_step, etdrk4_motor_step, euler_step, rk4_step
 from .paper_scheme import PaperScheme
 
 INPUTS: tuple[tuple[str, str, float, str], ...] = (
@@ -70,7 +70,7 @@ class DriveSimulator:
         self.omega_ref = INPUTS[1][2]
         self.h_next = min(self.h_max, 1e-4)  # rk45's first trial step [s]
         self.steps_taken = 0  # internal steps, for benchmarks
-        self._etd: EtdCoefficients | None = None
+        self._etd: MotorEtdCoefficients | None = None
         self._outputs: dict[str, float] | None = None
         theta0, omega0, i0 = p["theta0"], p["omega0"], p["i0"]
         self.kind = "speed" if model.drive == "speed" else model.formulation
@@ -250,11 +250,30 @@ class DriveSimulator:
             return rk4_step(f, y, dt)
         if self.solver == "rk45":
             return dopri_step(f, y, dt)[0]
+        if not self.hybrid.has_current:
+            return rk4_step(f, y, dt)  # ETDRK4 with no linear part is the classical RK4
+        # ETD on the current's deviation e = i - (u - c_e omega) / R from its
+        # quasi-static value: de/dt = -(R/L) e + (c_e/R) omega_dot, and on e's
+        # torque c_m e / J on omega. The forcing stays bounded as L -> 0, so the
+        # stiff limit and the fast transient after a break-away are exact.
+        # Measured before: ETD on i alone lags the back-EMF by one step (order 1,
+        # 2.4e-2 rad at 1 ms with L = 1e-6 H) and a diagonal ETD on e still
+        # missed the transient's torque (7e-3 rad).
+        model, u = self.model, self.u
+        R, ce, rate = model.R, model.c_e, model.R / model.L
         coef = self._etd
         if coef is None or coef.h != dt:
-            rates = (0.0, 0.0, -self.model.R / self.model.L) if self.hybrid.has_current else (0.0, 0.0)
-            coef = self._etd = EtdCoefficients(rates, dt)
-        return etdrk4_step(f, y, coef)
+            coef = self._etd = MotorEtdCoefficients(-rate, dt)
+        s1 = model.program.derivatives(y[0])[1]
+        a = model.c_m / (model.J_m + (model.m * s1 * s1 if self.mode.contact != 0 else 0.0))
+
+        def deviation_rate(z):
+            i = (u - ce * z[1]) / R + z[2]
+            d = f((z[0], z[1], i))
+            return (d[0], d[1], -rate * z[2] + ce / R * d[1])
+
+        z = etdrk4_motor_step(deviation_rate, (y[0], y[1], y[2] - (u - ce * y[1]) / R), coef, a)
+        return [z[0], z[1], z[2] + (u - ce * z[1]) / R]
 
     def _adaptive_step(self, f, y, remaining: float, k1):
         """One accepted Dormand-Prince step: (dt, y_new, f(y_new))."""
