@@ -149,6 +149,7 @@ class CamDriveSlave(Fmi2Slave):
     def _build(self) -> None:
         try:
             sim = _simulator.DriveSimulator(self._params)
+            sim.set_inputs(**self._inputs)  # initial outputs see the inputs set before initialisation
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
             self._fail(str(exc))
         self._publish(sim, sim.outputs())
@@ -175,7 +176,7 @@ class CamDriveSlave(Fmi2Slave):
             if not math.isfinite(value):
                 self._fail(f"input {name!r} = {value!r} is not finite: allowed any finite value")
         try:
-            self._sim.do_step(current_time, step_size, self._inputs["u"], self._inputs["omega_ref"])
+            self._sim.do_step(current_time, step_size, **self._inputs)
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
             self._fail(f"at t = {current_time!r} s: {exc}")
         self._publish(self._sim, self._sim.outputs())

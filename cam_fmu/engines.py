@@ -76,11 +76,12 @@ def ensure_fmu(fmu_path: str | Path | None = None) -> Path:
 
 
 def input_table(scene: Scene) -> np.ndarray:
-    """The scene's input signals as fmpy's structured input array (time, u, omega_ref).
+    """The scene's input signals as fmpy's structured input array (time, u, omega_ref, omega_dot_ref).
 
     Jumps are repeated time stamps (left value, then right value), as fmpy reads them.
     """
-    given = {"u": scene.u, "omega_ref": scene.omega_ref}
+    given = {"u": scene.u, "omega_ref": scene.omega_ref,
+             "omega_dot_ref": scene.omega_ref.slope_signal() if scene.omega_ref else None}
     # An input the scene does not give is held at the FMU's start value (the drive ignores it).
     signals = {name: given[name] or constant(start) for name, _unit, start, _desc in INPUTS}
     stop = scene.stop_time

@@ -227,7 +227,10 @@ def _speed(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> dict[str, 
         s_cam, s1, _, _ = model.program.derivatives(theta)
         gap = s_cam - s
         engaged = model.c == 0.0 or (abs(gap) >= model.c * (1 - 1e-9) and gap * s1 * omega > 0.0)
-        rows.append(speed_drive_outputs(model, theta, omega, omega_ref.slope(float(t)), s, engaged))
+        # At a kink of omega(t) the acceleration of the interval that ends at t
+        # counts, as in a co-simulation step that ends there.
+        t_left = float(t) - 1e-12 * max(1.0, float(t)) if k else 0.0
+        rows.append(speed_drive_outputs(model, theta, omega, omega_ref.slope(t_left), s, engaged))
     return _collect(rows, grid)
 
 

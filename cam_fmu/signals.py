@@ -47,6 +47,10 @@ class Signal:
             return 0.0
         return (values[k] - values[k - 1]) / (times[k] - times[k - 1])
 
+    def slope_signal(self) -> "Signal":
+        """The slope as a staircase signal (for the FMU's omega_dot_ref input)."""
+        return Signal(self.breaks, tuple(self.slope(t) for t in self.breaks), hold=True)
+
     def sampled(self, step: float, stop: float) -> "Signal":
         """The zero-order hold a co-simulation master applies at communication points."""
         n = int(round(stop / step))

@@ -30,7 +30,8 @@ from .paper_scheme import PaperScheme
 
 INPUTS: tuple[tuple[str, str, float, str], ...] = (
     ("u", "V", 3.5, "armature voltage (voltage drive)"),
-    ("omega_ref", "rad/s", 1.0, "imposed cam speed (speed drive)"),
+    ("omega_ref", "rad/s", 1.0, "imposed cam speed at the start of the step (speed drive)"),
+    ("omega_dot_ref", "rad/s2", 0.0, "imposed angular acceleration over the step (speed drive: a ramp of omega is then exact)"),
 )
 OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("omega", "rad/s", "cam angular velocity"),
@@ -68,6 +69,7 @@ class DriveSimulator:
         self.time = 0.0
         self.u = INPUTS[0][2]
         self.omega_ref = INPUTS[1][2]
+        self.omega_dot_ref = INPUTS[2][2]
         self.h_next = min(self.h_max, 1e-4)  # rk45's first trial step [s]
         self.steps_taken = 0  # internal steps, for benchmarks
         self._etd: MotorEtdCoefficients | None = None
@@ -76,6 +78,7 @@ class DriveSimulator:
         self.kind = "speed" if model.drive == "speed" else model.formulation
         if self.kind == "speed":
             self.theta = theta0
+            self.speed = self.omega_ref  # rad/s, omega at the current time
             self.s = model.program.derivatives(theta0)[0]
         elif self.kind == "paper":
             self.scheme = PaperScheme(model, theta0, omega0, i0)
@@ -84,17 +87,23 @@ class DriveSimulator:
             self.y, self.mode = self.hybrid.initial(theta0, omega0, i0)
 
     # ------------------------------------------------------------ public
-    def set_inputs(self, u: float, omega_ref: float) -> None:
-        """Inputs used by ``outputs`` before the first step [V, rad/s]."""
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
+        """Inputs used by ``outputs`` before the first step [V, rad/s, rad/s2]."""
         self.u = _finite("u", u)
         self.omega_ref = _finite("omega_ref", omega_ref)
+        self.omega_dot_ref = _finite("omega_dot_ref", omega_dot_ref)
+        if self.kind == "speed":
+            self.speed = self.omega_ref
         self._outputs = None
 
-    def do_step(self, t: float, h: float, u: float, omega_ref: float) -> None:
-        """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation)."""
+    def do_step(self, t: float, h: float, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
+        """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation).
+
+        Speed drive: omega(t) = omega_ref + omega_dot_ref (t - t_k) over the step.
+        """
         if not (math.isfinite(h) and h > 0.0):
             raise SimulationError(f"communication step size = {h!r} s: allowed (0, inf)")
-        self.set_inputs(u, omega_ref)
+        self.set_inputs(u, omega_ref, omega_dot_ref)
         if self.kind == "speed":
             self._step_speed(h)
         elif self.kind == "paper":
@@ -116,7 +125,7 @@ class DriveSimulator:
         """Current value of every output in OUTPUTS (computed once per state)."""
         if self._outputs is None:
             if self.kind == "speed":
-                out = speed_drive_outputs(self.model, self.theta, self.omega_ref, 0.0, self.s, self._speed_engaged())
+                out = speed_drive_outputs(self.model, self.theta, self.speed, self.omega_dot_ref, self.s, self._speed_engaged())
             elif self.kind == "paper":
                 out = self.scheme.outputs()
             else:
@@ -127,11 +136,11 @@ class DriveSimulator:
     def get_state(self) -> dict[str, Any]:
         """Complete internal state, JSON-serialisable."""
         state: dict[str, Any] = {
-            "time": self.time, "u": self.u, "omega_ref": self.omega_ref,
+            "time": self.time, "u": self.u, "omega_ref": self.omega_ref, "omega_dot_ref": self.omega_dot_ref,
             "h_next": self.h_next, "steps_taken": self.steps_taken,
         }
         if self.kind == "speed":
-            state.update(theta=self.theta, s=self.s)
+            state.update(theta=self.theta, s=self.s, speed=self.speed)
         elif self.kind == "paper":
             state["scheme"] = self.scheme.get_state()
         else:
@@ -143,11 +152,13 @@ class DriveSimulator:
         self.time = float(state["time"])
         self.u = float(state["u"])
         self.omega_ref = float(state["omega_ref"])
+        self.omega_dot_ref = float(state["omega_dot_ref"])
         self.h_next = float(state["h_next"])
         self.steps_taken = int(state["steps_taken"])
         if self.kind == "speed":
             self.theta = float(state["theta"])
             self.s = float(state["s"])
+            self.speed = float(state["speed"])
         elif self.kind == "paper":
             self.scheme.set_state(state["scheme"])
         else:
@@ -156,9 +167,10 @@ class DriveSimulator:
 
     # ------------------------------------------------------ speed drive
     def _step_speed(self, h: float) -> None:
-        """theta advances at omega_ref (held); the play operator sees every extremum of s_cam."""
+        """theta follows omega_ref + omega_dot_ref t; the play operator sees every extremum of s_cam."""
         model = self.model
-        start, end = self.theta, self.theta + self.omega_ref * h
+        start, end = self.theta, self.theta + (self.omega_ref + 0.5 * self.omega_dot_ref * h) * h
+        self.speed = self.omega_ref + self.omega_dot_ref * h
         if model.c > 0.0:
             for angle in _crossed(model.program.breakpoints(), start, end):
                 self.s = play(model.program.derivatives(angle)[0], self.s, model.c)
@@ -174,7 +186,7 @@ class DriveSimulator:
             return True
         s_cam, s1, _, _ = model.program.derivatives(self.theta)
         gap = s_cam - self.s
-        return abs(gap) >= model.c * (1.0 - 1e-9) and gap * s1 * self.omega_ref > 0.0
+        return abs(gap) >= model.c * (1.0 - 1e-9) and gap * s1 * self.speed > 0.0
 
     # ---------------------------------------------- consistent, voltage
     def _step_hybrid(self, h: float, u: float) -> None:
