@@ -145,8 +145,22 @@ def test_input_table_has_jumps_as_repeated_times():
     scene = scene_from_dict({"u": {"type": "step", "time": 0.5, "before": 0.0, "after": 3.5},
                              "stop_time": 1.0, "output_interval": 0.1}, name="step")
     table = input_table(scene)
-    assert table.dtype.names == ("time", "u", "omega_ref")
-    assert [tuple(row) for row in table] == [(0.0, 0.0, 1.0), (0.5, 0.0, 1.0), (0.5, 3.5, 1.0), (1.0, 3.5, 1.0)]
+    assert table.dtype.names == ("time", "u", "omega_ref", "omega_dot_ref")
+    assert [tuple(row) for row in table] == [
+        (0.0, 0.0, 1.0, 0.0), (0.5, 0.0, 1.0, 0.0), (0.5, 3.5, 1.0, 0.0), (1.0, 3.5, 1.0, 0.0)]
+
+
+def test_input_table_gives_the_slope_of_a_speed_ramp():
+    scene = scene_from_dict({"drive": "speed", "omega_ref": {"type": "ramp", "start": 0.2, "stop": 1.0, "from": 0.0, "to": 8.0},
+                             "stop_time": 1.5, "output_interval": 0.1}, name="ramp")
+    table = input_table(scene)
+    for row in table:
+        t = row["time"]
+        if 0.2 < t < 1.0:
+            assert row["omega_dot_ref"] == 10.0  # 8 rad/s over 0.8 s
+            assert abs(row["omega_ref"] - 10.0 * (t - 0.2)) < 1e-12
+        elif t < 0.2 or t > 1.0:
+            assert row["omega_dot_ref"] == 0.0
 
 
 # ----------------------------------------------------- facts of the paper's figures
