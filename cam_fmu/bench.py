@@ -534,7 +534,7 @@ CHOICE_COLUMNS = ("case", "comm_step", "level", "solver", "setting", "theta_err"
 
 
 def choose(rows: list[dict]) -> list[dict]:
-    """Per case, comm step and accuracy level: the cheapest FMU run whose theta error is below it."""
+    """Per case, comm step and accuracy level: the FMU run of lowest cost ratio whose theta error is below it."""
     choices = []
     keys = sorted({(r["case"], r["comm_step"]) for r in rows if r["kind"] == "fmu"},
                   key=lambda k: (CASES.index(k[0]) if k[0] in CASES else 99, k[1]))
@@ -543,7 +543,7 @@ def choose(rows: list[dict]) -> list[dict]:
                 and r["status"] == "ok" and r["theta_err"] != ""]
         for level in LEVELS:
             good = [r for r in runs if r["theta_err"] < level]
-            best = min(good, key=lambda r: r["us_per_step"]) if good else None
+            best = min(good, key=lambda r: r["cost_ratio"]) if good else None
             choices.append({"case": case, "comm_step": comm, "level": level,
                             "solver": best["solver"] if best else "none",
                             "setting": best["setting"] if best else "",
@@ -581,7 +581,7 @@ def target_verdict(rows: list[dict]) -> str:
         parts.append("default settings: no successful run")
     good = [r for r in runs if r["status"] == "ok" and r["theta_err"] != "" and r["theta_err"] < TARGET_ERR]
     if good:
-        best = min(good, key=lambda r: r["us_per_step"])
+        best = min(good, key=lambda r: r["cost_ratio"])
         ok = best["cost_ratio"] <= TARGET_RATIO
         parts.append(f"cheapest setting with theta error < {TARGET_ERR:g} rad: {best['solver']} {best['setting']} "
                      f"({best['theta_err']:.2e} rad), {best['us_per_step']:.1f} us/step = {best['cost_ratio']:.2f}x "
