@@ -123,7 +123,9 @@ class HybridDrive:
             mode.stuck = True
             self.settle(y, u, mode)
         elif name == BREAK_AWAY:
-            self.settle(y, u, mode)
+            # The located zero of the margin: the torque is at the threshold
+            # (margin >= 0, often exactly 0 there), so the shaft starts now.
+            self.settle(y, u, mode, at_threshold=True)
         elif name == CONTACT:
             s = model.program.derivatives(y[0])[0]
             mode.s_free = s - model.c * mode.contact
@@ -134,12 +136,22 @@ class HybridDrive:
             # Plastic impact: generalised momentum J_m omega (+ m s' v = 0 before) is kept.
             y[1] = model.J_m * y[1] / (model.J_m + model.m * s1 * s1)
 
-    def settle(self, y, u: float, mode: Mode) -> None:
-        """At rest: stay stuck or start in the direction the torques allow."""
+    def settle(self, y, u: float, mode: Mode, at_threshold: bool = False) -> None:
+        """At rest: stay stuck or start in the direction the torques allow.
+
+        ``at_threshold``: called at a located break-away, where the margin is
+        zero to rounding; the shaft then starts toward the larger acceleration
+        instead of waiting for the next communication step.
+        """
         if not mode.stuck:
             return
         model = self.model
-        direction = model.breakaway_direction(y[0], self.torque(y, u), mode.contact != 0)
+        torque, engaged = self.torque(y, u), mode.contact != 0
+        direction = model.breakaway_direction(y[0], torque, engaged)
+        if direction == 0.0 and at_threshold:
+            forward = model.omega_dot(y[0], 0.0, torque, 1.0, engaged)
+            backward = -model.omega_dot(y[0], 0.0, torque, -1.0, engaged)
+            direction = 1.0 if forward >= backward else -1.0
         if direction == 0.0:
             return
         mode.stuck = False
