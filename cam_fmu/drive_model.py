@@ -50,6 +50,7 @@ class LoadState:
     v: float  # m/s, follower velocity
     a: float  # m/s2, follower acceleration
     alpha: float  # rad, pressure angle
+    s_cam: float  # m, cam lift at the contact
 
 
 class DriveModel:
@@ -120,14 +121,14 @@ class DriveModel:
         tan_a = s1 / (self.r_b + s)
         shaft = self.M_f * direction
         if not engaged:
-            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, math.atan(tan_a))
+            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, math.atan(tan_a), s)
         v = s1 * omega
         a = s2 * omega * omega + s1 * omega_dot
         sigma = _sign(s1 * direction)
         push = self.m * a - self.F_gx  # N, axial force without friction
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g)
         M_l = (push + sigma * f) * s1
-        return LoadState(omega_dot, shaft + M_l, self.J_m + self.m * s1 * s1, f, v, a, math.atan(tan_a))
+        return LoadState(omega_dot, shaft + M_l, self.J_m + self.m * s1 * s1, f, v, a, math.atan(tan_a), s)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True) -> float:
         """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).

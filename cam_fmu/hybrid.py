@@ -144,7 +144,11 @@ class HybridDrive:
         instead of waiting for the next communication step.
         """
         if not mode.stuck:
-            return
+            if y[1] != 0.0:
+                return
+            # At rest but marked as moving (it started under other inputs):
+            # decide again with the inputs of now.
+            mode.stuck = True
         model = self.model
         torque, engaged = self.torque(y, u), mode.contact != 0
         direction = model.breakaway_direction(y[0], torque, engaged)
@@ -163,22 +167,26 @@ class HybridDrive:
                 mode.contact = 0
 
     # ----------------------------------------------------------- outputs
-    def outputs(self, y, u: float, mode: Mode) -> dict[str, float]:
-        """Every output of the drive at state y (SI units)."""
+    def outputs(self, y, u: float, mode: Mode, omega_dot: float | None = None) -> dict[str, float]:
+        """Every output of the drive at state y (SI units).
+
+        ``omega_dot``: the angular acceleration at y when the caller has it
+        already (the last stage of a first-same-as-last step), else computed.
+        """
         model = self.model
         theta, omega = y[0], y[1]
         i = self.current(y, u)
         engaged = mode.contact != 0
-        s_cam = model.program.derivatives(theta)[0]
         if mode.stuck:
             load = model.load(theta, 0.0, 0.0, 0.0, engaged)
             load.M = model.c_m * i  # static friction takes whatever the motor applies
             load.v = load.a = 0.0
         else:
-            omega_dot = self.derivative(y, u, mode)[1]
+            if omega_dot is None:
+                omega_dot = self.derivative(y, u, mode)[1]
             load = model.load(theta, omega, omega_dot, mode.direction, engaged)
-        s = s_cam - model.c * mode.contact if engaged else mode.s_free
-        return _outputs(theta, omega, i, s, s_cam, load, u)
+        s = load.s_cam - model.c * mode.contact if engaged else mode.s_free
+        return _outputs(theta, omega, i, s, load.s_cam, load, u)
 
 
 def _outputs(theta: float, omega: float, i: float, s: float, s_cam: float, load: LoadState, voltage: float) -> dict[str, float]:

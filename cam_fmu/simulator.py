@@ -74,6 +74,7 @@ class DriveSimulator:
         self.steps_taken = 0  # internal steps, for benchmarks
         self._etd: MotorEtdCoefficients | None = None
         self._outputs: dict[str, float] | None = None
+        self._fsal: tuple[tuple, float] | None = None  # (f(y), u) of rk45's last stage
         theta0, omega0, i0 = p["theta0"], p["omega0"], p["i0"]
         self.kind = "speed" if model.drive == "speed" else model.formulation
         if self.kind == "speed":
@@ -85,6 +86,7 @@ class DriveSimulator:
         else:
             self.hybrid = HybridDrive(model)
             self.y, self.mode = self.hybrid.initial(theta0, omega0, i0)
+            self.hybrid.settle(self.y, self.u, self.mode)
 
     # ------------------------------------------------------------ public
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
@@ -94,6 +96,8 @@ class DriveSimulator:
         self.omega_dot_ref = _finite("omega_dot_ref", omega_dot_ref)
         if self.kind == "speed":
             self.speed = self.omega_ref
+        elif self.kind == "consistent":
+            self.hybrid.settle(self.y, self.u, self.mode)  # at rest: stuck, or starting now
         self._outputs = None
 
     def do_step(self, t: float, h: float, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
@@ -129,7 +133,9 @@ class DriveSimulator:
             elif self.kind == "paper":
                 out = self.scheme.outputs()
             else:
-                out = self.hybrid.outputs(self.y, self.u, self.mode)
+                fsal = self._fsal
+                omega_dot = fsal[0][1] if fsal is not None and fsal[1] == self.u else None
+                out = self.hybrid.outputs(self.y, self.u, self.mode, omega_dot)
             self._outputs = out
         return self._outputs
 
@@ -149,6 +155,7 @@ class DriveSimulator:
 
     def set_state(self, state: Mapping[str, Any]) -> None:
         self._outputs = None
+        self._fsal = None
         self.time = float(state["time"])
         self.u = float(state["u"])
         self.omega_ref = float(state["omega_ref"])
@@ -194,8 +201,15 @@ class DriveSimulator:
         y = self.y
         t = 0.0
         steps = 0
+        was_stuck = mode.stuck
         hybrid.settle(y, u, mode)
-        k1 = None  # FSAL derivative of rk45, valid while mode and u are unchanged
+        # rk45's first-same-as-last derivative f(y), kept across communication
+        # steps while u, the mode and y are those it was computed for.
+        k1 = self._fsal[0] if self._fsal is not None and self._fsal[1] == u and not was_stuck else None
+
+        def f(state, _mode=mode):
+            return hybrid.derivative(state, u, _mode)
+
         while h - t > 1e-12 * h:
             if mode.stuck and not hybrid.has_current:
                 break  # nothing evolves until the input changes
@@ -205,10 +219,6 @@ class DriveSimulator:
                     f"solver {self.solver!r} needed more than max_steps = {self.max_steps} internal steps "
                     f"in one communication step of {h:g} s at t = {self.time + t:g} s: raise max_steps, "
                     "loosen rtol/atol or use 'etdrk4' for a stiff electrical pole")
-
-            def f(state, _mode=mode):
-                return hybrid.derivative(state, u, _mode)
-
             remaining = h - t
             if mode.stuck:
                 dt = remaining
@@ -228,6 +238,7 @@ class DriveSimulator:
             k1 = None
         self.y = y
         self.steps_taken += steps
+        self._fsal = None if k1 is None or mode.stuck else (k1, u)
 
     def _stuck_current(self, y, u: float, dt: float) -> list[float]:
         """While stuck, only i moves: exact exponential approach to u / R."""
