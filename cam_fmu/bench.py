@@ -666,4 +666,5 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from cam_fmu.cli import exit_after_fmu
+    sys.exit(exit_after_fmu(main()))

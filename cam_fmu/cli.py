@@ -153,9 +153,29 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+FMU_SLAVE_MODULE = "camdrive_fmu_slave"  # imported into this process when cam.fmu is loaded here
+
+
+def exit_after_fmu(status: int) -> int:
+    """Leave at once (no interpreter teardown) when cam.fmu was loaded into this process.
+
+    pythonfmu 0.7.0 can corrupt the heap when the interpreter tears down a
+    process that has loaded a pythonfmu FMU: glibc then aborts with "corrupted
+    double-linked list" after all the work is done (seen once in about 60 runs,
+    under load). Output is flushed first; nothing is lost.
+    """
+    if FMU_SLAVE_MODULE in sys.modules:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        import os
+
+        os._exit(status)
+    return status
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return args._run(args)
+    return exit_after_fmu(args._run(args))
 
 
 if __name__ == "__main__":
