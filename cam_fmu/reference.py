@@ -55,8 +55,11 @@ def simulate_reference(
 def _grid(stop_time: float, output_interval: float) -> np.ndarray:
     if not (stop_time > 0.0 and output_interval > 0.0):
         raise ValueError(f"stop_time = {stop_time} s and output_interval = {output_interval} s must be > 0")
-    n = int(round(stop_time / output_interval))
-    return np.linspace(0.0, n * output_interval, n + 1)
+    n = int(math.floor(stop_time / output_interval * (1.0 + 1e-12)))
+    grid = np.arange(n + 1) * output_interval
+    if stop_time - grid[-1] > 1e-9 * stop_time:  # a last, shorter interval ends at stop_time, as fmpy does
+        grid = np.append(grid, stop_time)
+    return grid
 
 
 def _collect(rows: list[dict[str, float]], grid: np.ndarray) -> dict[str, np.ndarray]:
