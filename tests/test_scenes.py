@@ -52,9 +52,11 @@ def test_scene_runs_on_the_reference(name):
         scene = scene.with_stop_time(SHORT)
     results = run_scene(scene, "reference")
     assert list(results) == [run.label for run in scene.runs]
-    n = int(round(scene.stop_time / scene.output_interval)) + 1
+    # every output interval, plus a last shorter one ending at stop_time (as fmpy does: fig. 4 lasts 2 pi s)
+    n = int(np.floor(scene.stop_time / scene.output_interval * (1 + 1e-12))) + 1
+    n += scene.stop_time - (n - 1) * scene.output_interval > 1e-9 * scene.stop_time
     for label, r in results.items():
-        assert r["time"][0] == 0.0 and len(r["time"]) == n, label
+        assert r["time"][0] == 0.0 and len(r["time"]) == n and r["time"][-1] == scene.stop_time, label
         for out, _unit, _desc in OUTPUTS:
             assert r[out].shape == (n,) and np.all(np.isfinite(r[out])), (label, out)
 
