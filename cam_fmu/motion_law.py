@@ -230,16 +230,19 @@ class MotionLaw:
         idx = np.minimum(idx, len(self._segs) - 1)
         t0, F, c, kind, V0, S0 = (a[k][idx] for k in ("start", "F", "c", "kind", "V0", "S0"))
         u = T - t0
-        x = u / F
-        sx, cx = np.sin(x), np.cos(x)
-        cF = c * F
-        is_sin, is_cos = kind == _SIN, kind == _COS
-        S = np.where(is_sin, S0 + V0 * u + cF * (u - F * sx),
-                     np.where(is_cos, S0 + V0 * u + cF * F * (1.0 - cx),
-                              S0 + u * (V0 + 0.5 * c * u)))
-        V = np.where(is_sin, V0 + cF * (1.0 - cx), np.where(is_cos, V0 + cF * sx, V0 + c * u))
-        A = np.where(is_sin, c * sx, np.where(is_cos, c * cx, c))
-        J = np.where(is_sin, c / F * cx, np.where(is_cos, -c / F * sx, 0.0))
+        # np.where evaluates every branch: a linear segment's F (or an empty one's)
+        # makes u / F and c / F meaningless there, and they are discarded.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            x = u / F
+            sx, cx = np.sin(x), np.cos(x)
+            cF = c * F
+            is_sin, is_cos = kind == _SIN, kind == _COS
+            S = np.where(is_sin, S0 + V0 * u + cF * (u - F * sx),
+                         np.where(is_cos, S0 + V0 * u + cF * F * (1.0 - cx),
+                                  S0 + u * (V0 + 0.5 * c * u)))
+            V = np.where(is_sin, V0 + cF * (1.0 - cx), np.where(is_cos, V0 + cF * sx, V0 + c * u))
+            A = np.where(is_sin, c * sx, np.where(is_cos, c * cx, c))
+            J = np.where(is_sin, c / F * cx, np.where(is_cos, -c / F * sx, 0.0))
         before, after = T < 0.0, T > 1.0
         S = np.where(before, 0.0, np.where(after, 1.0, S))
         outside = before | after
