@@ -65,7 +65,7 @@ DEFAULT_OUT = Path("out") / "bench"
 
 SOLVER_KEYS = ("solver", "h_max", "rtol", "atol", "max_steps")
 FIXED_STEP_H = (1e-3, 2.5e-4, 1e-4)  # s, h_max of euler, rk4, etdrk4
-RK45_RTOL = (1e-6, 1e-8, 1e-10)  # atol = rtol / 100 (1e-10 is the default)
+RK45_RTOL = (1e-6, 1e-8, 1e-9, 1e-10)  # atol = rtol / 100 (1e-10 is the default)
 COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s
 CASES = ("fig6", "backlash", "inductance")
 LEVELS = (1e-3, 1e-6, 1e-8)  # rad: accuracy levels of the choice table
@@ -326,7 +326,7 @@ class RunError(RuntimeError):
 
 
 def input_array(u, stop_time: float):
-    """fmpy input table for a voltage-drive signal (plus omega_ref held at its start value)."""
+    """fmpy input table for a voltage-drive signal (omega_ref, omega_dot_ref held at their start values)."""
     import numpy as np
 
     # the Signal's own rows: repeated time stamps are jumps, fmpy interpolates between rows
@@ -336,7 +336,9 @@ def input_array(u, stop_time: float):
                 for r in ([(t, rows[k - 1][1], w)] if k else []) + [(t, v, w)]]
     if rows[0][0] > 0.0:
         rows.insert(0, (0.0, float(u.value(0.0)), 1.0))
-    return np.array(rows, dtype=[("time", np.float64), ("u", np.float64), ("omega_ref", np.float64)])
+    return np.array([row + (0.0,) for row in rows],
+                    dtype=[("time", np.float64), ("u", np.float64), ("omega_ref", np.float64),
+                           ("omega_dot_ref", np.float64)])
 
 
 # =========================================================================== reference

@@ -77,6 +77,7 @@ class DriveModel:
         self.mu = p["mu"] if p["guide_friction"] else 0.0
         self.r_b = p["r_b"]
         self.c = p["c"] if p["backlash"] else 0.0
+        self._profile = self.program.derivatives  # bound once: the hot path calls it at every stage
         self.formulation = p["formulation"]
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
@@ -102,17 +103,19 @@ class DriveModel:
         drive = torque - self.M_f * direction
         if not (engaged and self.follower):
             return drive / self.J_m
-        s, s1, s2, _ = self.program.derivatives(theta)
+        s, s1, s2, _ = self._profile(theta)
         m = self.m
         J = self.J_m + m * s1 * s1
-        w2 = omega * omega
-        x0 = (drive - (m * s2 * w2 - self.F_gx) * s1) / J
-        if self.mu == 0.0:
+        inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
+        x0 = (drive - inertial * s1) / J
+        mu = self.mu
+        if mu == 0.0:
             return x0
-        sigma = _sign(s1 * direction)
+        v_sign = s1 * direction
+        sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
         tan_a = s1 / (self.r_b + s)
-        n0 = (m * s2 * w2 - self.F_gx + m * s1 * x0) * tan_a + self.G_y
-        f = solve_guide_friction(n0, self.J_m / J * tan_a, sigma, self.mu, self.N_g)
+        n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
+        f = solve_guide_friction(n0, self.J_m / J * tan_a, sigma, mu, self.N_g)
         return x0 - sigma * f * s1 / J
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:

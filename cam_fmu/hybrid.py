@@ -143,14 +143,16 @@ class HybridDrive:
         zero to rounding; the shaft then starts toward the larger acceleration
         instead of waiting for the next communication step.
         """
+        model = self.model
+        torque, engaged = self.torque(y, u), mode.contact != 0
         if not mode.stuck:
             if y[1] != 0.0:
                 return
-            # At rest but marked as moving (it started under other inputs):
-            # decide again with the inputs of now.
+            # At rest but marked as moving (it started under other inputs, or at
+            # a break-away): it goes on unless it now accelerates backwards.
+            if mode.direction * model.omega_dot(y[0], 0.0, torque, mode.direction, engaged) >= 0.0:
+                return
             mode.stuck = True
-        model = self.model
-        torque, engaged = self.torque(y, u), mode.contact != 0
         direction = model.breakaway_direction(y[0], torque, engaged)
         if direction == 0.0 and at_threshold:
             forward = model.omega_dot(y[0], 0.0, torque, 1.0, engaged)

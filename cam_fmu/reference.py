@@ -109,9 +109,13 @@ class _Consistent:
         k_out = 0
         breaks = [b for b in u.breaks if 0.0 < b < stop] + [stop]
         events_seen = 0
+        input_changed = True  # at the start and at each input break: decide stick/slip anew
         while True:
             u_now = u.value(t)
-            hybrid.settle(y, u_now, mode)
+            if input_changed:
+                # Not after an event: its transition has settled the mode already, and
+                # settling again at a located break-away (margin ~ -1e-17) re-sticks it.
+                hybrid.settle(y, u_now, mode)
             # Outputs due at t (after any transition at t).
             while k_out < len(grid) and grid[k_out] <= t + 1e-12:
                 rows.append(hybrid.outputs(y[:n], u.value(float(grid[k_out])), mode) | self._energy_row(y))
@@ -119,11 +123,14 @@ class _Consistent:
             if t >= stop - 1e-12:
                 break
             t_end = next(b for b in breaks if b > t + 1e-12)
+            # theta is integrated relative to the last whole turn: rtol then acts on
+            # an angle below 4 pi, not on the unbounded theta (long runs keep their accuracy).
+            base = 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
             names = list(hybrid.event_names(mode))
-            funcs = [self._event(k, mode) for k in range(len(names))]
+            funcs = [self._event(k, mode, base) for k in range(len(names))]
             if not mode.stuck:
                 target = self._next_breakpoint(y[0], mode.direction)
-                funcs.append(self._breakpoint_event(target, mode.direction))
+                funcs.append(self._breakpoint_event(target - base, mode.direction))
                 names.append("breakpoint")
             for fn in funcs:
                 fn.terminal, fn.direction = True, -1
@@ -131,7 +138,7 @@ class _Consistent:
             # the error control discards it; numpy's warning about it is noise.
             with np.errstate(over="ignore", invalid="ignore"):
                 sol = solve_ivp(
-                    self._rhs(mode), (t, t_end), y, method=self.method, rtol=self.rtol,
+                    self._rhs(mode, base), (t, t_end), [y[0] - base, *y[1:]], method=self.method, rtol=self.rtol,
                     atol=self._atol(len(y)), events=funcs or None, dense_output=True,
                 )
             if sol.status < 0:
@@ -140,14 +147,18 @@ class _Consistent:
             while k_out < len(grid) and grid[k_out] < t_stop - 1e-12 * max(1.0, t_stop):
                 tk = float(grid[k_out])
                 yk = list(sol.sol(tk))
+                yk[0] += base
                 rows.append(hybrid.outputs(yk[:n], u.value(tk), mode) | self._energy_row(yk))
                 k_out += 1
             y = list(sol.y[:, -1])
+            y[0] += base
             t = t_stop
+            input_changed = sol.status != 1
             if sol.status == 1:
                 fired = [k for k, te in enumerate(sol.t_events) if len(te)]
                 k = min(fired, key=lambda j: sol.t_events[j][0])
                 y = list(sol.y_events[k][0])
+                y[0] += base
                 events_seen += 1
                 if names[k] != "breakpoint":
                     hybrid.apply_event(y, u.value(t), mode, names[k])
@@ -160,26 +171,26 @@ class _Consistent:
             tol[-len(ENERGY):] = [self.atol * 1e-2] * len(ENERGY)
         return tol
 
-    def _rhs(self, mode):
+    def _rhs(self, mode, base: float):
         hybrid, model, u, n = self.hybrid, self.model, self.u, self.hybrid.size
         energy = self.energy
 
         def rhs(t, y):
             u_t = u.value(t)
-            state = y[:n]
+            state = [y[0] + base, *y[1:n]]
             dy = list(hybrid.derivative(state, u_t, mode))
             if energy:
                 i = hybrid.current(state, u_t)
                 omega = 0.0 if mode.stuck else y[1]
-                load = model.load(y[0], omega, dy[1], mode.direction, mode.contact != 0)
+                load = model.load(state[0], omega, dy[1], mode.direction, mode.contact != 0)
                 dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), load.f * abs(load.v)]
             return dy
 
         return rhs
 
-    def _event(self, k: int, mode):
+    def _event(self, k: int, mode, base: float):
         hybrid, u, n = self.hybrid, self.u, self.hybrid.size
-        return lambda t, y: hybrid.event_values(y[:n], u.value(t), mode)[k]
+        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u.value(t), mode)[k]
 
     @staticmethod
     def _breakpoint_event(target: float, direction: float):
