@@ -301,7 +301,7 @@ class DriveSimulator:
 
     def _adaptive_step(self, f, y, remaining: float, k1):
         """One accepted Dormand-Prince step: (dt, y_new, f(y_new))."""
-        dt = min(self.h_next, remaining)
+        dt = min(self.h_next, remaining, self.h_max)
         floor = 1e-14 * max(1.0, self.time)
         while True:
             y5, err, k7 = dopri_step(f, y, dt, k1)

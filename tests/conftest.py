@@ -61,3 +61,12 @@ def run_fmu_script(script: Path, *args: str, cwd: Path | None = None, timeout: f
     result = json.loads(lines[-1])
     result["_stderr"] = proc.stderr
     return result
+
+
+def copy_fmu(cam_fmu_path: Path, tmp_path_factory, label: str) -> Path:
+    """A private copy of the session's cam.fmu in a fresh folder (a child process extracts it there)."""
+    import shutil
+    folder = tmp_path_factory.mktemp(label)
+    path = folder / "cam.fmu"
+    shutil.copyfile(cam_fmu_path, path)
+    return path

@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -50,12 +49,9 @@ def _child(fmu: str) -> dict:
 
 @pytest.fixture(scope="module")
 def fmu_runs(cam_fmu_path, tmp_path_factory):
-    from conftest import run_fmu_script
-    folder = tmp_path_factory.mktemp("fmu_vs_reference")
-    fmu = folder / "cam.fmu"
-    shutil.copyfile(cam_fmu_path, fmu)
-    result = run_fmu_script(HERE, str(fmu), cwd=HERE.parents[1], timeout=900)
-    return result
+    from conftest import copy_fmu, run_fmu_script
+    fmu = copy_fmu(cam_fmu_path, tmp_path_factory, "fmu_vs_reference")
+    return run_fmu_script(HERE, str(fmu), cwd=HERE.parents[1], timeout=900)
 
 
 def _tolerance(params: dict) -> tuple[float, float]:
