@@ -13,7 +13,8 @@ Solvers (consistent formulation, voltage drive):
 - ``etdrk4``: exponential RK4, exact on the electrical pole -R/L: stable and
   accurate with L > 0 at steps far above L/R.
 Every solver stops at the hybrid events (stick, backlash contact) by re-stepping
-to the located zero, and applies the transition there.
+to the located zero, and applies the transition there; every step also ends at
+the profile breakpoint it would cross (segment ends: the third derivative of s jumps).
 
 The paper formulation runs its own fixed-step algorithm (paper_scheme.py) with
 T = the largest step <= h_max that divides the communication step.
@@ -75,6 +76,7 @@ class DriveSimulator:
         self.steps_taken = 0  # internal steps, for benchmarks
         self._etd: MotorEtdCoefficients | None = None
         self._outputs: dict[str, float] | None = None
+        self._breakpoints = model.program.breakpoints()  # rad, in [0, 2 pi)
         self._fsal: tuple[tuple, float] | None = None  # (f(y), u) of rk45's last stage
         theta0, omega0, i0 = p["theta0"], p["omega0"], p["i0"]
         self.kind = "speed" if model.drive == "speed" else model.formulation
@@ -226,9 +228,13 @@ class DriveSimulator:
                 y_new = self._stuck_current(y, u, dt)
             elif self.solver == "rk45":
                 dt, y_new, k1 = self._adaptive_step(f, y, remaining, k1)
+                cut, y_cut = self._stop_at_breakpoint(f, y, y_new, dt, mode)
+                if cut != dt:  # ends on a breakpoint: its FSAL derivative belonged to the longer step
+                    dt, y_new, k1 = cut, y_cut, None
             else:
                 dt = min(remaining, self._fixed_step_size(y, mode))
                 y_new = self._fixed_step(f, y, dt)
+                dt, y_new = self._stop_at_breakpoint(f, y, y_new, dt, mode)
             hit = self._first_event(f, y, y_new, dt, u, mode)
             if hit is None:
                 y, t = y_new, t + dt
@@ -240,6 +246,27 @@ class DriveSimulator:
         self.y = y
         self.steps_taken += steps
         self._fsal = None if k1 is None or mode.stuck else (k1, u)
+
+    def _stop_at_breakpoint(self, f, y, y_new, dt: float, mode: Mode):
+        """Shorten a step so that it ends at the first profile breakpoint it crosses.
+
+        Where the third derivative of s jumps, a fixed-step method stepping
+        across loses its order (MODEL.md section 6). Measured on fig. 6 at 1 ms:
+        rk4's theta error stopped falling near 1e-6 rad as h_max went from 2.5e-4
+        to 1e-4 s (now 7.6e-7 and 6.4e-9 rad at 2.5e-4 and 1.25e-4 s), and rk45's
+        error at rtol 1e-8 was 1.3e-5 rad, dominated by these crossings (now
+        8.5e-9 rad at the same cost). The step is cut at the located crossing
+        (just past it), so every step sees one smooth piece of the profile.
+        """
+        crossed = _crossed(self._breakpoints, y[0], y_new[0])
+        if not crossed:
+            return dt, y_new
+        target, direction = crossed[0], mode.direction
+
+        def gap(state):
+            return direction * (target - state[0])
+
+        return _locate(gap, lambda tau: self._fixed_step(f, y, tau), gap(y), gap(y_new), dt, y_new)
 
     def _stuck_current(self, y, u: float, dt: float) -> list[float]:
         """While stuck, only i moves: exact exponential approach to u / R."""
