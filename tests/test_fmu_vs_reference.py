@@ -4,12 +4,13 @@ The FMU runs in a child process (this file as a script; an FMU must not be
 loaded into pytest: see conftest). Tolerances follow from the solver settings:
 
 - consistent formulation, rk45 (default rtol 1e-10, atol 1e-12): the global
-  theta error measured on fig. 6 is 1.7e-7 rad at 1 ms, 5e-8 rad at 10 ms; the
-  reference's own is ~1e-8 rad. Allowed: 1e-6 rad. omega is compared relative to
+  theta error measured on fig. 6 is 2.8e-9 rad at 1 ms and 10 ms, up to 2.4e-7 rad
+  for laws with jumps in the acceleration; the reference's own is ~1e-8 rad.
+  Allowed: 1e-6 rad. omega is compared relative to
   its peak (1e-4): where J drops 45x at the stroke ends omega changes by up to
   5 rad/s per ms, so a time error of 1e-8 s is already 5e-5 rad/s there.
 - etdrk4 at h_max = 1e-4 s (the inductance scene): fixed step, RK4 class,
-  measured 2.3e-6 rad on fig. 6; allowed 1e-5 rad.
+  measured 3.9e-8 rad; allowed 1e-6 rad.
 - the paper formulation: the FMU and the reference run the same discrete
   algorithm with the same steps: equal to rounding (1e-9).
 - speed drive: theta = omega t and closed-form outputs: equal to rounding.
@@ -61,7 +62,7 @@ def _tolerance(params: dict) -> tuple[float, float]:
     if params["solver"] == "rk45":
         return 1e-6, 1e-4
     if params["solver"] == "etdrk4" and params["h_max"] <= 1e-4:
-        return 1e-5, 1e-3
+        return 1e-6, 1e-4
     raise AssertionError(f"no tolerance stated for solver {params['solver']!r}, h_max {params['h_max']}")
 
 
