@@ -70,18 +70,34 @@ class HybridDrive:
     # -------------------------------------------------------- continuous
     def derivative(self, y, u: float, mode: Mode) -> tuple[float, ...]:
         """dy/dt. While moving, friction opposes mode.direction (fixed over a step)."""
+        return self.rhs(u, mode)(y)
+
+    def rhs(self, u: float, mode: Mode):
+        """dy/dt as a function of y alone, for the input u and the mode as they are now.
+
+        The integrators' hot path: the mode's values are bound once, so a
+        right-hand-side evaluation is one call into DriveModel.omega_dot. Build
+        it again after the mode changes (an event).
+        """
         model = self.model
-        omega = y[1]
+        R, L, c_e, c_m = model.R, model.L, model.c_e, model.c_m
+        omega_dot = model.omega_dot
+        direction, engaged = mode.direction, mode.contact != 0
         if self.has_current:
-            i = y[2]
-            di = (u - model.R * i - model.c_e * omega) / model.L
             if mode.stuck:
-                return (0.0, 0.0, di)
-            return (omega, model.omega_dot(y[0], omega, model.c_m * i, mode.direction, mode.contact != 0), di)
+                return lambda y: (0.0, 0.0, (u - R * y[2] - c_e * y[1]) / L)
+
+            def with_current(y):
+                omega, i = y[1], y[2]
+                return (omega, omega_dot(y[0], omega, c_m * i, direction, engaged), (u - R * i - c_e * omega) / L)
+            return with_current
         if mode.stuck:
-            return (0.0, 0.0)
-        torque = model.c_m * (u - model.c_e * omega) / model.R
-        return (omega, model.omega_dot(y[0], omega, torque, mode.direction, mode.contact != 0))
+            return lambda y: (0.0, 0.0)
+
+        def quasi_static_current(y):
+            omega = y[1]
+            return (omega, omega_dot(y[0], omega, c_m * (u - c_e * omega) / R, direction, engaged))
+        return quasi_static_current
 
     # ------------------------------------------------------------ events
     def event_names(self, mode: Mode) -> tuple[str, ...]:

@@ -210,9 +210,7 @@ class DriveSimulator:
         # steps while u, the mode and y are those it was computed for.
         k1 = self._fsal[0] if self._fsal is not None and self._fsal[1] == u and not was_stuck else None
 
-        def f(state, _mode=mode):
-            return hybrid.derivative(state, u, _mode)
-
+        f = hybrid.rhs(u, mode)
         while h - t > 1e-12 * h:
             if mode.stuck and not hybrid.has_current:
                 break  # nothing evolves until the input changes
@@ -242,6 +240,7 @@ class DriveSimulator:
             name, tau, y_event = hit
             y, t = y_event, t + tau
             hybrid.apply_event(y, u, mode, name)
+            f = hybrid.rhs(u, mode)  # the mode changed
             k1 = None
         self.y = y
         self.steps_taken += steps
