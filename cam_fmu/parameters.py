@@ -121,7 +121,7 @@ _SOLVER = (
     _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step)", low=0.0, high=10.0, low_open=True),
     _P("rtol", "1", 1e-10, "relative tolerance of 'rk45'", low=1e-14, high=0.1),
     _P("atol", "1", 1e-12, "absolute tolerance of 'rk45' (on rad, rad/s, A)", low=1e-16, high=1.0),
-    _P("max_steps", "1", 100000.0, "most internal steps in one communication step before an error is reported", low=1.0, high=1e9),
+    _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4)", low=1.0, high=1e9),
 )
 
 PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER
