@@ -12,6 +12,7 @@ triggers ``apply_event`` with the index of the function.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -232,6 +233,44 @@ def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot
         voltage += model.L * omega * dM / model.c_m
     s_cam = model.program.derivatives(theta)[0]
     return _outputs(theta, omega, i, s, s_cam, load, voltage)
+
+
+def crossed(points, start: float, end: float) -> list[float]:
+    """Angles of the periodic points (in [0, 2 pi)) passed going from start to end [rad], in order."""
+    two_pi = 2.0 * math.pi
+    lo, hi = min(start, end), max(start, end)
+    out = []
+    for p in points:
+        k = math.ceil((lo - p) / two_pi)
+        angle = p + k * two_pi
+        while angle < hi:
+            if angle > lo:
+                out.append(angle)
+            angle += two_pi
+    out.sort(reverse=end < start)
+    return out
+
+
+def follower_along(program, s: float, start: float, end: float, c: float) -> float:
+    """Follower position [m] after the cam turns from start to end [rad] with play c [m].
+
+    The play operator sees every breakpoint passed on the way, where the
+    extrema of s_cam lie, not only the end point (speed drive).
+    """
+    if c == 0.0:
+        return program.derivatives(end)[0]
+    for angle in crossed(program.breakpoints(), start, end):
+        s = play(program.derivatives(angle)[0], s, c)
+    return play(program.derivatives(end)[0], s, c)
+
+
+def speed_engaged(program, theta: float, s: float, omega: float, c: float) -> bool:
+    """Is the follower at s [m] dragged by the cam at theta moving at omega (not free in the gap)?"""
+    if c == 0.0:
+        return True
+    s_cam, s1, _, _ = program.derivatives(theta)
+    gap = s_cam - s
+    return abs(gap) >= c * (1.0 - 1e-9) and gap * s1 * omega > 0.0
 
 
 def play(s_cam: float, s_prev: float, c: float) -> float:

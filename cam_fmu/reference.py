@@ -21,7 +21,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .drive_model import DriveModel
-from .hybrid import HybridDrive, speed_drive_outputs, play
+from .hybrid import HybridDrive, follower_along, speed_drive_outputs, speed_engaged
 from .paper_scheme import PaperScheme
 from .signals import Signal, constant
 from .simulator import OUTPUTS
@@ -222,7 +222,6 @@ def _speed(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> dict[str, 
     p = model.params
     theta = p["theta0"]
     s = model.program.derivatives(theta)[0]
-    from .simulator import _crossed  # the same extremum-aware play operator as the FMU
 
     def integral(t0: float, t1: float) -> float:
         pts = [t0] + [b for b in omega_ref.breaks if t0 < b < t1] + [t1]
@@ -233,17 +232,10 @@ def _speed(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> dict[str, 
     for k, t in enumerate(grid):
         if k:
             end = theta + integral(float(grid[k - 1]), float(t))
-            if model.c > 0.0:
-                for angle in _crossed(model.program.breakpoints(), theta, end):
-                    s = play(model.program.derivatives(angle)[0], s, model.c)
-                s = play(model.program.derivatives(end)[0], s, model.c)
-            else:
-                s = model.program.derivatives(end)[0]
+            s = follower_along(model.program, s, theta, end, model.c)  # the same play operator as the FMU
             theta = end
         omega = omega_ref.value(float(t))
-        s_cam, s1, _, _ = model.program.derivatives(theta)
-        gap = s_cam - s
-        engaged = model.c == 0.0 or (abs(gap) >= model.c * (1 - 1e-9) and gap * s1 * omega > 0.0)
+        engaged = speed_engaged(model.program, theta, s, omega, model.c)
         # At a kink of omega(t) the acceleration of the interval that ends at t
         # counts, as in a co-simulation step that ends there.
         t_left = float(t) - 1e-12 * max(1.0, float(t)) if k else 0.0

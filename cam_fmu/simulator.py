@@ -25,7 +25,7 @@ import math
 from typing import Any, Mapping
 
 from .drive_model import DriveModel
-from .hybrid import HybridDrive, Mode, play, speed_drive_outputs
+from .hybrid import HybridDrive, Mode, crossed, follower_along, speed_drive_outputs, speed_engaged
 from .integrators import MotorEtdCoefficients, dopri_step, etdrk4_motor_step, euler_step, rk4_step
 from .paper_scheme import PaperScheme
 
@@ -132,7 +132,9 @@ class DriveSimulator:
         """Current value of every output in OUTPUTS (computed once per state)."""
         if self._outputs is None:
             if self.kind == "speed":
-                out = speed_drive_outputs(self.model, self.theta, self.speed, self.omega_dot_ref, self.s, self._speed_engaged())
+                model = self.model
+                engaged = speed_engaged(model.program, self.theta, self.s, self.speed, model.c)
+                out = speed_drive_outputs(model, self.theta, self.speed, self.omega_dot_ref, self.s, engaged)
             elif self.kind == "paper":
                 out = self.scheme.outputs()
             else:
@@ -179,24 +181,11 @@ class DriveSimulator:
     def _step_speed(self, h: float) -> None:
         """theta follows omega_ref + omega_dot_ref t; the play operator sees every extremum of s_cam."""
         model = self.model
-        start, end = self.theta, self.theta + (self.omega_ref + 0.5 * self.omega_dot_ref * h) * h
+        end = self.theta + (self.omega_ref + 0.5 * self.omega_dot_ref * h) * h
         self.speed = self.omega_ref + self.omega_dot_ref * h
-        if model.c > 0.0:
-            for angle in _crossed(model.program.breakpoints(), start, end):
-                self.s = play(model.program.derivatives(angle)[0], self.s, model.c)
-            self.s = play(model.program.derivatives(end)[0], self.s, model.c)
-        else:
-            self.s = model.program.derivatives(end)[0]
+        self.s = follower_along(model.program, self.s, self.theta, end, model.c)
         self.theta = end
         self.steps_taken += 1
-
-    def _speed_engaged(self) -> bool:
-        model = self.model
-        if model.c == 0.0:
-            return True
-        s_cam, s1, _, _ = model.program.derivatives(self.theta)
-        gap = s_cam - self.s
-        return abs(gap) >= model.c * (1.0 - 1e-9) and gap * s1 * self.speed > 0.0
 
     # ---------------------------------------------- consistent, voltage
     def _step_hybrid(self, h: float, u: float) -> None:
@@ -257,10 +246,10 @@ class DriveSimulator:
         8.5e-9 rad at the same cost). The step is cut at the located crossing
         (just past it), so every step sees one smooth piece of the profile.
         """
-        crossed = _crossed(self._breakpoints, y[0], y_new[0])
-        if not crossed:
+        crossed_points = crossed(self._breakpoints, y[0], y_new[0])
+        if not crossed_points:
             return dt, y_new
-        target, direction = crossed[0], mode.direction
+        target, direction = crossed_points[0], mode.direction
 
         def gap(state):
             return direction * (target - state[0])
@@ -400,22 +389,6 @@ def _locate(g, advance, g_lo: float, g_hi: float, dt: float, y_hi):
                 g_hi *= 0.5
             side = 1
     return hi, list(y_hi)
-
-
-def _crossed(points, start: float, end: float) -> list[float]:
-    """Angles of the periodic points (in [0, 2 pi)) passed going from start to end, in order."""
-    two_pi = 2.0 * math.pi
-    lo, hi = min(start, end), max(start, end)
-    out = []
-    for p in points:
-        k = math.ceil((lo - p) / two_pi)
-        angle = p + k * two_pi
-        while angle < hi:
-            if angle > lo:
-                out.append(angle)
-            angle += two_pi
-    out.sort(reverse=end < start)
-    return out
 
 
 def _finite(name: str, value: float) -> float:
