@@ -327,18 +327,9 @@ class RunError(RuntimeError):
 
 def input_array(u, stop_time: float):
     """fmpy input table for a voltage-drive signal (omega_ref, omega_dot_ref held at their start values)."""
-    import numpy as np
+    from .engines import signals_table
 
-    # the Signal's own rows: repeated time stamps are jumps, fmpy interpolates between rows
-    rows = [(float(t), float(v), 1.0) for t, v in zip(u.times, u.values)]
-    if u.hold:  # a staircase: each new value starts with a jump
-        rows = [r for k, (t, v, w) in enumerate(rows)
-                for r in ([(t, rows[k - 1][1], w)] if k else []) + [(t, v, w)]]
-    if rows[0][0] > 0.0:
-        rows.insert(0, (0.0, float(u.value(0.0)), 1.0))
-    return np.array([row + (0.0,) for row in rows],
-                    dtype=[("time", np.float64), ("u", np.float64), ("omega_ref", np.float64),
-                           ("omega_dot_ref", np.float64)])
+    return signals_table({"u": u}, stop_time)
 
 
 # =========================================================================== reference

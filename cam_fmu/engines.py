@@ -18,7 +18,7 @@ from __future__ import annotations
 import importlib.util
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -76,15 +76,19 @@ def ensure_fmu(fmu_path: str | Path | None = None) -> Path:
 
 
 def input_table(scene: Scene) -> np.ndarray:
-    """The scene's input signals as fmpy's structured input array (time, u, omega_ref, omega_dot_ref).
+    """The scene's input signals as fmpy's structured input array (time, u, omega_ref, omega_dot_ref)."""
+    return signals_table({"u": scene.u, "omega_ref": scene.omega_ref,
+                          "omega_dot_ref": scene.omega_ref.slope_signal() if scene.omega_ref else None},
+                         scene.stop_time)
 
+
+def signals_table(given: Mapping[str, Signal | None], stop: float) -> np.ndarray:
+    """fmpy's structured input array for the FMU's inputs from 0 to ``stop`` [s].
+
+    An input not given is held at the FMU's start value (the drive ignores it).
     Jumps are repeated time stamps (left value, then right value), as fmpy reads them.
     """
-    given = {"u": scene.u, "omega_ref": scene.omega_ref,
-             "omega_dot_ref": scene.omega_ref.slope_signal() if scene.omega_ref else None}
-    # An input the scene does not give is held at the FMU's start value (the drive ignores it).
-    signals = {name: given[name] or constant(start) for name, _unit, start, _desc in INPUTS}
-    stop = scene.stop_time
+    signals = {name: given.get(name) or constant(start) for name, _unit, start, _desc in INPUTS}
     times: set[float] = {0.0, stop}
     for sig in signals.values():
         times.update(t for t in as_table(sig, stop)[0] if 0.0 <= t <= stop)
