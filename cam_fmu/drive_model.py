@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from .cam_program import CamProgram
+from .kinematics.cam_program import CamProgram
 from .parameters import law_spec, resolve
 
 

@@ -90,29 +90,3 @@ def env_line(env: Dict[str, str] | None = None, export: bool = False) -> str:
     if export:
         return "\n".join(f"export {p}" for p in parts)
     return " ".join(parts)
-
-
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    p = subparsers.add_parser(
-        "host-env",
-        help="print the environment a non-Python FMU host (ecos, C/C++ tools) needs for cam.fmu",
-        description="Print LD_PRELOAD=... PYTHONHOME=... PYTHONPATH=... for this machine's Python: "
-                    "prefix a native co-simulation host with it, e.g. "
-                    "`env $(cam-fmu host-env) ecos simulate --path models/cam.fmu --stopTime 2 --stepSize 1e-3`.")
-    fmt = p.add_mutually_exclusive_group()
-    fmt.add_argument("--export", action="store_true", help="print `export VAR=...` lines for a shell script")
-    fmt.add_argument("--json", action="store_true", help="print a JSON object")
-    return p
-
-
-def run(args) -> int:
-    try:
-        env = host_env()
-    except HostEnvError as exc:
-        print(f"cam-fmu host-env: error: {exc}", file=sys.stderr)
-        return 1
-    if args.json:
-        print(json.dumps(env))
-    else:
-        print(env_line(env, export=args.export))
-    return 0

@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu.cam_program import CamProgram, paper_program
-from cam_fmu.motion_law import MotionLaw, PRESETS
+from cam_fmu.kinematics.cam_program import CamProgram, paper_program
+from cam_fmu.kinematics.motion_law import MotionLaw
+from cam_fmu.kinematics.presets import PRESETS
 
 A = 0.035
 PI = math.pi

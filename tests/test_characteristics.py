@@ -21,8 +21,9 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu.characteristics import characteristics
-from cam_fmu.motion_law import MotionLaw, PRESETS
+from cam_fmu.kinematics.characteristics import characteristics
+from cam_fmu.kinematics.motion_law import MotionLaw
+from cam_fmu.kinematics.presets import PRESETS
 
 HANDBOOK = {  # name: (Vm, Am, Jm or None for unbounded, Qm) as printed
     "cycloidal": ("2.00", "6.28", "39.5", "8.16"),

@@ -252,7 +252,7 @@ def test_backlash_follower_stays_in_the_gap(runs):
 
 def _static_limits(run: dict, k: int) -> tuple[float, float]:
     """Motor torque and gravity torque at output k (guide friction off): c_m i and G s'(theta)."""
-    from cam_fmu.cam_program import paper_program
+    from cam_fmu.kinematics.cam_program import paper_program
     s1 = paper_program().derivatives(float(run["theta"][k]))[1]
     return C_M * run["i"][k], 4.0 * s1  # F_gx = G sin(90 deg) cos(180 deg) = -G: gravity opposes the rise
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings, strategies as st
 
-from cam_fmu.motion_law import MotionLaw, PRESETS
+from cam_fmu.kinematics.motion_law import MotionLaw
+from cam_fmu.kinematics.presets import PRESETS
 
 ALL_T = list(PRESETS.values()) + [
     (0.1, 0.2, 0.35, 0.5, 0.6, 0.9),          # asymmetric, Amp != Amm

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from cam_fmu import cli
-from cam_fmu.cam_program import paper_program
+from cam_fmu.kinematics.cam_program import paper_program
 from cam_fmu.engines import input_table, run_scene
 from cam_fmu.parameters import KGF, defaults
 from cam_fmu.scenes import SceneError, load_scene, scene_files, scene_from_dict

@@ -13,7 +13,7 @@ import pytest
 import sympy
 from sympy import Rational as R, integrate, pi, sin, symbols
 
-from cam_fmu.motion_law import MotionLaw
+from cam_fmu.kinematics.motion_law import MotionLaw
 
 T_CASE = (R(1, 10), R(1, 5), R(7, 20), R(1, 2), R(3, 5), R(9, 10))
 

@@ -24,7 +24,8 @@ from typing import Sequence, Union
 
 import numpy as np
 
-from .motion_law import MotionLaw, golden_max, law
+from .motion_law import MotionLaw, golden_max
+from .presets import law
 
 __all__ = ["CamProgram", "paper_program"]
 

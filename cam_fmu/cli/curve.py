@@ -1,35 +1,13 @@
-"""The `cam-fmu` command line.
-
-Subcommands are registered from modules listed in SUBCOMMAND_MODULES.  Each
-such module defines
-
-    add_parser(subparsers) -> argparse.ArgumentParser   # subparsers.add_parser(...)
-    run(args) -> int                                    # exit status
-
-and keeps its top-level imports light (numpy at most): every module is
-imported to build `--help`; heavy imports (matplotlib, scipy, fmpy) belong
-inside run().  To add a subcommand, write such a module and append its name.
-The `curve` subcommand is defined in this module itself.
-"""
+"""`cam-fmu curve`: characteristic values and plots of a harmonic-trapezoid motion law."""
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import math
 import sys
-from typing import Sequence
-
-SUBCOMMAND_MODULES: list[str] = [
-    "cam_fmu.cli",          # curve
-    "cam_fmu.host_env",     # host-env (environment line for native FMU hosts)
-    "cam_fmu.simulate_cli", # simulate (run a scene file: CSV + figure)
-    "cam_fmu.bench",        # bench (speed-accuracy benchmark of cam.fmu through fmpy)
-]
 
 
-# --------------------------------------------------------------------------- curve
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "curve",
@@ -82,8 +60,8 @@ def _table(name: str, c) -> str:
 
 
 def _program(args, rise_law):
-    from .cam_program import CamProgram
-    from .motion_law import law
+    from ..kinematics.cam_program import CamProgram
+    from ..kinematics.presets import law
 
     if args.return_T is not None:
         ret = law(args.return_T)
@@ -103,8 +81,8 @@ def _program(args, rise_law):
 
 
 def run(args) -> int:
-    from .characteristics import characteristics
-    from .motion_law import PRESETS, law
+    from ..kinematics.characteristics import characteristics
+    from ..kinematics.presets import PRESETS, law
 
     if args.list:
         width = max(map(len, PRESETS))
@@ -134,49 +112,8 @@ def run(args) -> int:
         print(f"max pressure angle (r_b = {args.base_radius_mm:g} mm): "
               f"{math.degrees(alpha):.4g} deg at theta = {math.degrees(where):.6g} deg")
     if args.plot:
-        from .curve_plots import plot_law_and_program
+        from ..plots.curve import plot_law_and_program
         plot_law_and_program(m, program, args.plot, title=name, characteristics=c)
         if not args.json:
             print(f"plot written to {args.plot}")
     return 0
-
-
-# --------------------------------------------------------------------------- main
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="cam-fmu", description="Cam motion laws and an electromechanical cam drive FMU.")
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for modname in SUBCOMMAND_MODULES:
-        module = sys.modules[__name__] if modname == __name__ else importlib.import_module(modname)
-        sub = module.add_parser(subparsers)
-        sub.set_defaults(_run=module.run)
-    return parser
-
-
-FMU_SLAVE_MODULE = "camdrive_fmu_slave"  # imported into this process when cam.fmu is loaded here
-
-
-def exit_after_fmu(status: int) -> int:
-    """Leave at once (no interpreter teardown) when cam.fmu was loaded into this process.
-
-    pythonfmu 0.7.0 can corrupt the heap when the interpreter tears down a
-    process that has loaded a pythonfmu FMU: glibc then aborts with "corrupted
-    double-linked list" after all the work is done (seen once in about 60 runs,
-    under load). Output is flushed first; nothing is lost.
-    """
-    if FMU_SLAVE_MODULE in sys.modules:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        import os
-
-        os._exit(status)
-    return status
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return exit_after_fmu(args._run(args))
-
-
-if __name__ == "__main__":
-    sys.exit(main())

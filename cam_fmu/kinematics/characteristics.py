@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .motion_law import MotionLaw, _COS, _SIN, golden_max
+from .motion_law import SHAPE_COS, SHAPE_SIN, MotionLaw, golden_max
 
 __all__ = ["Characteristics", "characteristics"]
 
@@ -68,10 +68,10 @@ def characteristics(law: MotionLaw, samples: int = 401) -> Characteristics:
         Jm, at_Jm = None, None
     else:
         cand = []
-        for end, start, F, c, kind, _, _ in law._segs:
-            if kind == _SIN:      # |J| = |c|/F cos x: peak at the segment start
+        for end, start, F, c, kind, _, _ in law.segments():
+            if kind == SHAPE_SIN:      # |J| = |c|/F cos x: peak at the segment start
                 cand.append((abs(c) / F, start))
-            elif kind == _COS:    # |J| = |c|/F sin x: peak at the segment end
+            elif kind == SHAPE_COS:    # |J| = |c|/F sin x: peak at the segment end
                 cand.append((abs(c) / F, end))
         Jm, at_Jm = _first_max(cand)
 
@@ -80,14 +80,14 @@ def characteristics(law: MotionLaw, samples: int = 401) -> Characteristics:
         return abs(a * v)
 
     cand = []
-    for end, start, _, c, kind, _, _ in law._segs:
+    for end, start, _, c, kind, _, _ in law.segments():
         if c == 0.0:
             continue
         t = np.linspace(start, end, samples)
         _, V, A, _ = law.evaluate(t)
         q = np.abs(A * V)
         # Segment start belongs to the previous segment: use the right limit.
-        q[0] = abs(c * (0.0 if kind == _SIN else 1.0) * V[0])
+        q[0] = abs(c * (0.0 if kind == SHAPE_SIN else 1.0) * V[0])
         k = int(np.argmax(q))
         if k in (0, samples - 1):
             cand.append((float(q[k]), float(t[k])))

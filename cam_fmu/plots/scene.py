@@ -13,7 +13,7 @@ from typing import Mapping
 
 import numpy as np
 
-from .scenes import Scene
+from ..scenes import Scene
 
 
 def plot_scene(scene: Scene, results: Mapping[str, Mapping[str, np.ndarray]], path: str | Path, engine: str = "reference") -> Path:

@@ -34,7 +34,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def columns(result) -> list[str]:
     """CSV column order: time, theta, omega, s, i, M, J, then the other outputs."""
-    from .simulator import OUTPUTS
+    from ..simulator import OUTPUTS
 
     rest = [name for name, _u, _d in OUTPUTS if name not in FIRST_COLUMNS]
     rest += [name for name in result if name not in FIRST_COLUMNS and name not in rest]
@@ -55,8 +55,8 @@ def csv_path(out: Path, scene_name: str, label: str | None) -> Path:
 
 
 def run(args) -> int:
-    from .engines import EngineError, run_scene
-    from .scenes import SceneError, load_scene
+    from ..engines import EngineError, run_scene
+    from ..scenes import SceneError, load_scene
 
     try:
         scene = load_scene(args.scene)
@@ -74,6 +74,6 @@ def run(args) -> int:
         print(f"{path}  [{label}{', primary' if k == 0 else ''}]  t = 0..{result['time'][-1]:g} s, "
               f"omega max {omega.max():.6g} rad/s, mean {omega.mean():.6g} rad/s")
     if not args.no_plot:
-        from .scene_plots import plot_scene
+        from ..plots.scene import plot_scene
         print(plot_scene(scene, results, out / f"{scene.name}.png", engine=args.engine))
     return 0

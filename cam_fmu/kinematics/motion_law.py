@@ -34,17 +34,30 @@ This module imports only math and numpy: it is bundled into the FMU.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
-__all__ = ["MotionLaw", "PRESETS", "law", "golden_max"]
+__all__ = ["MotionLaw", "Segment", "SHAPE_CONST", "SHAPE_SIN", "SHAPE_COS", "golden_max"]
 
 _HALF_PI = 0.5 * math.pi
 
 # Segment shapes: A = c * shape(x).
-_CONST, _SIN, _COS = 0, 1, 2
+SHAPE_CONST, SHAPE_SIN, SHAPE_COS = 0, 1, 2
+_CONST, _SIN, _COS = SHAPE_CONST, SHAPE_SIN, SHAPE_COS
 _KINDS = (_SIN, _CONST, _COS, _CONST, _SIN, _CONST, _COS)
+
+
+class Segment(NamedTuple):
+    """One non-empty segment of a law: A = c * shape((T - start) / F) on (start, end]."""
+
+    end: float
+    start: float
+    F: float  # (end - start) / (pi/2); 1 for constant segments (unused there)
+    c: float  # coefficient: +Amp, -Amm or 0
+    kind: int  # SHAPE_CONST, SHAPE_SIN or SHAPE_COS
+    V0: float  # V at the segment start
+    S0: float  # S at the segment start
 # Which coefficient each segment uses: +1 -> +Amp, -1 -> -Amm, 0 -> A = 0.
 _SIDE = (1, 1, 1, 0, -1, -1, -1)
 
@@ -160,8 +173,8 @@ class MotionLaw:
         # Non-empty segments only, as plain-float tuples for the scalar path:
         # (end, start, F, c, kind, V0, S0).  Const segments get F = 1 (unused).
         segs = tuple(
-            (edges[i + 1], edges[i], F[i] if _KINDS[i] != _CONST else 1.0,
-             coef[i], _KINDS[i], V0[i], S0[i])
+            Segment(edges[i + 1], edges[i], F[i] if _KINDS[i] != _CONST else 1.0,
+                    coef[i], _KINDS[i], V0[i], S0[i])
             for i in range(7) if L[i] > 0.0)
         arr = {k: np.array([s[j] for s in segs], dtype=float)
                for j, k in enumerate(("end", "start", "F", "c", "kind", "V0", "S0"))}
@@ -252,6 +265,10 @@ class MotionLaw:
         return S, V, A, J
 
     # -- structure ---------------------------------------------------------------
+    def segments(self) -> tuple[Segment, ...]:
+        """The non-empty segments in order (zero-length ones own no point)."""
+        return self._segs
+
     def constants(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """The 14 integration constants in local form: (V0_1..V0_7, S0_1..S0_7),
         V and S at the start T_{i-1} of each segment (zero-length ones included)."""
@@ -277,34 +294,3 @@ class MotionLaw:
             if abs(left - right) > 1e-12 * scale:
                 out.append(t)
         return tuple(out)
-
-
-# Named split points; documented (with sources) in presets.py, which re-exports
-# them.  They live here so the FMU bundle (motion_law + cam_program) is
-# self-contained.
-PRESETS: dict[str, tuple[float, ...]] = {
-    "cycloidal": (1 / 4, 1 / 4, 1 / 2, 1 / 2, 3 / 4, 3 / 4),
-    "modified_sine": (1 / 8, 1 / 8, 1 / 2, 1 / 2, 7 / 8, 7 / 8),
-    "modified_trapezoid": (1 / 8, 3 / 8, 1 / 2, 1 / 2, 5 / 8, 7 / 8),
-    "simple_harmonic": (0.0, 0.0, 1 / 2, 1 / 2, 1.0, 1.0),
-    "constant_acceleration": (0.0, 1 / 2, 1 / 2, 1 / 2, 1 / 2, 1.0),
-    "mcv50": (1 / 16, 1 / 16, 1 / 4, 3 / 4, 15 / 16, 15 / 16),
-    "paper": (1 / 8, 1 / 8, 1 / 4, 3 / 4, 7 / 8, 7 / 8),
-}
-
-
-def law(name_or_T) -> MotionLaw:
-    """A MotionLaw from a preset name, 6 split points, or a MotionLaw (returned as is).
-
-    Unknown names raise ValueError listing the known ones.
-    """
-    if isinstance(name_or_T, MotionLaw):
-        return name_or_T
-    if isinstance(name_or_T, str):
-        try:
-            T = PRESETS[name_or_T]
-        except KeyError:
-            raise ValueError(
-                f"unknown motion law {name_or_T!r}; known presets: {', '.join(PRESETS)}") from None
-        return MotionLaw(T)
-    return MotionLaw(name_or_T)

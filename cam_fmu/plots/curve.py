@@ -12,9 +12,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .cam_program import CamProgram  # noqa: E402
-from .characteristics import Characteristics, characteristics as _characteristics  # noqa: E402
-from .motion_law import MotionLaw  # noqa: E402
+from ..kinematics.cam_program import CamProgram  # noqa: E402
+from ..kinematics.characteristics import Characteristics, characteristics as _characteristics  # noqa: E402
+from ..kinematics.motion_law import MotionLaw  # noqa: E402
 
 
 def _law_samples(law: MotionLaw, n: int = 4001) -> np.ndarray:

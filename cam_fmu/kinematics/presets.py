@@ -1,0 +1,58 @@
+"""Named split points (T1..T6) of the general harmonic-trapezoid curve.
+
+    name                    T1     T2     T3    T4    T5      T6
+    cycloidal               1/4    1/4    1/2   1/2   3/4     3/4
+    modified_sine           1/8    1/8    1/2   1/2   7/8     7/8
+    modified_trapezoid      1/8    3/8    1/2   1/2   5/8     7/8
+    simple_harmonic         0      0      1/2   1/2   1       1
+    constant_acceleration   0      1/2    1/2   1/2   1/2     1
+    mcv50                   1/16   1/16   1/4   3/4   15/16   15/16
+    paper                   1/8    1/8    1/4   3/4   7/8     7/8
+
+Sources: MODEL.md section 1 for the five classical members.  `mcv50` is the
+modified constant-velocity curve with a 50 % constant-velocity part (T4 - T3
+= 1/2) whose ramps are modified-sine shaped (quarter sine over 1/16, quarter
+cosine over 3/16, the 1:3 ratio of the modified sine), the "MCV50" of Makino's
+universal cam curve tables (H. Makino, cam-mechanism handbooks; the same table
+is reproduced in index-drive makers' catalogues); these T reproduce its
+tabulated Vm = 1.28, Am = 8.01, Jm = 201.4, (AV)m = 5.73 (checked in
+tests/test_characteristics.py).  `paper` is the law of the paper's profile
+(seed 002, section 2.1; MODEL.md section 2).
+
+This is the one table of named laws: the parameter choices of the FMU
+(``rise_law``/``return_law``), the CLI's ``--preset`` and the docs derive
+from it.  ``math`` only: the FMU bundles it.
+"""
+
+from __future__ import annotations
+
+from .motion_law import MotionLaw
+
+__all__ = ["PRESETS", "law"]
+
+PRESETS: dict[str, tuple[float, ...]] = {
+    "cycloidal": (1 / 4, 1 / 4, 1 / 2, 1 / 2, 3 / 4, 3 / 4),
+    "modified_sine": (1 / 8, 1 / 8, 1 / 2, 1 / 2, 7 / 8, 7 / 8),
+    "modified_trapezoid": (1 / 8, 3 / 8, 1 / 2, 1 / 2, 5 / 8, 7 / 8),
+    "simple_harmonic": (0.0, 0.0, 1 / 2, 1 / 2, 1.0, 1.0),
+    "constant_acceleration": (0.0, 1 / 2, 1 / 2, 1 / 2, 1 / 2, 1.0),
+    "mcv50": (1 / 16, 1 / 16, 1 / 4, 3 / 4, 15 / 16, 15 / 16),
+    "paper": (1 / 8, 1 / 8, 1 / 4, 3 / 4, 7 / 8, 7 / 8),
+}
+
+
+def law(name_or_T) -> MotionLaw:
+    """A MotionLaw from a preset name, 6 split points, or a MotionLaw (returned as is).
+
+    Unknown names raise ValueError listing the known ones.
+    """
+    if isinstance(name_or_T, MotionLaw):
+        return name_or_T
+    if isinstance(name_or_T, str):
+        try:
+            T = PRESETS[name_or_T]
+        except KeyError:
+            raise ValueError(
+                f"unknown motion law {name_or_T!r}; known presets: {', '.join(PRESETS)}") from None
+        return MotionLaw(T)
+    return MotionLaw(name_or_T)

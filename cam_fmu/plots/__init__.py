@@ -1,0 +1,1 @@
+"""Figures (matplotlib, Agg backend): motion laws and cam programs, scenes."""
