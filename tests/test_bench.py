@@ -1,4 +1,4 @@
-"""`python -m cam_fmu.bench --quick`: the CSV it writes, and physics it must show.
+"""`cam-fmu bench --quick`: the CSV it writes, and physics it must show.
 
 The bench runs in a child process (it loads two pythonfmu FMUs, whose module
 names are process-global; the pytest process never loads an FMU). No wall-clock
@@ -31,7 +31,7 @@ def quick(tmp_path_factory, cam_fmu_path):
     out = tmp_path_factory.mktemp("bench")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env["MPLBACKEND"] = "Agg"
-    proc = subprocess.run([sys.executable, "-m", "cam_fmu.bench", "--quick", "--out", str(out),
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "bench", "--quick", "--out", str(out),
                            "--fmu", str(cam_fmu_path)],
                           capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
     if proc.returncode != 0:
@@ -117,15 +117,15 @@ def test_euler_is_less_accurate_than_rk4(quick):
 ERROR_SCRIPT = r"""
 import json, sys, tempfile
 from pathlib import Path
-from cam_fmu import bench
+from cam_fmu.tools.bench import cases, timing
 tmp = Path(tempfile.mkdtemp())
-cam = bench.Runner(Path(sys.argv[1]), tmp, "cam")
-case = bench.load_cases(["fig6"])[0]
-inputs = bench.input_array(case.u, 0.05)
+cam = timing.TimedRunner(Path(sys.argv[1]), tmp, "cam")
+case = cases.load_cases(["fig6"])[0]
+inputs = timing.input_array(case.u, 0.05)
 try:
     cam.run({"solver": "rk4", "h_max": 1e-5, "max_steps": 2}, 0.05, 1e-3, inputs, 1, 0.0)
     error = None
-except bench.RunError as exc:
+except timing.RunError as exc:
     error = str(exc)
 result, wall, done = cam.run({"solver": "rk4"}, 0.05, 1e-3, inputs, 1, 0.0)
 print(json.dumps({"error": error, "t_end": float(result["time"][-1]), "n": len(result)}))

@@ -96,7 +96,7 @@ def test_closed_form_profile_is_continuous_and_periodic():
 
 def test_cam_program_matches_the_paper_profile():
     """The default cam program of DriveModel is the paper's profile (to 1e-13 m)."""
-    from cam_fmu.drive_model import DriveModel
+    from cam_fmu.physics.drive import DriveModel
 
     prog = DriveModel({}).program
     for k in range(1001):
@@ -109,7 +109,7 @@ def test_cam_program_matches_the_paper_profile():
 
 
 def test_defaults_are_the_papers_numbers():
-    from cam_fmu.parameters import defaults
+    from cam_fmu.physics.parameters import defaults
 
     d = defaults()
     for name, value in DEFAULTS.items():

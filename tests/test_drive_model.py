@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from cam_fmu import paper_scheme
-from cam_fmu.drive_model import DriveModel
-from cam_fmu.parameters import ParameterError
-from cam_fmu.paper_scheme import PaperScheme
+from cam_fmu.physics.formulations import paper as paper_scheme
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.parameters import ParameterError
+from cam_fmu.physics.formulations.paper import PaperScheme
 from cam_fmu.reference import simulate_reference
-from cam_fmu.signals import constant
-from cam_fmu.simulator import DriveSimulator
+from cam_fmu.experiments.signals import constant
+from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import A, DEFAULTS, friction_fixed_point, paper_profile, sgn
 
 NO_LOSSES = dict(shaft_friction=False, guide_friction=False, gravity=False)

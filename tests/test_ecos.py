@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cam_fmu import ecos_host, host_env
+from cam_fmu.tools import ecos_host, host_env
 
 HERE = Path(__file__).resolve().parent
 RUNS = 4

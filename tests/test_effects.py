@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu.simulator import DriveSimulator
+from cam_fmu.fmu.engine import DriveSimulator
 
 R, C_E, C_M, J_M, M_F = 19.0, 0.146, 0.015 * 9.80665, 4.41e-5, 0.012
 FOLLOWER_OFF = {"follower_inertia": False, "gravity": False, "guide_friction": False}

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from cam_fmu import parameters  # the pytest process may import cam_fmu: it never loads the FMU
+from cam_fmu.physics import parameters  # the pytest process may import cam_fmu: it never loads the FMU
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,11 +31,8 @@ def test_validate_fmu_reports_no_problem(cam_fmu_path):
 
 
 def test_default_build_target_is_models_cam_fmu():
-    import importlib.util
-    spec = importlib.util.spec_from_file_location("build_fmu_under_test", ROOT / "build_fmu.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    assert module.DEFAULT_DEST == ROOT / "models" / "cam.fmu"
+    from cam_fmu.experiments.fmu_file import default_fmu_path
+    assert default_fmu_path() == ROOT / "models" / "cam.fmu"
 
 
 def test_model_description_complete(md_root):
@@ -90,8 +87,9 @@ def test_bundle_holds_only_numpy_only_modules(cam_fmu_path):
         bundled = {n for n in names if n.startswith("resources/cam_fmu/")}
         sources = {n: z.read(n).decode("utf-8") for n in bundled if n.endswith(".py")}
     assert "resources/camdrive_fmu_slave.py" in names
-    assert {"resources/cam_fmu/parameters.py", "resources/cam_fmu/simulator.py"} <= bundled
-    for unwanted in ("reference.py", "cli.py", "curve_plots.py", "fmu_xml.py", "ecos_host.py", "host_env.py"):
+    assert {"resources/cam_fmu/physics/parameters.py", "resources/cam_fmu/fmu/engine.py"} <= bundled
+    for unwanted in ("reference/integrate.py", "cli/__init__.py", "plots/curve.py", "fmu/model_description.py",
+                     "fmu/build.py", "tools/ecos_host.py", "tools/host_env.py"):
         assert f"resources/cam_fmu/{unwanted}" not in bundled
     for name, text in sources.items():
         for heavy in ("scipy", "matplotlib"):
@@ -143,7 +141,7 @@ def test_build_refuses_scipy_in_the_bundle(tmp_path):
     """The import closure check is live: a bundled module importing scipy fails the build."""
     pkg = tmp_path / "cam_fmu"
     shutil.copytree(ROOT / "cam_fmu", pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    sim = pkg / "simulator.py"
+    sim = pkg / "fmu" / "engine.py"
     sim.write_text(sim.read_text(encoding="utf-8") + "\nimport scipy.integrate  # noqa\n", encoding="utf-8")
     proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--package-dir", str(pkg),
                            "--dest", str(tmp_path / "out" / "cam.fmu")], capture_output=True, text=True,
@@ -154,9 +152,9 @@ def test_build_refuses_scipy_in_the_bundle(tmp_path):
 
 
 def test_readme_variable_table_is_the_generated_one():
-    """The README's FMU variable table is `python -m cam_fmu.fmu_xml`'s output: it cannot drift from the code."""
+    """The README's FMU variable table is `python -m cam_fmu.fmu.model_description`'s output: it cannot drift from the code."""
     from pathlib import Path
 
-    from cam_fmu.fmu_xml import markdown_table
+    from cam_fmu.fmu.model_description import markdown_table
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
     assert markdown_table().strip() in readme

@@ -27,19 +27,19 @@ import numpy as np
 import pytest
 
 HERE = Path(__file__).resolve()
-MODELS = HERE.parents[1] / "models"
+from cam_fmu.experiments.scenes import SCENE_DIR as MODELS  # noqa: E402  (the shipped scenes)
 SCENE_NAMES = sorted(p.stem for p in MODELS.glob("*.toml"))
 FACTORS = (1, 10)  # communication step = the scene's output_interval times this
 
 
 def _scene(name: str, factor: int):
-    from cam_fmu.scenes import load_scene
+    from cam_fmu.experiments.scenes import load_scene
     scene = load_scene(MODELS / f"{name}.toml")
     return dataclasses.replace(scene, output_interval=scene.output_interval * factor)
 
 
 def _child(fmu: str) -> dict:
-    from cam_fmu.engines import run_scene
+    from cam_fmu.experiments.runner import run_scene
     out = {}
     for name in SCENE_NAMES:
         for factor in FACTORS:
@@ -69,7 +69,7 @@ def _tolerance(params: dict) -> tuple[float, float]:
 @pytest.mark.parametrize("factor", FACTORS)
 @pytest.mark.parametrize("name", SCENE_NAMES)
 def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, factor):
-    from cam_fmu.engines import run_scene
+    from cam_fmu.experiments.runner import run_scene
     scene = _scene(name, factor)
     fmu = fmu_runs[f"{name}@{factor}"]
     ref = run_scene(scene, "reference")

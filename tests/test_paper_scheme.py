@@ -17,9 +17,9 @@ import math
 
 import pytest
 
-from cam_fmu.drive_model import DriveModel
-from cam_fmu.paper_scheme import PaperScheme
-from cam_fmu.simulator import DriveSimulator
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.formulations.paper import PaperScheme
+from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import DEFAULTS, paper_profile, sgn
 
 R, C_E, C_M, J_M, M_F, MASS, G, MU, R_B = (DEFAULTS[k] for k in ("R", "c_e", "c_m", "J_m", "M_f", "m", "G", "mu", "r_b"))

@@ -13,11 +13,11 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu import hybrid as hybrid_module
-from cam_fmu.drive_model import DriveModel
-from cam_fmu.hybrid import HybridDrive
+from cam_fmu.physics.formulations import consistent as hybrid_module
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.formulations.consistent import HybridDrive
 from cam_fmu.reference import simulate_reference
-from cam_fmu.simulator import DriveSimulator
+from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import DEFAULTS
 
 C_M = DEFAULTS["c_m"]

@@ -18,13 +18,13 @@ import pytest
 
 from cam_fmu import cli
 from cam_fmu.kinematics.cam_program import paper_program
-from cam_fmu.engines import input_table, run_scene
-from cam_fmu.parameters import KGF, defaults
-from cam_fmu.scenes import SceneError, load_scene, scene_files, scene_from_dict
-from cam_fmu.simulator import OUTPUTS
+from cam_fmu.experiments.runner import input_table, run_scene
+from cam_fmu.physics.parameters import KGF, defaults
+from cam_fmu.experiments.scenes import SCENE_DIR, SceneError, load_scene, scene_files, scene_from_dict
+from cam_fmu.fmu.engine import OUTPUTS
 
 ROOT = Path(__file__).resolve().parents[1]
-MODELS = ROOT / "models"
+MODELS = SCENE_DIR  # the shipped scenes
 SCENES = {path.stem: path for path in scene_files(MODELS)}
 REQUIRED = {"paper_fig4", "paper_fig5a", "paper_fig5b", "paper_fig6", "backlash", "tilted", "inductance"}
 SHORT = 0.1  # s: voltage-drive scenes are shortened to this in the smoke test
@@ -256,7 +256,7 @@ def test_cli_fmu_engine_matches_reference(tmp_path, cam_fmu_path):
 def test_readme_documents_every_parameter_and_scene():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     section = text.split("## The drive model", 1)[1].split("\n## ", 1)[0]
-    from cam_fmu.parameters import PARAMETERS
+    from cam_fmu.physics.parameters import PARAMETERS
     for p in PARAMETERS:
         unit = p.unit if p.unit else "-"
         assert f"| `{p.name}` | {unit} |" in section, f"README parameter table lacks {p.name} [{unit}]"

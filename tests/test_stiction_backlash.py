@@ -21,12 +21,12 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu import hybrid as hybrid_module
-from cam_fmu.drive_model import DriveModel, break_away_voltage
-from cam_fmu.hybrid import ENGAGE_DOWN, ENGAGE_UP, HybridDrive, Mode
+from cam_fmu.physics.formulations import consistent as hybrid_module
+from cam_fmu.physics.drive import DriveModel, break_away_voltage
+from cam_fmu.physics.formulations.consistent import ENGAGE_DOWN, ENGAGE_UP, HybridDrive, Mode
 from cam_fmu.reference import simulate_reference
-from cam_fmu.signals import constant
-from cam_fmu.simulator import DriveSimulator
+from cam_fmu.experiments.signals import constant
+from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import DEFAULTS, H, friction_fixed_point, paper_profile
 
 R, C_M, J_M, M_F, MASS, G, MU, R_B = (DEFAULTS[k] for k in ("R", "c_m", "J_m", "M_f", "m", "G", "mu", "r_b"))

@@ -23,7 +23,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..bench import run_bench
+    from ..tools.bench.run import run_bench
 
     rows = run_bench(args.out, quick=args.quick, fmu_path=args.fmu)
     silent = [r for r in rows if r["status"] == "early stop"]

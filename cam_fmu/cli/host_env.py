@@ -19,7 +19,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..host_env import HostEnvError, env_line, host_env
+    from ..tools.host_env import HostEnvError, env_line, host_env
 
     try:
         env = host_env()

@@ -2,7 +2,7 @@
 
 Writes DIR/<scene>.csv (the primary run), DIR/<scene>__<label>.csv (each
 further run) and DIR/<scene>.png (the scene's figure). CSV columns: time, then
-theta, omega, s, i, M, J, then the remaining outputs of simulator.OUTPUTS, all in
+theta, omega, s, i, M, J, then the remaining outputs of physics.variables.OUTPUTS, all in
 SI units (s, rad, rad/s, m, A, N m, kg m^2, m/s, m/s^2, rad, m, V).
 """
 from __future__ import annotations
@@ -17,16 +17,16 @@ FIRST_COLUMNS = ("time", "theta", "omega", "s", "i", "M", "J")
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "simulate",
-        help="run a scene (models/*.toml) and write its CSV files and figure",
+        help="run a scene (a shipped scene's name or a .toml file) and write its CSV files and figure",
         description="Run every run of a scene file on the reference integration or on the FMU; "
                     "write DIR/<scene>.csv (primary run), DIR/<scene>__<label>.csv (further runs) "
                     "and DIR/<scene>.png.")
-    p.add_argument("scene", metavar="SCENE.toml", help="scene file, e.g. models/paper_fig6.toml")
+    p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. paper_fig6) or a scene file (.toml)")
     p.add_argument("--engine", choices=("reference", "fmu"), default="reference",
-                   help="'reference': scipy integration (default); 'fmu': models/cam.fmu via fmpy "
-                        "(built with build_fmu.py when missing)")
+                   help="'reference': scipy integration (default); 'fmu': cam.fmu via fmpy "
+                        "(built when missing or older than its sources)")
     p.add_argument("--out", metavar="DIR", default="out", help="output directory (default: out)")
-    p.add_argument("--fmu", metavar="FILE.fmu", default=None, help="FMU to run with --engine fmu (default: models/cam.fmu)")
+    p.add_argument("--fmu", metavar="FILE.fmu", default=None, help="FMU to run with --engine fmu (default: models/cam.fmu in a checkout, else a user cache)")
     p.add_argument("--stop-time", type=float, default=None, metavar="T", help="override the scene's stop_time [s]")
     p.add_argument("--no-plot", action="store_true", help="write the CSV files only")
     return p
@@ -34,9 +34,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def columns(result) -> list[str]:
     """CSV column order: time, theta, omega, s, i, M, J, then the other outputs."""
-    from ..simulator import OUTPUTS
+    from ..physics.variables import OUTPUT_NAMES
 
-    rest = [name for name, _u, _d in OUTPUTS if name not in FIRST_COLUMNS]
+    rest = [name for name in OUTPUT_NAMES if name not in FIRST_COLUMNS]
     rest += [name for name in result if name not in FIRST_COLUMNS and name not in rest]
     return list(FIRST_COLUMNS) + rest
 
@@ -55,11 +55,11 @@ def csv_path(out: Path, scene_name: str, label: str | None) -> Path:
 
 
 def run(args) -> int:
-    from ..engines import EngineError, run_scene
-    from ..scenes import SceneError, load_scene
+    from ..experiments.runner import EngineError, run_scene
+    from ..experiments.scenes import SceneError, find_scene
 
     try:
-        scene = load_scene(args.scene)
+        scene = find_scene(args.scene)
         if args.stop_time is not None:
             scene = scene.with_stop_time(args.stop_time)
         results = run_scene(scene, args.engine, args.fmu)

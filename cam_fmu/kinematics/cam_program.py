@@ -1,6 +1,6 @@
 """A full cam cycle: rise, upper dwell, return, lower dwell over 2*pi.
 
-theta is the cam angle [rad], s the follower lift [m] (MODEL.md section 1):
+theta is the cam angle [rad], s the follower lift [m] (docs/model.md section 1):
 
     rise   [0, b_r]:                    s = h S(phi/b_r),       phi = theta
     upper dwell (b_r, b_r + b_u]:       s = h
@@ -82,6 +82,7 @@ class CamProgram:
                     lift / self.return_angle ** 2, lift / self.return_angle ** 3)
         self._rise = self.rise_law.scalar
         self._ret = self.return_law.scalar
+        self._breakpoints = self.breakpoints()
 
     def __repr__(self):
         return (f"CamProgram(rise_law={self.rise_law.T}, return_law={self.return_law.T}, "
@@ -145,6 +146,10 @@ class CamProgram:
                 out.append(p)
         return tuple(out)
 
+    def breakpoints_passed(self, start: float, end: float) -> list[float]:
+        """Breakpoint angles [rad] passed going from start to end, in the order passed."""
+        return crossed(self._breakpoints, start, end)
+
     # -- pressure angle ------------------------------------------------------------
     def pressure_angle(self, theta, base_radius: float):
         """Pressure angle [rad] of the in-line roller follower,
@@ -174,8 +179,23 @@ class CamProgram:
         return best, best_t
 
 
+def crossed(points, start: float, end: float) -> list[float]:
+    """Angles of the periodic points (in [0, 2 pi)) passed going from start to end [rad], in order."""
+    lo, hi = min(start, end), max(start, end)
+    out = []
+    for p in points:
+        k = math.ceil((lo - p) / TWO_PI)
+        angle = p + k * TWO_PI
+        while angle < hi:
+            if angle > lo:
+                out.append(angle)
+            angle += TWO_PI
+    out.sort(reverse=end < start)
+    return out
+
+
 def paper_program(A: float = 0.035) -> CamProgram:
-    """The paper's profile (seed 002 section 2.1, MODEL.md section 2): rise over
+    """The paper's profile (the paper's section 2.1; docs/model.md section 2): rise over
     [0, pi] and return over [pi, 2 pi] with the `paper` law, no dwells,
     lift h = 3 pi A / 2 (A = 35 mm -> h = 164.93 mm, peak ds/dtheta = 2 A)."""
     return CamProgram("paper", "paper", lift=1.5 * math.pi * A,

@@ -1,11 +1,14 @@
 """The consistent cam drive as a hybrid system: continuous states, modes, events.
 
-Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A].
+Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A]
+(slots THETA, OMEGA, CURRENT).
 Discrete mode: stuck (shaft held by static friction), direction of motion,
 backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
 gap) and the follower's position while free. Both the FMU stepper and the
 scipy reference integrate ``derivative`` and stop at the zeros of
-``event_values``: one physics code, two integrators (MODEL.md sections 5-6).
+``event_values``: one physics code, two integrators (docs/model.md sections 5-6).
+``ConsistentVoltage`` is this formulation under a voltage input, advanced by
+the engine's integrator.
 
 Events are functions that are > 0 while nothing happens; a crossing to <= 0
 triggers ``apply_event`` with the index of the function.
@@ -16,8 +19,11 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from .drive_model import DriveModel, LoadState
+from ..drive import DriveModel
+from ..variables import output_record
+from .base import Formulation
 
+THETA, OMEGA, CURRENT = 0, 1, 2  # slots of the continuous state y
 STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY = "stop", "contact", "engage_up", "engage_down", "break_away"
 
 
@@ -42,9 +48,12 @@ class HybridDrive:
 
     def __init__(self, model: DriveModel) -> None:
         self.model = model
+        self.motor = model.motor
         self.has_current = model.L > 0.0
         self.backlash = model.c > 0.0
         self.size = 3 if self.has_current else 2
+        # theta enters the physics mod 2 pi: its error is scaled by at most 2 pi
+        self.error_caps = (2.0 * math.pi, math.inf, math.inf)[: self.size]
 
     # ------------------------------------------------------------ set-up
     def initial(self, theta0: float, omega0: float, i0: float) -> tuple[list[float], Mode]:
@@ -59,14 +68,13 @@ class HybridDrive:
 
     def torque(self, y, u: float) -> float:
         """Motor torque c_m i [N m]."""
-        m = self.model
         if self.has_current:
-            return m.c_m * y[2]
-        return m.c_m * (u - m.c_e * y[1]) / m.R
+            return self.motor.c_m * y[CURRENT]
+        return self.motor.quasi_static_torque(u, y[OMEGA])
 
     def current(self, y, u: float) -> float:
-        m = self.model
-        return y[2] if self.has_current else (u - m.c_e * y[1]) / m.R
+        """Armature current [A]: the state, or quasi-static with L = 0."""
+        return y[CURRENT] if self.has_current else self.motor.quasi_static_current(u, y[OMEGA])
 
     # -------------------------------------------------------- continuous
     def derivative(self, y, u: float, mode: Mode) -> tuple[float, ...]:
@@ -80,25 +88,64 @@ class HybridDrive:
         right-hand-side evaluation is one call into DriveModel.omega_dot. Build
         it again after the mode changes (an event).
         """
-        model = self.model
-        R, L, c_e, c_m = model.R, model.L, model.c_e, model.c_m
+        model, motor = self.model, self.motor
+        c_m = motor.c_m
+        current_rate, quasi_static_torque = motor.current_rate, motor.quasi_static_torque
         omega_dot = model.omega_dot
         direction, engaged = mode.direction, mode.contact != 0
         if self.has_current:
             if mode.stuck:
-                return lambda y: (0.0, 0.0, (u - R * y[2] - c_e * y[1]) / L)
+                return lambda y: (0.0, 0.0, current_rate(u, y[CURRENT], y[OMEGA]))
 
             def with_current(y):
-                omega, i = y[1], y[2]
-                return (omega, omega_dot(y[0], omega, c_m * i, direction, engaged), (u - R * i - c_e * omega) / L)
+                omega, i = y[OMEGA], y[CURRENT]
+                return (omega, omega_dot(y[THETA], omega, c_m * i, direction, engaged), current_rate(u, i, omega))
             return with_current
         if mode.stuck:
             return lambda y: (0.0, 0.0)
 
         def quasi_static_current(y):
-            omega = y[1]
-            return (omega, omega_dot(y[0], omega, c_m * (u - c_e * omega) / R, direction, engaged))
+            omega = y[OMEGA]
+            return (omega, omega_dot(y[THETA], omega, quasi_static_torque(u, omega), direction, engaged))
         return quasi_static_current
+
+    def stuck_state(self, y, u: float, dt: float) -> list[float]:
+        """y after dt [s] held by static friction: only i moves (exactly, toward u / R)."""
+        return [y[THETA], 0.0, self.motor.current_at_rest(y[CURRENT], u, dt)]
+
+    def stiffness_rate(self, y, mode: Mode, electrical: bool) -> float:
+        """Largest rate [1/s] of the dynamics at y, for an explicit method's stability limit.
+
+        The mechanical part: d(omega_dot)/d(omega) and the theta-omega oscillation
+        that the profile's curvature makes, of frequency
+        |omega| sqrt(m (s2^2 + |s1 s3|) / J). ``electrical`` False leaves out the
+        pole of the current (a solver that integrates it exactly).
+        """
+        model = self.model
+        s, s1, s2, s3 = model.program.derivatives(y[THETA])
+        engaged = mode.contact != 0
+        J = model.J_m + (model.m * s1 * s1 if engaged else 0.0)
+        omega = y[OMEGA]
+        rate = 0.0
+        if engaged:
+            rate = (2.0 * model.m * abs(s1 * s2 * omega)
+                    + abs(omega) * math.sqrt(model.m * J * (s2 * s2 + abs(s1 * s3)))) / J
+        if model.L > 0.0:
+            if electrical:
+                rate += self.motor.electrical_rate(J)
+        else:
+            rate += self.motor.electrical_rate(J)
+        return rate
+
+    def torque_gain(self, y, mode: Mode) -> float:
+        """d(omega_dot)/d(i) = c_m / J [1/(A s2)] at y."""
+        model = self.model
+        s1 = model.program.derivatives(y[THETA])[1]
+        return model.c_m / (model.J_m + (model.m * s1 * s1 if mode.contact != 0 else 0.0))
+
+    def breakpoints_passed(self, start: float, end: float) -> list[float]:
+        """Profile breakpoints [rad] between two angles, in the order passed."""
+        return self.model.program.breakpoints_passed(start, end)
 
     # ------------------------------------------------------------ events
     def event_names(self, mode: Mode) -> tuple[str, ...]:
@@ -116,27 +163,27 @@ class HybridDrive:
             if not self.has_current:
                 return ()
             return (-self._breakaway_margin(y, u, mode),)
-        stop = y[1] * mode.direction
+        stop = y[OMEGA] * mode.direction
         if not self.backlash:
             return (stop,)
-        s, s1, _, _ = self.model.program.derivatives(y[0])
+        s, s1, _, _ = self.model.program.derivatives(y[THETA])
         c = self.model.c
         if mode.contact == 0:
             return (stop, mode.s_free - (s - c), (s + c) - mode.s_free)
-        return (stop, mode.contact * s1 * y[1])
+        return (stop, mode.contact * s1 * y[OMEGA])
 
     def _breakaway_margin(self, y, u: float, mode: Mode) -> float:
         """> 0 when the shaft would start moving from rest [rad/s2]."""
         model, torque, engaged = self.model, self.torque(y, u), mode.contact != 0
-        forward = model.omega_dot(y[0], 0.0, torque, 1.0, engaged)
-        backward = -model.omega_dot(y[0], 0.0, torque, -1.0, engaged)
+        forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, engaged)
+        backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, engaged)
         return max(forward, backward)
 
     def apply_event(self, y, u: float, mode: Mode, name: str) -> None:
         """The transition of event ``name``, in place on y and mode."""
         model = self.model
         if name == STOP:
-            y[1] = 0.0
+            y[OMEGA] = 0.0
             mode.stuck = True
             self.settle(y, u, mode)
         elif name == BREAK_AWAY:
@@ -144,14 +191,14 @@ class HybridDrive:
             # (margin >= 0, often exactly 0 there), so the shaft starts now.
             self.settle(y, u, mode, at_threshold=True)
         elif name == CONTACT:
-            s = model.program.derivatives(y[0])[0]
+            s = model.program.derivatives(y[THETA])[0]
             mode.s_free = s - model.c * mode.contact
             mode.contact = 0
         else:
             mode.contact = 1 if name == ENGAGE_UP else -1
-            s1 = model.program.derivatives(y[0])[1]
+            s1 = model.program.derivatives(y[THETA])[1]
             # Plastic impact: generalised momentum J_m omega (+ m s' v = 0 before) is kept.
-            y[1] = model.J_m * y[1] / (model.J_m + model.m * s1 * s1)
+            y[OMEGA] = model.J_m * y[OMEGA] / (model.J_m + model.m * s1 * s1)
 
     def settle(self, y, u: float, mode: Mode, at_threshold: bool = False) -> None:
         """At rest: stay stuck or start in the direction the torques allow.
@@ -163,24 +210,24 @@ class HybridDrive:
         model = self.model
         torque, engaged = self.torque(y, u), mode.contact != 0
         if not mode.stuck:
-            if y[1] != 0.0:
+            if y[OMEGA] != 0.0:
                 return
             # At rest but marked as moving (it started under other inputs, or at
             # a break-away): it goes on unless it now accelerates backwards.
-            if mode.direction * model.omega_dot(y[0], 0.0, torque, mode.direction, engaged) >= 0.0:
+            if mode.direction * model.omega_dot(y[THETA], 0.0, torque, mode.direction, engaged) >= 0.0:
                 return
             mode.stuck = True
-        direction = model.breakaway_direction(y[0], torque, engaged)
+        direction = model.breakaway_direction(y[THETA], torque, engaged)
         if direction == 0.0 and at_threshold:
-            forward = model.omega_dot(y[0], 0.0, torque, 1.0, engaged)
-            backward = -model.omega_dot(y[0], 0.0, torque, -1.0, engaged)
+            forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, engaged)
+            backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, engaged)
             direction = 1.0 if forward >= backward else -1.0
         if direction == 0.0:
             return
         mode.stuck = False
         mode.direction = direction
         if self.backlash and mode.contact != 0:
-            s, s1, _, _ = model.program.derivatives(y[0])
+            s, s1, _, _ = model.program.derivatives(y[THETA])
             if mode.contact * s1 * direction < 0.0:  # the cam leaves the follower
                 mode.s_free = s - model.c * mode.contact
                 mode.contact = 0
@@ -193,7 +240,7 @@ class HybridDrive:
         already (the last stage of a first-same-as-last step), else computed.
         """
         model = self.model
-        theta, omega = y[0], y[1]
+        theta, omega = y[THETA], y[OMEGA]
         i = self.current(y, u)
         engaged = mode.contact != 0
         if mode.stuck:
@@ -205,80 +252,36 @@ class HybridDrive:
                 omega_dot = self.derivative(y, u, mode)[1]
             load = model.load(theta, omega, omega_dot, mode.direction, engaged)
         s = load.s_cam - model.c * mode.contact if engaged else mode.s_free
-        return _outputs(theta, omega, i, s, load.s_cam, load, u)
+        return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
+                             alpha=load.alpha, s_cam=load.s_cam, voltage=u)
 
 
-def _outputs(theta: float, omega: float, i: float, s: float, s_cam: float, load: LoadState, voltage: float) -> dict[str, float]:
-    return {
-        "omega": omega, "theta": theta, "s": s, "i": i, "M": load.M, "J": load.J,
-        "v": load.v, "a": load.a, "alpha": load.alpha, "s_cam": s_cam, "voltage": voltage,
-    }
+class ConsistentVoltage(Formulation):
+    """The energy-consistent drive under the voltage input u, stepped by the engine's integrator."""
 
+    def __init__(self, model: DriveModel, u: float) -> None:
+        p = model.params
+        self.hybrid = HybridDrive(model)
+        self.y, self.mode = self.hybrid.initial(p["theta0"], p["omega0"], p["i0"])
+        self.u = u
+        self.hybrid.settle(self.y, u, self.mode)
 
-def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot: float, s: float, engaged: bool) -> dict[str, float]:
-    """Speed drive: torque, inertia, current and voltage needed for a given motion.
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
+        self.u = u
+        self.hybrid.settle(self.y, u, self.mode)  # at rest: stuck, or starting now
 
-    c_m i = J_m omega_dot + M (consistent formulation); the voltage adds
-    L di/dt, with di/dt = omega dM/dtheta at constant speed (central difference,
-    1e-6 rad).
-    """
-    direction = 1.0 if omega > 0.0 else (-1.0 if omega < 0.0 else 0.0)
-    load = model.load(theta, omega, omega_dot, direction, engaged)
-    i = (model.J_m * omega_dot + load.M) / model.c_m
-    voltage = model.R * i + model.c_e * omega
-    if model.L > 0.0 and omega != 0.0:
-        d = 1e-6
-        dM = (model.load(theta + d, omega, omega_dot, direction, engaged).M
-              - model.load(theta - d, omega, omega_dot, direction, engaged).M) / (2 * d)
-        voltage += model.L * omega * dM / model.c_m
-    s_cam = model.program.derivatives(theta)[0]
-    return _outputs(theta, omega, i, s, s_cam, load, voltage)
+    def advance(self, h: float, integrator: Any, time: float) -> int:
+        self.y, steps = integrator.advance(self.hybrid, self.y, self.mode, self.u, h, time)
+        return steps
 
+    def outputs(self, integrator: Any) -> dict[str, float]:
+        return self.hybrid.outputs(self.y, self.u, self.mode, integrator.derivative_at_end(self.u))
 
-def crossed(points, start: float, end: float) -> list[float]:
-    """Angles of the periodic points (in [0, 2 pi)) passed going from start to end [rad], in order."""
-    two_pi = 2.0 * math.pi
-    lo, hi = min(start, end), max(start, end)
-    out = []
-    for p in points:
-        k = math.ceil((lo - p) / two_pi)
-        angle = p + k * two_pi
-        while angle < hi:
-            if angle > lo:
-                out.append(angle)
-            angle += two_pi
-    out.sort(reverse=end < start)
-    return out
+    def get_state(self) -> dict[str, Any]:
+        return {"y": list(self.y), "mode": self.mode.to_dict()}
 
-
-def follower_along(program, s: float, start: float, end: float, c: float) -> float:
-    """Follower position [m] after the cam turns from start to end [rad] with play c [m].
-
-    The play operator sees every breakpoint passed on the way, where the
-    extrema of s_cam lie, not only the end point (speed drive).
-    """
-    if c == 0.0:
-        return program.derivatives(end)[0]
-    for angle in crossed(program.breakpoints(), start, end):
-        s = play(program.derivatives(angle)[0], s, c)
-    return play(program.derivatives(end)[0], s, c)
-
-
-def speed_engaged(program, theta: float, s: float, omega: float, c: float) -> bool:
-    """Is the follower at s [m] dragged by the cam at theta moving at omega (not free in the gap)?"""
-    if c == 0.0:
-        return True
-    s_cam, s1, _, _ = program.derivatives(theta)
-    gap = s_cam - s
-    return abs(gap) >= c * (1.0 - 1e-9) and gap * s1 * omega > 0.0
-
-
-def play(s_cam: float, s_prev: float, c: float) -> float:
-    """Backlash play operator (paper eqs. 6-8, continuous form): follower position [m]."""
-    if s_cam > s_prev + c:
-        return s_cam - c
-    if s_cam < s_prev - c:
-        return s_cam + c
-    return s_prev
-
-
+    def set_state(self, state: dict[str, Any]) -> None:
+        """The engine's state: this formulation's entries and the input held."""
+        self.u = float(state["u"])
+        self.y = [float(x) for x in state["y"]]
+        self.mode = Mode(**state["mode"])

@@ -1,4 +1,7 @@
-"""Scenes: small TOML files in models/ that describe one simulation experiment.
+"""Scenes: small TOML files that describe one simulation experiment.
+
+The scenes shipped with the package are in ``experiments/scene_files/``;
+``find_scene`` takes a scene's name (``paper_fig6``) or the path of any file.
 
 A scene names the drive and its input signal, parameter overrides (effects are
 the boolean parameters shaft_friction, guide_friction, gravity,
@@ -34,17 +37,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping
 
-from . import parameters as _parameters
-from .signals import Signal, from_spec
+from ..physics import parameters as _parameters
+from .signals import OPTIONAL_KEYS, SIGNAL_KEYS, Signal, from_spec
 
 TOP_KEYS = ("description", "drive", "u", "omega_ref", "parameters", "stop_time", "output_interval", "plot", "runs")
-PLOTS = ("fig4", "fig5", "fig6", "time")
-SIGNAL_KEYS = {
-    "constant": ("type", "value"),
-    "step": ("type", "time", "before", "after"),
-    "ramp": ("type", "start", "stop", "from", "to"),
-    "table": ("type", "time", "value", "hold"),
-}
+SCENE_DIR = Path(__file__).resolve().parent / "scene_files"
 DEFAULT_LABEL = "base"  # label of the only run of a scene without [[runs]]
 _LABEL = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
@@ -148,6 +145,8 @@ def scene_from_dict(data: Mapping[str, Any], name: str, path: Path | None = None
     if output_interval > stop_time:
         raise SceneError(f"{where}: 'output_interval' = {output_interval} s exceeds 'stop_time' = {stop_time} s")
 
+    from ..plots.scene import PLOTS  # the figure kinds' one table (matplotlib is imported only to draw)
+
     plot = data.get("plot", "time")
     if plot not in PLOTS:
         raise SceneError(f"{where}: 'plot' = {plot!r}: allowed {', '.join(map(repr, PLOTS))}")
@@ -218,7 +217,7 @@ def _signal(data: Mapping[str, Any], key: str, where: str) -> Signal | None:
         if unknown:
             raise SceneError(f"{where}: [{key}] (type {kind!r}): unknown key(s) {', '.join(map(repr, unknown))}; "
                              f"allowed: {', '.join(allowed)}")
-        missing = [k for k in allowed if k not in ("type", "hold") and k not in spec]
+        missing = [k for k in allowed if k != "type" and k not in OPTIONAL_KEYS and k not in spec]
         if missing:
             raise SceneError(f"{where}: [{key}] (type {kind!r}): missing key(s) {', '.join(map(repr, missing))}")
     try:
@@ -227,6 +226,23 @@ def _signal(data: Mapping[str, Any], key: str, where: str) -> Signal | None:
         raise SceneError(f"{where}: [{key}]: {exc}") from None
 
 
-def scene_files(directory: str | Path) -> list[Path]:
-    """The scene files (*.toml) of a directory, sorted."""
+def scene_files(directory: str | Path = SCENE_DIR) -> list[Path]:
+    """The scene files (*.toml) of a directory (default: the shipped scenes), sorted."""
     return sorted(Path(directory).glob("*.toml"))
+
+
+def scene_names() -> list[str]:
+    """Names of the shipped scenes."""
+    return [path.stem for path in scene_files()]
+
+
+def find_scene(name_or_path: str | Path) -> Scene:
+    """Load a shipped scene by name (``paper_fig6``) or any scene file by path."""
+    path = Path(name_or_path)
+    if path.suffix == ".toml" or path.exists() or len(path.parts) > 1:
+        return load_scene(path)
+    shipped = SCENE_DIR / f"{path.name}.toml"
+    if not shipped.is_file():
+        raise SceneError(f"no scene named {str(name_or_path)!r}: shipped scenes are "
+                         f"{', '.join(scene_names())}; or give the path of a .toml file")
+    return load_scene(shipped)

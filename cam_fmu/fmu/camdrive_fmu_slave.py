@@ -1,17 +1,17 @@
 """The FMI 2.0 co-simulation slave of cam.fmu (pythonfmu 0.7.0).
 
 Thin by design: it registers the FMI variables (inputs ``u`` and ``omega_ref``,
-the outputs of ``simulator.OUTPUTS`` and every parameter of
-``parameters.PARAMETERS`` under the same name and unit) and maps the FMI calls
-onto ``simulator.DriveSimulator``, the same physics code the reference uses.
+the outputs of ``physics.variables.OUTPUTS`` and every parameter of
+``physics.parameters.PARAMETERS`` under the same name and unit) and maps the FMI
+calls onto ``fmu.engine.DriveSimulator``, the same physics code the reference uses.
 
 The module name ``camdrive_fmu_slave`` is deliberately unique: pythonfmu imports
 the slave script as a *top-level* module of the host process, and module names
 are process-global (two FMUs whose scripts share a module name cannot both load
 in one process).
 
-Imports at run time: pythonfmu, ``cam_fmu.parameters`` and ``cam_fmu.simulator``
-(numpy at most). Never scipy: it crashes native hosts at Py_Finalize.
+Imports at run time: pythonfmu, ``cam_fmu.physics.parameters``,
+``cam_fmu.physics.variables`` and ``cam_fmu.fmu.engine`` (numpy at most). Never scipy: it crashes native hosts at Py_Finalize.
 
 Errors. pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
 an FMI call (fmi2SetReal/Boolean/String, fmi2EnterInitializationMode,
@@ -46,8 +46,9 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variab
 from pythonfmu.enums import Fmi2Status
 from pythonfmu.default_experiment import DefaultExperiment
 
-from cam_fmu import parameters as _parameters
-from cam_fmu import simulator as _simulator
+from cam_fmu.fmu import engine as _simulator
+from cam_fmu.physics import parameters as _parameters
+from cam_fmu.physics import variables as _variables
 
 MODEL_NAME = "cam"
 DESCRIPTION = (
@@ -55,7 +56,8 @@ DESCRIPTION = (
     "in-line roller follower (friction, gravity, backlash); voltage or speed drive. "
     "Default experiment: the paper's fig. 6 scene (u = 3.5 V, horizontal mounting)."
 )
-# The paper's fig. 6 scene: 0..2 s, 1 ms communication step.
+# The paper's fig. 6 scene: 0..2 s, 1 ms communication step (the one place it is set;
+# the model description is written from it and a test checks the paper_fig6 scene against it).
 DEFAULT_EXPERIMENT = DefaultExperiment(start_time=0.0, stop_time=2.0, step_size=1e-3)
 
 
@@ -74,16 +76,16 @@ class CamDriveSlave(Fmi2Slave):
         super().__init__(**kwargs)
         self.modelName = MODEL_NAME
         self._params: Dict[str, Any] = _parameters.defaults()
-        self._inputs: Dict[str, float] = {name: float(start) for name, _u, start, _d in _simulator.INPUTS}
-        self._outputs: Dict[str, float] = {name: 0.0 for name, _u, _d in _simulator.OUTPUTS}
+        self._inputs: Dict[str, float] = {name: float(start) for name, _u, start, _d in _variables.INPUTS}
+        self._outputs: Dict[str, float] = {name: 0.0 for name, _u, _d in _variables.OUTPUTS}
         self._sim = None  # DriveSimulator, built at exit_initialization_mode or on first use
         self._initialized = False  # True after exit_initialization_mode: parameters are fixed
 
-        for name, _unit, _start, desc in _simulator.INPUTS:
+        for name, _unit, _start, desc in _variables.INPUTS:
             self.register_variable(Real(
                 name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
                 description=desc, getter=self._input_getter(name), setter=self._input_setter(name)))
-        for name, _unit, desc in _simulator.OUTPUTS:
+        for name, _unit, desc in _variables.OUTPUTS:
             self.register_variable(Real(
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                 initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(name)))
@@ -99,7 +101,7 @@ class CamDriveSlave(Fmi2Slave):
         return lambda: self._inputs[name]
 
     def _input_setter(self, name: str):
-        unit = {n: u for n, u, _s, _d in _simulator.INPUTS}[name]
+        unit = {n: u for n, u, _s, _d in _variables.INPUTS}[name]
 
         def setter(value: Any) -> None:
             number = float(value)

@@ -1,11 +1,11 @@
 """The paper's discrete simulation algorithm (section 3, steps 1-9), reproduced.
 
-Reproduced as printed, except for the OCR errors MODEL.md corrects: step 3 sums
+Reproduced as printed, except for the OCR errors docs/model.md corrects: step 3 sums
 omega (not alpha), eq. (1) keeps its mu, c_m is in N m/A, and v/omega is taken
 as ds/dtheta from the profile (undefined at omega = 0 otherwise). Signed v and
 a on a fixed X axis replace the paper's unsigned values and beta flip.
 
-What makes it differ from the consistent formulation (MODEL.md section 5):
+What makes it differ from the consistent formulation (docs/model.md section 5):
 eq. (12) divides by J = J_m + m s'^2 and subtracts an M_l that holds m a s'
 with a = s'' omega^2 + s' omega_dot taken from backward differences, so the
 follower's inertia m s'^2 omega_dot is counted twice, one step late. The lag
@@ -20,8 +20,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .drive_model import DriveModel, _sign, solve_guide_friction
-from .hybrid import play
+from ..contact import play
+from ..drive import DriveModel, sign, solve_guide_friction
+from ..variables import output_record
+from .base import Formulation
 
 
 class PaperScheme:
@@ -55,18 +57,19 @@ class PaperScheme:
         """M_f with its sign, or None when the shaft stays stuck this step."""
         model = self.model
         if self.omega != 0.0:
-            return model.M_f * _sign(self.omega)
+            return model.M_f * sign(self.omega)
         net = drive_torque - self.M_l
         if abs(net) <= model.M_f:
             return None
-        return model.M_f * _sign(net)
+        return model.M_f * sign(net)
 
     def step(self, T: float, u: float) -> None:
         """Steps 2-8 for one calculation step T [s] under the voltage u [V]."""
         model = self.model
         self.voltage = u
         L = model.L
-        drive = model.c_m * (self.i if L > 0.0 else (u - model.c_e * self.omega) / model.R)
+        motor = model.motor
+        drive = model.c_m * (self.i if L > 0.0 else motor.quasi_static_current(u, self.omega))
         shaft = self._shaft_friction(drive)
         omega_old = self.omega
         if shaft is not None:
@@ -81,9 +84,9 @@ class PaperScheme:
             elif omega_old == 0.0 and self.omega * shaft < 0.0:
                 self.omega = 0.0
         elif L > 0.0:
-            self.i = u / model.R + (self.i - u / model.R) * math.exp(-T * model.R / L)
+            self.i = motor.current_at_rest(self.i, u, T)
         if L == 0.0:
-            self.i = (u - model.c_e * self.omega) / model.R
+            self.i = motor.quasi_static_current(u, self.omega)
         # Step 3: theta by summation of omega (printed as alpha: an OCR error).
         self.theta += self.omega * T
         # Step 4: profile and backlash law (eqs. 6-8).
@@ -100,20 +103,17 @@ class PaperScheme:
         tan_a = s1 / (model.r_b + s_cam)
         self.alpha = math.atan(tan_a)
         push = model.m * self.a - model.F_gx
-        sigma = _sign(self.v)
+        sigma = sign(self.v)
         f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g)
         self.M_l = (push + sigma * f) * X
         # Step 8: eq. (4).
         self.J = model.J_m + model.m * X * X
-        self.M = model.M_f * _sign(self.omega) + self.M_l
+        self.M = model.M_f * sign(self.omega) + self.M_l
 
     def outputs(self) -> dict[str, float]:
         s_cam = self.model.program.derivatives(self.theta)[0]
-        return {
-            "omega": self.omega, "theta": self.theta, "s": self.s, "i": self.i, "M": self.M,
-            "J": self.J, "v": self.v, "a": self.a, "alpha": self.alpha, "s_cam": s_cam,
-            "voltage": self.voltage,
-        }
+        return output_record(omega=self.omega, theta=self.theta, s=self.s, i=self.i, M=self.M, J=self.J,
+                             v=self.v, a=self.a, alpha=self.alpha, s_cam=s_cam, voltage=self.voltage)
 
 
 def _rk4_motor(model: DriveModel, omega: float, M: float, J: float, u: float, T: float) -> float:
@@ -132,13 +132,14 @@ def _rk4_motor(model: DriveModel, omega: float, M: float, J: float, u: float, T:
 
 def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J: float, u: float, T: float) -> tuple[float, float]:
     """RK4 on eqs. (9)-(10) with L > 0, sub-stepped inside RK4's stability limit."""
-    R, L, cm, ce = model.R, model.L, model.c_m, model.c_e
-    rate = R / L + math.sqrt(cm * ce / (J * L))
+    motor = model.motor
+    cm, current_rate = motor.c_m, motor.current_rate
+    rate = motor.electrical_rate(J)
     n = max(1, math.ceil(T * rate / 2.0))
     h = T / n
 
     def f(w: float, c: float) -> tuple[float, float]:
-        return (cm * c - M) / J, (u - R * c - ce * w) / L
+        return (cm * c - M) / J, current_rate(u, c, w)
 
     for _ in range(n):
         a1, b1 = f(omega, i)
@@ -148,3 +149,33 @@ def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J:
         omega += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
         i += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
     return omega, i
+
+
+class PaperVoltage(Formulation):
+    """The paper's algorithm under the voltage input u, with T = the largest step <= h_max dividing h."""
+
+    def __init__(self, model: DriveModel, u: float) -> None:
+        p = model.params
+        self.scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
+        self.h_max = p["h_max"]
+        self.u = u
+
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
+        self.u = u
+
+    def advance(self, h: float, integrator: Any, time: float) -> int:
+        n = max(1, math.ceil(h / self.h_max - 1e-9))
+        for _ in range(n):
+            self.scheme.step(h / n, self.u)
+        return n
+
+    def outputs(self, integrator: Any) -> dict[str, float]:
+        return self.scheme.outputs()
+
+    def get_state(self) -> dict[str, Any]:
+        return {"scheme": self.scheme.get_state()}
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """The engine's state: this formulation's entries and the input held."""
+        self.u = float(state["u"])
+        self.scheme.set_state(state["scheme"])

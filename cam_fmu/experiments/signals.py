@@ -4,7 +4,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass, field
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 
 @dataclass(frozen=True)
@@ -62,6 +62,34 @@ def constant(value: float) -> Signal:
     return Signal((0.0,), (float(value),))
 
 
+def _step(spec: Mapping[str, Any]) -> Signal:
+    t, a, b = float(spec["time"]), float(spec["before"]), float(spec["after"])
+    return Signal((0.0, t, t), (a, a, b)) if t > 0.0 else constant(b)
+
+
+def _ramp(spec: Mapping[str, Any]) -> Signal:
+    t0, t1 = float(spec["start"]), float(spec["stop"])
+    a, b = float(spec["from"]), float(spec["to"])
+    if not t1 > t0 >= 0.0:
+        raise ValueError(f"ramp: need 0 <= start < stop, got start = {t0}, stop = {t1}")
+    return Signal((0.0, t0, t1), (a, a, b))
+
+
+def _table(spec: Mapping[str, Any]) -> Signal:
+    return Signal(tuple(map(float, spec["time"])), tuple(map(float, spec["value"])), bool(spec.get("hold", False)))
+
+
+# The one table of signal kinds: the keys each takes (after 'type') and its builder.
+SIGNAL_KINDS: dict[str, tuple[tuple[str, ...], Callable[[Mapping[str, Any]], Signal]]] = {
+    "constant": (("value",), lambda spec: constant(spec["value"])),
+    "step": (("time", "before", "after"), _step),
+    "ramp": (("start", "stop", "from", "to"), _ramp),
+    "table": (("time", "value", "hold"), _table),
+}
+OPTIONAL_KEYS = ("hold",)
+SIGNAL_KEYS: dict[str, tuple[str, ...]] = {kind: ("type",) + keys for kind, (keys, _b) in SIGNAL_KINDS.items()}
+
+
 def from_spec(spec: Mapping[str, Any] | float) -> Signal:
     """Signal from a scene entry: a number, or a table with 'type'.
 
@@ -72,20 +100,9 @@ def from_spec(spec: Mapping[str, Any] | float) -> Signal:
     if isinstance(spec, (int, float)):
         return constant(spec)
     kind = spec.get("type", "constant")
-    if kind == "constant":
-        return constant(spec["value"])
-    if kind == "step":
-        t, a, b = float(spec["time"]), float(spec["before"]), float(spec["after"])
-        return Signal((0.0, t, t), (a, a, b)) if t > 0.0 else constant(b)
-    if kind == "ramp":
-        t0, t1 = float(spec["start"]), float(spec["stop"])
-        a, b = float(spec["from"]), float(spec["to"])
-        if not t1 > t0 >= 0.0:
-            raise ValueError(f"ramp: need 0 <= start < stop, got start = {t0}, stop = {t1}")
-        return Signal((0.0, t0, t1), (a, a, b))
-    if kind == "table":
-        return Signal(tuple(map(float, spec["time"])), tuple(map(float, spec["value"])), bool(spec.get("hold", False)))
-    raise ValueError(f"signal type {kind!r}: allowed 'constant', 'step', 'ramp', 'table'")
+    if kind not in SIGNAL_KINDS:
+        raise ValueError(f"signal type {kind!r}: allowed {', '.join(map(repr, SIGNAL_KINDS))}")
+    return SIGNAL_KINDS[kind][1](spec)
 
 
 def as_table(signal: Signal, stop: float) -> tuple[Sequence[float], Sequence[float]]:

@@ -10,7 +10,9 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-KGF = 9.80665  # N per kgf: the paper's c_m = 0.015 is in kgf m/A (MODEL.md section 3)
+from ..kinematics.presets import PRESETS
+
+KGF = 9.80665  # N per kgf: the paper's c_m = 0.015 is in kgf m/A (docs/model.md section 3)
 PAPER_A = 0.035  # m, the paper's profile constant A
 
 
@@ -66,10 +68,8 @@ class ParameterSpec:
         return number
 
 
-LAW_CHOICES = (
-    "paper", "cycloidal", "modified_sine", "modified_trapezoid", "simple_harmonic",
-    "constant_acceleration", "mcv50", "custom",
-)
+LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table
+# Checked against the registries (physics.formulations.FORMULATIONS, solvers.SOLVERS) by tests/test_layout.py.
 FORMULATIONS = ("consistent", "paper")
 DRIVES = ("voltage", "speed")
 SOLVERS = ("euler", "rk4", "rk45", "etdrk4")
@@ -110,7 +110,7 @@ _PROGRAM = (
 )
 
 _MODE = (
-    _P("formulation", "", "consistent", "'consistent' (energy-consistent, MODEL.md section 5) or 'paper' (published steps 1-9)", kind="string", choices=FORMULATIONS),
+    _P("formulation", "", "consistent", "'consistent' (energy-consistent, docs/model.md section 5) or 'paper' (published steps 1-9)", kind="string", choices=FORMULATIONS),
     _P("drive", "", "voltage", "'voltage': u(t) is the input; 'speed': omega_ref(t) is imposed", kind="string", choices=DRIVES),
     *(_P(name, "", True, f"model the {name.replace('_', ' ')} (false: the effect is off and costs nothing)", kind="boolean")
       for name in EFFECTS),

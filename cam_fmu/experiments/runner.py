@@ -2,12 +2,12 @@
 
 ``run_scene(scene, engine)`` returns ``{label: {"time": array, <output>: array, ...}}``
 in the order of the scene's runs (the first is the primary run). Every result
-holds 'time' and every name of simulator.OUTPUTS, in SI units.
+holds 'time' and every name of physics.variables.OUTPUTS, in SI units.
 
 - ``reference``: reference.simulate_reference with the run's parameters and the
   scene's input signals (continuous in time, breaks located exactly).
-- ``fmu``: models/cam.fmu (built with build_fmu.build() first when missing)
-  simulated by fmpy.simulate_fmu: start values = the run's parameter overrides,
+- ``fmu``: cam.fmu (fmu_file.ensure_fmu: built first when missing or stale)
+  simulated through the one fmpy runner (fmpy_runner.FmuRunner): start values = the run's parameter overrides,
   input = the scene's signals as a table (fmpy applies them at each
   communication point and the FMU holds them over the step), communication
   step = the scene's output interval. A run that stops before stop_time (fmpy
@@ -15,21 +15,17 @@ holds 'time' and every name of simulator.OUTPUTS, in SI units.
 """
 from __future__ import annotations
 
-import importlib.util
-import math
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping
 
 import numpy as np
 
+from ..physics.variables import INPUTS, OUTPUT_NAMES
+from .fmu_file import FmuFileError, ensure_fmu
 from .scenes import Run, Scene
 from .signals import Signal, as_table, constant
-from .simulator import INPUTS, OUTPUTS
 
 ENGINES = ("reference", "fmu")
-REPO_ROOT = Path(__file__).resolve().parent.parent
-DEFAULT_FMU = REPO_ROOT / "models" / "cam.fmu"
-OUTPUT_NAMES = tuple(name for name, _unit, _desc in OUTPUTS)
 
 
 class EngineError(RuntimeError):
@@ -42,13 +38,16 @@ def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | No
         raise ValueError(f"engine {engine!r}: allowed {', '.join(map(repr, ENGINES))}")
     if engine == "reference":
         return {run.label: _reference(scene, run) for run in scene.runs}
-    fmu = ensure_fmu(fmu_path)
+    try:
+        fmu = ensure_fmu(fmu_path)
+    except FmuFileError as exc:
+        raise EngineError(str(exc)) from None
     return _fmu_runs(scene, fmu)
 
 
 # ------------------------------------------------------------------ reference
 def _reference(scene: Scene, run: Run) -> dict[str, np.ndarray]:
-    from .reference import simulate_reference  # scipy: only on this path
+    from ..reference import simulate_reference  # scipy: only on this path
 
     try:
         return simulate_reference(run.overrides, scene.stop_time, scene.output_interval,
@@ -58,23 +57,6 @@ def _reference(scene: Scene, run: Run) -> dict[str, np.ndarray]:
 
 
 # ------------------------------------------------------------------------ fmu
-def ensure_fmu(fmu_path: str | Path | None = None) -> Path:
-    """Path of the FMU; the default models/cam.fmu is built with build_fmu.build() when missing."""
-    path = Path(fmu_path) if fmu_path else DEFAULT_FMU
-    if path.is_file():
-        return path
-    if fmu_path:
-        raise EngineError(f"FMU {str(path)!r} does not exist")
-    script = REPO_ROOT / "build_fmu.py"
-    if not script.is_file():
-        raise EngineError(f"{path} is missing and there is no {script} to build it")
-    spec = importlib.util.spec_from_file_location("build_fmu", script)
-    module = importlib.util.module_from_spec(spec)
-    assert spec.loader is not None
-    spec.loader.exec_module(module)
-    return Path(module.build(path))
-
-
 def input_table(scene: Scene) -> np.ndarray:
     """The scene's input signals as fmpy's structured input array (time, u, omega_ref, omega_dot_ref)."""
     return signals_table({"u": scene.u, "omega_ref": scene.omega_ref,
@@ -119,54 +101,19 @@ def _left_value(sig: Signal, t: float) -> float:
 def _fmu_runs(scene: Scene, fmu: Path) -> dict[str, dict[str, np.ndarray]]:
     """All runs on one instance of the FMU, reset between runs.
 
-    The FMU is extracted and its library loaded once per scene (fmpy's default
-    path instantiates and frees an instance per run).
+    No fmi2FreeInstance: with it, the process aborted at exit in about half of
+    the runs under pytest ("corrupted double-linked list"); without it, never.
+    The instance goes with the process.
     """
-    import shutil
-    import tempfile
+    from .fmpy_runner import FmuRunner
 
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-
-    md = read_model_description(str(fmu))
-    workdir = tempfile.mkdtemp(prefix="cam_fmu_scene_")
-    try:
-        unzipdir = extract(str(fmu), unzipdir=workdir)
-        instance = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=scene.name)
-        instance.instantiate()
-        results = {}
-        for k, run in enumerate(scene.runs):
-            if k:
-                instance.reset()
-            results[run.label] = _fmu(scene, run, fmu, unzipdir, md, instance)
-        # No fmi2FreeInstance: with it, the process aborted at exit in about half of the
-        # runs under pytest ("corrupted double-linked list"); without it, never. The
-        # instance goes with the process.
-        return results
-    finally:
-        shutil.rmtree(workdir, ignore_errors=True)
-
-
-def _fmu(scene: Scene, run: Run, fmu: Path, unzipdir: str, md: Any, instance: Any) -> dict[str, np.ndarray]:
-    from fmpy import simulate_fmu  # heavy: only on this path
-
-    reached = [0.0]
-
-    def step_finished(time: float, _recorder: Any) -> bool:
-        reached[0] = time
-        return True
-
-    try:
-        result = simulate_fmu(
-            unzipdir, model_description=md, fmu_instance=instance, start_time=0.0,
-            stop_time=scene.stop_time, output_interval=scene.output_interval,
-            start_values=run.start_values(), input=input_table(scene), output=list(OUTPUT_NAMES),
-            step_finished=step_finished,
-        )
-    except Exception as exc:  # noqa: BLE001 - re-raised with the scene and run named
-        raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu' ({fmu}): {exc}") from exc
-    if not math.isclose(reached[0], scene.stop_time, rel_tol=1e-9, abs_tol=1e-12):
-        raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu': the FMU stopped at "
-                          f"t = {reached[0]:g} s before stop_time = {scene.stop_time:g} s")
-    return {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}
+    runner = FmuRunner(fmu, name=scene.name)
+    results = {}
+    for run in scene.runs:
+        try:
+            result = runner.simulate(run.start_values(), scene.stop_time, scene.output_interval,
+                                     input_table(scene), outputs=OUTPUT_NAMES, check_end=True)
+        except Exception as exc:  # noqa: BLE001 - re-raised with the scene and run named
+            raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu' ({fmu}): {exc}") from exc
+        results[run.label] = {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}
+    return results

@@ -1,69 +1,10 @@
-"""One-step methods on short tuples of floats (``math`` only: the FMU's hot path).
-
-``f(y)`` returns dy/dt as a tuple; y is a list or tuple of floats. Each
-function advances by one step h [s] and returns the new state as a list.
-"""
+"""Exponential RK4 for the motor's linear part: coefficients and one step (``math`` only)."""
 from __future__ import annotations
 
 import math
-from typing import Callable, Sequence
 
-Vector = Sequence[float]
-Derivative = Callable[[Vector], tuple]
-
-
-def euler_step(f: Derivative, y: Vector, h: float) -> list[float]:
-    """Explicit Euler, order 1."""
-    return [a + h * b for a, b in zip(y, f(y))]
-
-
-def rk4_step(f: Derivative, y: Vector, h: float) -> list[float]:
-    """Classical Runge-Kutta, order 4."""
-    k1 = f(y)
-    k2 = f([a + 0.5 * h * b for a, b in zip(y, k1)])
-    k3 = f([a + 0.5 * h * b for a, b in zip(y, k2)])
-    k4 = f([a + h * b for a, b in zip(y, k3)])
-    h6 = h / 6.0
-    return [a + h6 * (b1 + 2.0 * b2 + 2.0 * b3 + b4) for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4)]
-
-
-# Dormand-Prince 5(4) tableau (Hairer, Norsett, Wanner, Solving ODE I, table 5.2).
-_C = (0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0)
-_A = (
-    (),
-    (1 / 5,),
-    (3 / 40, 9 / 40),
-    (44 / 45, -56 / 15, 32 / 9),
-    (19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729),
-    (9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656),
-    (35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84),
-)
-_E = (71 / 57600, 0.0, -71 / 16695, 71 / 1920, -17253 / 339200, 22 / 525, -1 / 40)  # b5 - b4
-
-
-def dopri_step(f: Derivative, y: Vector, h: float, k1: tuple | None = None) -> tuple[list[float], list[float], tuple]:
-    """Dormand-Prince 5(4): (y5, error estimate y5 - y4, f(y5) for FSAL reuse).
-
-    Unrolled over the tableau: this is the FMU's hot path.
-    """
-    a2, a3, a4, a5, a6, b = _A[1:]
-    if k1 is None:
-        k1 = f(y)
-    k2 = f([x + h * a2[0] * p1 for x, p1 in zip(y, k1)])
-    k3 = f([x + h * (a3[0] * p1 + a3[1] * p2) for x, p1, p2 in zip(y, k1, k2)])
-    k4 = f([x + h * (a4[0] * p1 + a4[1] * p2 + a4[2] * p3) for x, p1, p2, p3 in zip(y, k1, k2, k3)])
-    k5 = f([x + h * (a5[0] * p1 + a5[1] * p2 + a5[2] * p3 + a5[3] * p4)
-            for x, p1, p2, p3, p4 in zip(y, k1, k2, k3, k4)])
-    k6 = f([x + h * (a6[0] * p1 + a6[1] * p2 + a6[2] * p3 + a6[3] * p4 + a6[4] * p5)
-            for x, p1, p2, p3, p4, p5 in zip(y, k1, k2, k3, k4, k5)])
-    # b[1] is 0; the seventh stage is evaluated at y5 itself (first same as last).
-    y5 = [x + h * (b[0] * p1 + b[2] * p3 + b[3] * p4 + b[4] * p5 + b[5] * p6)
-          for x, p1, p3, p4, p5, p6 in zip(y, k1, k3, k4, k5, k6)]
-    k7 = f(y5)
-    e = _E
-    err = [h * (e[0] * p1 + e[2] * p3 + e[3] * p4 + e[4] * p5 + e[5] * p6 + e[6] * p7)
-           for p1, p3, p4, p5, p6, p7 in zip(k1, k3, k4, k5, k6, k7)]
-    return y5, err, k7
+from .base import Derivative, Stepper, Vector
+from .explicit import rk4_step
 
 
 def phi_functions(z: float) -> tuple[float, float, float, float, float]:
@@ -146,3 +87,43 @@ def etdrk4_motor_step(f: Derivative, y: Vector, coef: MotorEtdCoefficients, a: f
              + h * a_full * (g1 * n_y[2] + 2.0 * g2 * (n_a[2] + n_b[2]) + g3 * n_c[2]))
     e = coef.e_full * y[2] + h * (f1 * n_y[2] + 2.0 * f2 * (n_a[2] + n_b[2]) + f3 * n_c[2])
     return [theta, omega, e]
+
+
+class ETDRK4(Stepper):
+    """Exponential RK4: the electrical pole -R/L and its torque on omega integrated exactly.
+
+    ETD runs on the current's deviation e = i - (u - c_e omega) / R from its
+    quasi-static value: de/dt = -(R/L) e + (c_e/R) omega_dot, and on e's torque
+    c_m e / J on omega. The forcing stays bounded as L -> 0, so the stiff limit
+    and the fast transient after a break-away are exact. Measured before: ETD
+    on i alone lags the back-EMF by one step (order 1, 2.4e-2 rad at 1 ms with
+    L = 1e-6 H) and a diagonal ETD on e still missed the transient's torque
+    (7e-3 rad). With no current in the state it is the classical RK4.
+    """
+
+    name = "etdrk4"
+    stability = 2.5
+    exact_electrical_pole = True
+
+    def __init__(self, settings):
+        super().__init__(settings)
+        self._coef: MotorEtdCoefficients | None = None
+
+    def step(self, f, y, dt, system, u, mode):
+        if not system.has_current:
+            return rk4_step(f, y, dt)
+        motor = system.motor
+        R, ce, rate = motor.R, motor.c_e, motor.R / motor.L
+        coef = self._coef
+        if coef is None or coef.h != dt:
+            coef = self._coef = MotorEtdCoefficients(-rate, dt)
+        a = system.torque_gain(y, mode)
+        qs = motor.quasi_static_current
+
+        def deviation_rate(z):
+            i = qs(u, z[1]) + z[2]
+            d = f((z[0], z[1], i))
+            return (d[0], d[1], -rate * z[2] + ce / R * d[1])
+
+        z = etdrk4_motor_step(deviation_rate, (y[0], y[1], y[2] - qs(u, y[1])), coef, a)
+        return [z[0], z[1], z[2] + qs(u, z[1])]

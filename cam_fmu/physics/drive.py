@@ -1,7 +1,7 @@
 """Physics of the cam drive: follower forces, load torque, inertia, motor.
 
 Plain functions of plain floats (``math`` only), shared by the reference
-integration, the FMU and the tests. Equations and corrections: MODEL.md
+integration, the FMU and the tests. Equations and corrections: docs/model.md
 sections 3-6. Sign conventions: X is the rise direction, theta and omega are
 positive in the cam's forward sense, v = ds/dt and a = d2s/dt2 are signed.
 
@@ -15,11 +15,13 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from .kinematics.cam_program import CamProgram
+from ..kinematics.cam_program import CamProgram
+from .motor import Motor
 from .parameters import law_spec, resolve
 
 
-def _sign(x: float) -> float:
+def sign(x: float) -> float:
+    """+1, -1 or 0 (Coulomb friction's sgn, with sgn(0) = 0)."""
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
@@ -28,7 +30,7 @@ def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_sup
 
     The side force N_r = n0 + sigma kappa f depends on f itself (through the
     contact force): solved exactly on its two linear branches instead of lagging
-    f by a step (MODEL.md section 5). Unique because mu |kappa| < 1.
+    f by a step (docs/model.md section 5). Unique because mu |kappa| < 1.
     """
     if mu == 0.0:
         return 0.0
@@ -67,6 +69,7 @@ class DriveModel:
         self.L = p["L"] if p["inductance"] else 0.0
         self.c_e = p["c_e"]
         self.c_m = p["c_m"]
+        self.motor = Motor(self.R, self.L, self.c_e, self.c_m)
         self.J_m = p["J_m"]
         self.M_f = p["M_f"] if p["shaft_friction"] else 0.0
         self.m = p["m"] if p["follower_inertia"] else 0.0
@@ -83,18 +86,9 @@ class DriveModel:
         # Does the follower load the shaft at all? (inertia, gravity or friction)
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
 
-    # ----------------------------------------------------------------- motor
-    def current(self, u: float, omega: float) -> float:
-        """Armature current [A] with L = 0: i = (u - c_e omega) / R."""
-        return (u - self.c_e * omega) / self.R
-
-    def current_rate(self, u: float, omega: float, i: float) -> float:
-        """di/dt [A/s] with L > 0: (u - R i - c_e omega) / L."""
-        return (u - self.R * i - self.c_e * omega) / self.L
-
     # ----------------------------------------------------------- mechanics
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True) -> float:
-        """Angular acceleration [rad/s2], consistent formulation (MODEL.md section 5).
+        """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5).
 
         ``torque`` is the motor torque c_m i [N m]; ``direction`` is sgn(omega),
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
@@ -127,7 +121,7 @@ class DriveModel:
             return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, math.atan(tan_a), s)
         v = s1 * omega
         a = s2 * omega * omega + s1 * omega_dot
-        sigma = _sign(s1 * direction)
+        sigma = sign(s1 * direction)
         push = self.m * a - self.F_gx  # N, axial force without friction
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g)
         M_l = (push + sigma * f) * s1

@@ -24,7 +24,8 @@ from typing import Any, Dict, List, Optional
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
-from . import parameters
+from ..physics import parameters
+from ..physics.variables import INPUTS, OUTPUTS
 
 # SI base-unit exponents of the units used by the model (FMI 2.0 BaseUnit attributes).
 BASE_UNITS: Dict[str, Dict[str, int]] = {
@@ -50,20 +51,14 @@ BASE_UNITS: Dict[str, Dict[str, int]] = {
 BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
-def _simulator():
-    from . import simulator  # imported lazily: the build needs it, the README table too
-    return simulator
-
-
 def variable_rows() -> List[Dict[str, Any]]:
     """Every FMU variable in value-reference order (the slave registers inputs, outputs, parameters)."""
-    sim = _simulator()
     rows: List[Dict[str, Any]] = []
-    for name, unit, start, desc in sim.INPUTS:
+    for name, unit, start, desc in INPUTS:
         rows.append(dict(name=name, type="Real", causality="input", variability="continuous", initial=None,
                          unit=unit, start=float(start), min=None, max=None, description=desc,
                          allowed="any finite value"))
-    for name, unit, desc in sim.OUTPUTS:
+    for name, unit, desc in OUTPUTS:
         rows.append(dict(name=name, type="Real", causality="output", variability="continuous",
                          initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
                          allowed="(output)"))
@@ -87,8 +82,7 @@ def _fmt(value: Any) -> str:
     return str(value)
 
 
-def postprocess(xml_bytes: bytes, description: Optional[str] = None,
-                default_experiment: tuple = (0.0, 2.0, 1e-3)) -> bytes:
+def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Optional[str] = None) -> bytes:
     """Return the completed modelDescription.xml."""
     root = ET.fromstring(xml_bytes)
     for element in root.iter():  # drop pythonfmu's pretty-printing whitespace before re-indenting
@@ -107,7 +101,9 @@ def postprocess(xml_bytes: bytes, description: Optional[str] = None,
     unit_defs = ET.Element("UnitDefinitions")
     for unit in units:
         node = ET.SubElement(unit_defs, "Unit", name=unit)
-        exps = BASE_UNITS.get(unit)
+        if unit not in BASE_UNITS:
+            raise ValueError(f"unit {unit!r} has no entry in BASE_UNITS (its SI base-unit exponents)")
+        exps = BASE_UNITS[unit]
         if exps:
             ET.SubElement(node, "BaseUnit", {k: str(exps[k]) for k in BASE_UNIT_ORDER if k in exps})
     children = list(root)
@@ -199,5 +195,5 @@ def markdown_table() -> str:
     return "\n".join(lines)
 
 
-if __name__ == "__main__":  # python -m cam_fmu.fmu_xml: print the README table
+if __name__ == "__main__":  # python -m cam_fmu.fmu.model_description: print the variable table
     print(markdown_table())

@@ -1,6 +1,6 @@
 """Direct-Python reference integration of the drive with scipy (the ground truth).
 
-It integrates the same hybrid system as the FMU (hybrid.py) with
+It integrates the same hybrid system as the FMU (physics.formulations.consistent) with
 scipy.integrate.solve_ivp at tight tolerances, and stops at every non-smooth
 point instead of stepping over it: profile segment ends (s''' jumps), input
 breaks, stick/slip and backlash contact changes; each transition is applied at
@@ -8,7 +8,7 @@ the located time and the integration restarts there. L > 0 with a fast
 electrical pole uses Radau (implicit), otherwise DOP853.
 
 Results are a dict of numpy arrays on the output grid: time and the outputs of
-simulator.OUTPUTS. With ``energy=True`` four integrals are added [J]:
+physics.variables.OUTPUTS. With ``energy=True`` four integrals are added [J]:
 E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt and
 E_guide = int f |v| dt, for the power balance.
 """
@@ -20,11 +20,13 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .drive_model import DriveModel
-from .hybrid import HybridDrive, follower_along, speed_drive_outputs, speed_engaged
-from .paper_scheme import PaperScheme
-from .signals import Signal, constant
-from .simulator import OUTPUTS
+from ..experiments.signals import Signal, constant
+from ..physics.contact import follower_along, speed_engaged
+from ..physics.drive import DriveModel
+from ..physics.formulations.consistent import HybridDrive
+from ..physics.formulations.paper import PaperScheme
+from ..physics.formulations.speed import speed_drive_outputs
+from ..physics.variables import INPUT_STARTS, OUTPUTS
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide")
 
@@ -42,8 +44,8 @@ def simulate_reference(
 ) -> dict[str, np.ndarray]:
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s]."""
     model = DriveModel(params)
-    u = u or constant(3.5)
-    omega_ref = omega_ref or constant(1.0)
+    u = u or constant(INPUT_STARTS["u"])
+    omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
     grid = _grid(stop_time, output_interval)
     if model.drive == "speed":
         return _speed(model, grid, omega_ref)

@@ -1,0 +1,105 @@
+"""The one fmpy runner: an FMU extracted and instantiated once, reset between runs.
+
+Used by the scene runner and the bench. fmpy's default path instantiates and
+frees an instance per run; this one keeps the library loaded and the
+instance alive. An instance that failed is abandoned, never freed: freeing a
+pythonfmu 0.7.0 instance after an error crashes the host at exit.
+"""
+from __future__ import annotations
+
+import math
+import tempfile
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+
+class FmuRunError(RuntimeError):
+    """A run that failed or stopped early; the message is the FMU's own where it gave one."""
+
+
+class FmuRunner:
+    """``simulate`` runs the FMU from 0 to stop_time through fmpy.simulate_fmu."""
+
+    def __init__(self, fmu: str | Path, workdir: str | Path | None = None, name: str = "cam") -> None:
+        from fmpy import extract, read_model_description
+
+        self.name = name
+        self.fmu_path = Path(fmu)
+        self.md = read_model_description(str(fmu))
+        self._tmp = None
+        if workdir is None:
+            self._tmp = tempfile.TemporaryDirectory(prefix="cam_fmu_run_")
+            workdir = self._tmp.name
+        self.unzipdir = extract(str(fmu), unzipdir=str(Path(workdir) / f"unzip_{name}"))
+        self.count = 0
+        self.fmu = None
+        self.abandoned: list = []
+        self._new_instance()
+
+    def _new_instance(self, logging: bool = False, logger: Callable | None = None) -> None:
+        from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
+
+        if self.fmu is not None:
+            self.abandoned.append(self.fmu)
+        self.count += 1
+        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                             modelIdentifier=self.md.coSimulation.modelIdentifier,
+                             instanceName=f"{self.name}{self.count}")
+        callbacks = None
+        if logger is not None:
+            callbacks = fmi2CallbackFunctions()
+            callbacks.logger = fmi2CallbackLoggerTYPE(logger)
+            callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+            callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+            try:  # fmpy's proxy formats the variadic message
+                from ctypes import byref
+
+                from fmpy.logging import addLoggerProxy
+                addLoggerProxy(byref(callbacks))
+            except Exception:  # noqa: BLE001
+                pass
+            self._callbacks = callbacks  # keep the ctypes objects alive
+        self.fmu.instantiate(callbacks=callbacks, loggingOn=logging)
+        self.fresh = True
+
+    def simulate(self, start_values: dict[str, Any], stop_time: float, output_interval: float, inputs: Any,
+                 outputs: Sequence[str] | None = None, check_end: bool = False) -> Any:
+        """fmpy's result array; ``check_end``: raise FmuRunError when the run stopped before stop_time."""
+        from fmpy import simulate_fmu
+
+        if not self.fresh:
+            self.fmu.reset()
+        self.fresh = False
+        reached = [0.0]
+
+        def step_finished(time: float, _recorder: Any) -> bool:
+            reached[0] = time
+            return True
+
+        result = simulate_fmu(self.unzipdir, model_description=self.md, fmu_instance=self.fmu,
+                              start_values=start_values, start_time=0.0, stop_time=stop_time,
+                              output_interval=output_interval, input=inputs,
+                              output=list(outputs) if outputs is not None else None,
+                              step_finished=step_finished if check_end else None)
+        if check_end and not math.isclose(reached[0], stop_time, rel_tol=1e-9, abs_tol=1e-12):
+            raise FmuRunError(f"the FMU stopped at t = {reached[0]:g} s before stop_time = {stop_time:g} s")
+        return result
+
+    def error_text(self, exc: BaseException, *args: Any, **kwargs: Any) -> str:
+        """Re-run with logging on to capture the FMU's own message; leave a fresh instance behind."""
+        messages: list[str] = []
+
+        def logger(_env, _name, status, _category, message):
+            text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+            if status >= 3:  # fmi2Error, fmi2Fatal
+                messages.append(text.strip())
+
+        try:
+            self._new_instance(logging=True, logger=logger)
+            self.simulate(*args, **kwargs)
+        except Exception:  # noqa: BLE001
+            pass
+        self._new_instance()
+        own = [m for m in messages if "PyObject_CallMethod" not in m and "Fatal py exception" not in m]
+        return (own[0] if own else f"{type(exc).__name__}: {exc}").replace("\n", " ")

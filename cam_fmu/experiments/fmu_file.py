@@ -1,0 +1,68 @@
+"""The one place that finds or builds cam.fmu.
+
+In a source checkout (a ``build_fmu.py`` beside the package) the FMU is
+``models/cam.fmu``; in an installed package it lives in the user cache
+(``$XDG_CACHE_HOME/cam_fmu``, else ``~/.cache/cam_fmu``), named by the package
+version. Either way it is (re)built from the package's own sources when
+missing or older than them.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Callable
+
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+
+
+class FmuFileError(RuntimeError):
+    """The FMU could not be found or built; the message says why."""
+
+
+def source_checkout() -> Path | None:
+    """The repository root when the package runs from a checkout, else None."""
+    root = PACKAGE_DIR.parent
+    return root if (root / "build_fmu.py").is_file() and (root / "pyproject.toml").is_file() else None
+
+
+def default_fmu_path() -> Path:
+    """models/cam.fmu in a checkout, else the user-cache copy for this package version."""
+    root = source_checkout()
+    if root is not None:
+        return root / "models" / "cam.fmu"
+    from .. import __version__
+
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"
+    return cache / f"cam-{__version__}.fmu"
+
+
+def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
+    """The FMU to run: ``path`` as given (it must exist), or the default one, built when stale.
+
+    The build runs in a subprocess (it imports the slave as a top-level module
+    and pythonfmu edits sys.path) and replaces the file atomically.
+    """
+    if path is not None:
+        path = Path(path)
+        if not path.is_file():
+            raise FmuFileError(f"FMU {str(path)!r} does not exist")
+        return path
+    from ..fmu.build import is_stale
+
+    path = default_fmu_path()
+    if not is_stale(path):
+        return path
+    if log is not None:
+        log(f"# building {path} (missing or older than its sources)")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="cam_fmu_build_", dir=path.parent) as tmp:
+        dest = Path(tmp) / "cam.fmu"
+        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--dest", str(dest)],
+                              capture_output=True, text=True, cwd=str(PACKAGE_DIR.parent), timeout=600)
+        if proc.returncode != 0 or not dest.is_file():
+            raise FmuFileError(f"building {path} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+        os.replace(dest, path)  # atomic: a process reading the old file keeps it
+    return path

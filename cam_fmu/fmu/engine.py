@@ -1,0 +1,108 @@
+"""The drive stepped from one communication point to the next (the FMU's engine).
+
+``DriveSimulator`` joins one formulation (physics.formulations, chosen from
+the parameters ``drive`` and ``formulation``) and one solver (solvers.SOLVERS,
+parameter ``solver``) and owns the time, the inputs and the state; it holds
+no physics. The FMU class only maps FMI variables onto it. numpy is not
+imported on this path: the FMU's run-time path is ``math`` only (scipy in an
+FMU crashes native hosts at teardown).
+
+Solvers (consistent formulation, voltage drive):
+- ``euler``, ``rk4``: fixed internal step min(h_max, stability limit): a step
+  beyond the explicit method's stability limit is split, never taken.
+- ``rk45``: Dormand-Prince 5(4) with error control (rtol, atol); its step size
+  is carried across communication steps; failing to meet the tolerance within
+  ``max_steps`` or above the smallest step raises SimulationError.
+- ``etdrk4``: exponential RK4, exact on the electrical pole -R/L: stable and
+  accurate with L > 0 at steps far above L/R.
+The paper formulation runs its own fixed-step algorithm with T = the largest
+step <= h_max that divides the communication step; the speed drive is exact.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+from ..physics.drive import DriveModel
+from ..physics.formulations import formulation_for
+from ..physics.variables import INPUT_STARTS, INPUTS, OUTPUTS
+from ..solvers import SOLVERS, SimulationError
+from ..solvers.hybrid import HybridIntegrator
+
+__all__ = ["DriveSimulator", "SimulationError", "INPUTS", "OUTPUTS"]
+
+
+class DriveSimulator:
+    """One cam drive, advanced by ``do_step`` (times in s, SI units throughout)."""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        self.model = model = DriveModel(params)
+        p = model.params
+        self.stepper = SOLVERS[p["solver"]](p)
+        self.integrator = HybridIntegrator(self.stepper, int(p["max_steps"]))
+        self.time = 0.0
+        self.u = INPUT_STARTS["u"]
+        self.omega_ref = INPUT_STARTS["omega_ref"]
+        self.omega_dot_ref = INPUT_STARTS["omega_dot_ref"]
+        self.steps_taken = 0  # internal steps, for benchmarks
+        self._outputs: dict[str, float] | None = None
+        self.formulation = formulation_for(model, self.u, self.omega_ref)
+
+    # ------------------------------------------------------------ public
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
+        """Inputs used by ``outputs`` before the first step [V, rad/s, rad/s2]."""
+        self.u = _finite("u", u)
+        self.omega_ref = _finite("omega_ref", omega_ref)
+        self.omega_dot_ref = _finite("omega_dot_ref", omega_dot_ref)
+        self.formulation.set_inputs(self.u, self.omega_ref, self.omega_dot_ref)
+        self._outputs = None
+
+    def do_step(self, t: float, h: float, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
+        """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation).
+
+        Speed drive: omega(t) = omega_ref + omega_dot_ref (t - t_k) over the step.
+        """
+        if not (math.isfinite(h) and h > 0.0):
+            raise SimulationError(f"communication step size = {h!r} s: allowed (0, inf)")
+        self.set_inputs(u, omega_ref, omega_dot_ref)
+        self.steps_taken += self.formulation.advance(h, self.integrator, self.time)
+        self.time = t + h
+        self._outputs = None
+        for name, value in self.outputs().items():
+            if not math.isfinite(value):
+                raise SimulationError(
+                    f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
+                    f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
+
+    def outputs(self) -> dict[str, float]:
+        """Current value of every output in OUTPUTS (computed once per state)."""
+        if self._outputs is None:
+            self._outputs = self.formulation.outputs(self.integrator)
+        return self._outputs
+
+    def get_state(self) -> dict[str, Any]:
+        """Complete internal state, JSON-serialisable."""
+        state: dict[str, Any] = {
+            "time": self.time, "u": self.u, "omega_ref": self.omega_ref, "omega_dot_ref": self.omega_dot_ref,
+            "h_next": self.stepper.h_next, "steps_taken": self.steps_taken,
+        }
+        state.update(self.formulation.get_state())
+        return state
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        self._outputs = None
+        self.integrator.fsal = None
+        self.time = float(state["time"])
+        self.u = float(state["u"])
+        self.omega_ref = float(state["omega_ref"])
+        self.omega_dot_ref = float(state["omega_dot_ref"])
+        self.stepper.h_next = float(state["h_next"])
+        self.steps_taken = int(state["steps_taken"])
+        self.formulation.set_state(dict(state))
+
+
+def _finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise SimulationError(f"input {name!r} = {value!r}: allowed any finite value")
+    return value

@@ -1,0 +1,33 @@
+"""The contract of a formulation: how the drive's state advances over one communication step.
+
+The co-simulation engine holds one formulation and one integrator and knows
+no physics: it hands the formulation the inputs, asks it to advance by h [s]
+and reads its outputs. A formulation that is an ODE with events (the
+consistent one) uses the integrator it is given; the others step themselves.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+
+class Formulation:
+    """One way of computing the drive's motion. Subclasses implement every method."""
+
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
+        """Inputs held from now on [V, rad/s, rad/s2] (they may re-decide stick/slip)."""
+        raise NotImplementedError
+
+    def advance(self, h: float, integrator: Any, time: float) -> int:
+        """Advance by h [s] from ``time`` [s]; return the internal steps taken."""
+        raise NotImplementedError
+
+    def outputs(self, integrator: Any) -> dict[str, float]:
+        """Every output of physics.variables.OUTPUTS at the current state."""
+        raise NotImplementedError
+
+    def get_state(self) -> dict[str, Any]:
+        """The formulation's own state, JSON-serialisable."""
+        raise NotImplementedError
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        raise NotImplementedError

@@ -1,0 +1,37 @@
+"""The drive's inputs and outputs: one table each (name, SI unit, [start,] meaning).
+
+The FMU's variables, its model description, the README/docs tables, the CSV
+headers and every formulation's output record derive from these tuples.
+``math``-free and import-free: the FMU bundles it.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+INPUTS: tuple[tuple[str, str, float, str], ...] = (
+    ("u", "V", 3.5, "armature voltage (voltage drive)"),
+    ("omega_ref", "rad/s", 1.0, "imposed cam speed at the start of the step (speed drive)"),
+    ("omega_dot_ref", "rad/s2", 0.0, "imposed angular acceleration over the step (speed drive: a ramp of omega is then exact)"),
+)
+OUTPUTS: tuple[tuple[str, str, str], ...] = (
+    ("omega", "rad/s", "cam angular velocity"),
+    ("theta", "rad", "cam angle (unbounded; the profile uses theta mod 2 pi)"),
+    ("s", "m", "follower position (after backlash)"),
+    ("i", "A", "armature current"),
+    ("M", "N.m", "total load torque on the shaft: M_f sgn(omega) + M_l"),
+    ("J", "kg.m2", "equivalent inertia J_m + m (ds/dtheta)^2 (J_m while free in the gap)"),
+    ("v", "m/s", "follower velocity"),
+    ("a", "m/s2", "follower acceleration"),
+    ("alpha", "rad", "pressure angle"),
+    ("s_cam", "m", "cam profile lift at the contact (before backlash)"),
+    ("voltage", "V", "armature voltage: u (voltage drive) or the voltage needed (speed drive)"),
+)
+INPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in INPUTS)
+INPUT_STARTS: dict[str, float] = {row[0]: row[2] for row in INPUTS}
+OUTPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in OUTPUTS)
+UNITS: dict[str, str] = {row[0]: row[1] for row in INPUTS + OUTPUTS}  # type: ignore[operator]
+
+
+def output_record(**values: Any) -> dict[str, float]:
+    """Every output, in table order, from keyword values (a missing one is a KeyError)."""
+    return {name: values[name] for name in OUTPUT_NAMES}

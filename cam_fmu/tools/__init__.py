@@ -1,0 +1,1 @@
+"""Developer tools: the bench and native-host helpers (not bundled into the FMU)."""

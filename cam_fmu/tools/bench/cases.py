@@ -1,0 +1,126 @@
+"""The bench's cases (scenes), solver settings and reference results."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+from ...experiments.scenes import find_scene
+from ...experiments.signals import constant
+from ...physics.parameters import defaults
+from ...physics.variables import INPUT_STARTS
+from ...solvers import SOLVERS
+
+SOLVER_KEYS = ("solver", "h_max", "rtol", "atol", "max_steps")
+FIXED_STEP_H = (1e-3, 2.5e-4, 1e-4)  # s, h_max of euler, rk4, etdrk4
+RK45_RTOL = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)  # atol = rtol / 100 (1e-10 is the default)
+COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s
+CASES = ("fig6", "backlash", "inductance")
+LEVELS = (1e-3, 1e-6, 1e-8)  # rad: accuracy levels of the choice table
+TARGET_ERR = 1e-6  # rad: the project's accuracy target at 1 ms on fig. 6
+TARGET_RATIO = 3.0  # the cheapest setting meeting TARGET_ERR costs at most this x the floor
+
+CASE_SCENES = {"fig6": "paper_fig6", "backlash": "backlash", "inductance": "inductance"}  # shipped scenes
+
+COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
+           "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
+           "floor_us_per_step", "cost_ratio", "repeats", "error")
+
+
+@dataclass
+class Case:
+    name: str
+    start_values: dict[str, Any]  # FMU start values (no solver settings)
+    u: Any  # signals.Signal
+    stop_time: float
+    source: str  # scene name
+
+
+def load_cases(names: Sequence[str]) -> list[Case]:
+    """The benchmark cases: the primary run of each shipped scene."""
+    cases = []
+    for name in names:
+        scene = find_scene(CASE_SCENES[name])
+        values = {k: v for k, v in scene.primary.start_values().items() if k not in SOLVER_KEYS}
+        if scene.drive != "voltage":
+            raise ValueError(f"bench: scene {scene.name} has drive {scene.drive!r}; the bench needs 'voltage'")
+        values["drive"] = "voltage"
+        cases.append(Case(name, values, scene.u or constant(INPUT_STARTS["u"]), scene.stop_time, scene.name))
+    return cases
+
+
+@dataclass(frozen=True)
+class Setting:
+    solver: str
+    h_max: float
+    rtol: float
+    atol: float
+
+    @property
+    def label(self) -> str:
+        return f"rtol={self.rtol:g}" if SOLVERS[self.solver].adaptive else f"h={self.h_max:g}"
+
+    @property
+    def is_default(self) -> bool:
+        d = defaults()
+        return (self.solver, self.h_max, self.rtol, self.atol) == (d["solver"], d["h_max"], d["rtol"], d["atol"])
+
+    def start_values(self) -> dict[str, Any]:
+        return {"solver": self.solver, "h_max": self.h_max, "rtol": self.rtol, "atol": self.atol}
+
+
+def settings_grid(comm_step: float, quick: bool) -> list[Setting]:
+    """Solver settings run at one communication step (fixed-step h_max capped at the step, deduplicated).
+
+    The solvers come from the registry: every fixed-step solver over FIXED_STEP_H, every
+    adaptive one over RK45_RTOL (atol = rtol / 100).
+    """
+    h_default = defaults()["h_max"]
+    fixed = [name for name, cls in SOLVERS.items() if not cls.adaptive]
+    adaptive = [name for name, cls in SOLVERS.items() if cls.adaptive]
+    if quick:
+        return ([Setting(solver, min(1e-3, comm_step), 1e-10, 1e-12) for solver in fixed]
+                + [Setting(solver, h_default, rtol, rtol / 100.0) for solver in adaptive for rtol in (1e-6, 1e-10)])
+    grid: list[Setting] = []
+    for solver in fixed:
+        for h in sorted({min(h, comm_step) for h in FIXED_STEP_H}, reverse=True):
+            grid.append(Setting(solver, h, 1e-10, 1e-12))
+    for solver in adaptive:
+        for rtol in RK45_RTOL:
+            grid.append(Setting(solver, h_default, rtol, rtol / 100.0))
+    return grid
+
+
+class References:
+    """simulate_reference per case, computed once on the finest grid and subsampled to coarser ones."""
+
+    def __init__(self, comm_steps: Sequence[float]) -> None:
+        self.finest = min(comm_steps)
+        self.data: dict[str, tuple[float, dict]] = {}
+
+    def compute(self, case: Case) -> tuple[float, float]:
+        """Run the reference for ``case``; return (its comm step, wall time [s])."""
+        from ...reference import simulate_reference
+
+        t0 = time.perf_counter()
+        ref = simulate_reference(case.start_values, case.stop_time, self.finest, u=self._u(case, self.finest))
+        wall = time.perf_counter() - t0
+        self.data[case.name] = (self.finest, ref)
+        return self.finest, wall
+
+    @staticmethod
+    def _u(case: Case, comm_step: float):
+        # fmpy holds each input over a communication step: the reference sees the same staircase
+        return case.u if len(case.u.breaks) <= 1 else case.u.sampled(comm_step, case.stop_time)
+
+    def get(self, case: Case, comm_step: float) -> dict:
+        import numpy as np
+
+        step, ref = self.data[case.name]
+        ratio = comm_step / step
+        if abs(ratio - round(ratio)) < 1e-9 and len(case.u.breaks) <= 1:
+            k = int(round(ratio))
+            return {name: values[::k] for name, values in ref.items()}
+        from ...reference import simulate_reference
+
+        return simulate_reference(case.start_values, case.stop_time, comm_step, u=self._u(case, comm_step))

@@ -1,0 +1,149 @@
+"""The bench's report: rows, CSV, the choice table, the target verdict and the figure."""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import Sequence
+
+from ...solvers import SOLVERS
+from .cases import CASES, LEVELS, TARGET_ERR, TARGET_RATIO
+
+COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
+           "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
+           "floor_us_per_step", "cost_ratio", "repeats", "error")
+
+def _fmt(value, spec: str, width: int) -> str:
+    if value is None or value == "" or (isinstance(value, float) and math.isnan(value)):
+        return f"{'-':>{width}}"
+    return f"{value:>{width}{spec}}"
+
+
+HEADER = (f"{'case':<11}{'kind':<6}{'solver':<7}{'setting':<12}{'comm[s]':>8}{'theta_err':>11}{'omega_err':>11}"
+          f"{'us/step':>10}{'RTF':>9}{'ratio':>8}  status")
+
+
+def format_row(row: dict) -> str:
+    setting = row["setting"] + ("*" if row["default"] else "")
+    return (f"{row['case']:<11}{row['kind']:<6}{row['solver']:<7}{setting:<12}{row['comm_step']:>8g}"
+            f"{_fmt(row['theta_err'], '.2e', 11)}{_fmt(row['omega_err'], '.2e', 11)}"
+            f"{_fmt(row['us_per_step'], '.1f', 10)}{_fmt(row['rtf'], '.3g', 9)}{_fmt(row['cost_ratio'], '.2f', 8)}"
+            f"  {row['status']}" + (f": {row['error']}" if row["error"] else ""))
+
+
+def _row(**values) -> dict:
+    row = {name: "" for name in COLUMNS}
+    row.update(values)
+    return row
+
+
+def write_csv(rows: list[dict], path: Path, columns: Sequence[str] = COLUMNS) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(columns))
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items() if k in columns})
+
+
+# =========================================================================== summaries
+CHOICE_COLUMNS = ("case", "comm_step", "level", "solver", "setting", "theta_err", "us_per_step", "cost_ratio")
+
+
+def choose(rows: list[dict]) -> list[dict]:
+    """Per case, comm step and accuracy level: the FMU run of lowest cost ratio whose theta error is below it."""
+    choices = []
+    keys = sorted({(r["case"], r["comm_step"]) for r in rows if r["kind"] == "fmu"},
+                  key=lambda k: (CASES.index(k[0]) if k[0] in CASES else 99, k[1]))
+    for case, comm in keys:
+        runs = [r for r in rows if r["kind"] == "fmu" and r["case"] == case and r["comm_step"] == comm
+                and r["status"] == "ok" and r["theta_err"] != ""]
+        for level in LEVELS:
+            good = [r for r in runs if r["theta_err"] < level]
+            best = min(good, key=lambda r: r["cost_ratio"]) if good else None
+            choices.append({"case": case, "comm_step": comm, "level": level,
+                            "solver": best["solver"] if best else "none",
+                            "setting": best["setting"] if best else "",
+                            "theta_err": best["theta_err"] if best else "",
+                            "us_per_step": best["us_per_step"] if best else "",
+                            "cost_ratio": best["cost_ratio"] if best else ""})
+    return choices
+
+
+def format_choices(choices: list[dict]) -> str:
+    lines = ["# cheapest setting per accuracy level (theta error < level)",
+             f"{'case':<11}{'comm[s]':>8}{'level':>8}  {'solver':<7}{'setting':<12}{'theta_err':>11}"
+             f"{'us/step':>10}{'ratio':>8}"]
+    for c in choices:
+        lines.append(f"{c['case']:<11}{c['comm_step']:>8g}{c['level']:>8g}  {c['solver']:<7}{c['setting']:<12}"
+                     f"{_fmt(c['theta_err'], '.2e', 11)}{_fmt(c['us_per_step'], '.1f', 10)}"
+                     f"{_fmt(c['cost_ratio'], '.2f', 8)}")
+    return "\n".join(lines)
+
+
+def target_verdict(rows: list[dict]) -> str:
+    """The project's target at 1 ms on fig. 6, in words and numbers."""
+    runs = [r for r in rows if r["kind"] == "fmu" and r["case"] == "fig6" and math.isclose(r["comm_step"], 1e-3)]
+    if not runs:
+        return "# target: no fig6 runs at 1 ms"
+    default = [r for r in runs if r["default"]]
+    parts = []
+    if default and default[0]["status"] == "ok":
+        d = default[0]
+        parts.append(f"default ({d['solver']} {d['setting']}) theta error {d['theta_err']:.2e} rad "
+                     f"{'<' if d['theta_err'] < TARGET_ERR else '>='} {TARGET_ERR:g}: "
+                     f"{'met' if d['theta_err'] < TARGET_ERR else 'NOT met'}, {d['us_per_step']:.1f} us/step, "
+                     f"ratio {d['cost_ratio']:.2f}")
+    else:
+        parts.append("default settings: no successful run")
+    good = [r for r in runs if r["status"] == "ok" and r["theta_err"] != "" and r["theta_err"] < TARGET_ERR]
+    if good:
+        best = min(good, key=lambda r: r["cost_ratio"])
+        ok = best["cost_ratio"] <= TARGET_RATIO
+        parts.append(f"cheapest setting with theta error < {TARGET_ERR:g} rad: {best['solver']} {best['setting']} "
+                     f"({best['theta_err']:.2e} rad), {best['us_per_step']:.1f} us/step = {best['cost_ratio']:.2f}x "
+                     f"the floor ({best['floor_us_per_step']:.1f} us/step): "
+                     f"{'met' if ok else 'NOT met'} (target <= {TARGET_RATIO:g}x)")
+    else:
+        parts.append(f"no setting reaches theta error < {TARGET_ERR:g} rad")
+    return "# target (fig6, 1 ms): " + "; ".join(parts)
+
+
+def plot(rows: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    cases = [c for c in CASES if any(r["case"] == c for r in rows)]
+    palette = ("tab:red", "tab:blue", "tab:purple", "tab:green", "tab:orange", "tab:brown")
+    colors = {name: palette[k % len(palette)] for k, name in enumerate(SOLVERS)}
+    markers = {1e-4: "o", 1e-3: "s", 1e-2: "^"}
+    fig, axes = plt.subplots(1, len(cases), figsize=(5.2 * len(cases), 4.6), squeeze=False)
+    for ax, case in zip(axes[0], cases):
+        runs = [r for r in rows if r["case"] == case and r["kind"] == "fmu" and r["status"] == "ok"
+                and r["theta_err"] != ""]
+        for solver, color in colors.items():
+            for comm in sorted({r["comm_step"] for r in runs}):
+                # in grid order (coarse to fine setting), not sorted by cost
+                pts = [(r["cost_ratio"], max(r["theta_err"], 1e-10)) for r in runs
+                       if r["solver"] == solver and r["comm_step"] == comm]
+                if pts:
+                    ax.loglog(*zip(*pts), color=color, marker=markers.get(comm, "x"), linewidth=1.2,
+                              label=f"{solver}, comm {comm:g} s")
+        ax.axhline(TARGET_ERR, color="k", linestyle="--", linewidth=0.8)
+        ax.axhspan(1e-10, 1e-8, color="0.9", zorder=0)
+        ax.set_ylim(1e-10, None)
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.text(0.02, 0.02, "below the reference's own accuracy (~1e-8 rad)", transform=ax.transAxes,
+                fontsize=7, color="0.4")
+        ax.set_title(f"{case}")
+        ax.set_xlabel("cost ratio (us per comm step / trivial slave's)")
+        ax.set_ylabel("max |theta - theta_ref| [rad]")
+        ax.grid(True, which="both", alpha=0.3)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
+    fig.suptitle("cam.fmu through fmpy: theta error against cost (dashed: 1e-6 rad target)")
+    fig.tight_layout(rect=(0, 0.12, 1, 0.95))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
