@@ -138,6 +138,6 @@ def test_pressure_angle():
     amax, where = p.max_pressure_angle(rb)
     assert amax == pytest.approx(brute.max(), rel=1e-6) and amax >= brute.max() - 1e-15
     assert abs(p.pressure_angle(where, rb)) == pytest.approx(amax, rel=1e-14)
-    assert math.degrees(amax) < 30.0      # MODEL.md: r = 0.1 m keeps it under 30 deg
+    assert math.degrees(amax) < 30.0      # docs/model.md section 3: r = 0.1 m keeps it under 30 deg
     with pytest.raises(ValueError):
         p.pressure_angle(0.1, 0.0)

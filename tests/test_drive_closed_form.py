@@ -1,6 +1,6 @@
 """Closed forms shared by the drive tests, written from the paper, not from cam_fmu.
 
-The paper's profile (MODEL.md section 2, seed 002 section 2.1), A = 35 mm, in
+The paper's profile (docs/model.md section 2; the paper's section 2.1), A = 35 mm, in
 six pieces over one revolution (rise [0, pi], return [pi, 2 pi]):
 
     rise,   [0, pi/4]:      s = A (t - sin(4 t) / 4)
@@ -21,7 +21,7 @@ import pytest
 A = 0.035  # m
 H = 1.5 * math.pi * A  # m, lift
 
-# The project's defaults, written out (MODEL.md section 3 / issue 3's table), so a
+# The project's defaults, written out (docs/model.md section 3), so a
 # changed default in parameters.py shows up as a failing test, not a moved oracle.
 DEFAULTS = dict(R=19.0, c_e=0.146, c_m=0.015 * 9.80665, J_m=4.41e-5, M_f=0.012, m=0.4, G=4.0,
                 mu=0.001, r_b=0.1)
@@ -61,7 +61,7 @@ def paper_profile(theta: float) -> tuple[float, float, float]:
 def friction_fixed_point(n0: float, tan_a: float, sigma: float, mu: float, n_g: float) -> float:
     """Guide friction f from f = mu (|N_r| + |N_g|), N_r = n0 + sigma f tan(alpha), by iteration.
 
-    MODEL.md section 4: N cos(alpha) = m a + sigma f - F_gx, N_r = N sin(alpha) + G_y,
+    docs/model.md section 4: N cos(alpha) = m a + sigma f - F_gx, N_r = N sin(alpha) + G_y,
     so N_r = (m a - F_gx) tan(alpha) + G_y + sigma f tan(alpha) = n0 + sigma f tan(alpha).
     A contraction (factor mu |tan alpha| < 1): iterate to a fixed point, a method
     independent of the two-branch solve in drive_model.

@@ -1,4 +1,4 @@
-"""DriveModel physics against closed forms and invariants (MODEL.md sections 3-5).
+"""DriveModel physics against closed forms and invariants (docs/model.md sections 3-5).
 
 - energy: motor disconnected, no friction, no gravity: (1/2) J(theta) omega^2 is
   conserved by the consistent equation; the paper's eq. (12) is shown not to
@@ -118,7 +118,7 @@ MOUNTINGS = {
 
 
 def _closed_form_load(theta, omega, gamma, beta, G=DEFAULTS["G"], mu=DEFAULTS["mu"]):
-    """M and J at constant omega from MODEL.md section 4, written out by hand."""
+    """M and J at constant omega from docs/model.md section 4, written out by hand."""
     s, s1, s2 = paper_profile(theta)
     a = s2 * omega ** 2
     v = s1 * omega

@@ -1,7 +1,7 @@
 """The paper's discrete algorithm (section 3, steps 1-9) checked by hand.
 
 Three steps from rest with u = 3.5 V, T = 1e-3 s, horizontal mounting, L = 0,
-recomputed here from the printed steps (with MODEL.md's corrections) and
+recomputed here from the printed steps (with the corrections of docs/model.md) and
 compared with PaperScheme to 1e-12 relative (measured: agreement to round-off),
 with absolute floors for s, v, a, M: the motion-law code evaluates
 x - sin(x) near a segment start with cancellation (s(3.4e-4 rad) is off by 1e-21 m, s' likewise through 1 - cos,

@@ -1,4 +1,4 @@
-"""Stiction at omega = 0 and backlash impacts (MODEL.md section 6), against hand-derived values.
+"""Stiction at omega = 0 and backlash impacts (docs/model.md section 6), against hand-derived values.
 
 Stiction: at rest with L = 0 the motor torque is c_m u / R. At the break-away
 threshold omega = omega_dot = 0, so a = s'' omega^2 + s' omega_dot = 0 and the

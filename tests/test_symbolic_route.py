@@ -1,6 +1,6 @@
-"""The seed's own symbolic route (seeds/000, sympy) against the closed-form solve.
+"""The blog post's own symbolic route (sympy; docs/model.md section 1) against the closed-form solve.
 
-The seed builds A, V, S per segment with sympy (A = Amp sin P_i on segments 1
+The blog post builds A, V, S per segment with sympy (A = Amp sin P_i on segments 1
 and 3, Amm sin P_i on 5 and 7, P_i = (T - T_{i-1})/F_i + (i-1) pi/4, V and S by
 indefinite integration plus constants C_i, B_i) and announces, but never shows,
 the boundary-value solve.  We finish it: S(0) = V(0) = 0, S(1) = 1, V(1) = 0,
@@ -62,7 +62,7 @@ def test_seed_symbolic_route_matches_closed_form():
     assert m.Amp == pytest.approx(Amp_s, rel=1e-13)
     assert m.Amm == pytest.approx(Amm_s, rel=1e-13)
 
-    # The 14 constants: the seed's C_i, B_i (global-T antiderivatives) follow
+    # The 14 constants: the blog post's C_i, B_i (global-T antiderivatives) follow
     # from ours (V0_i, S0_i at each segment start) by C_i = V0_i - V_i|C=0 (T_{i-1}),
     # B_i = S0_i - S_i|B=0 (T_{i-1}).
     V0, S0 = m.constants()

@@ -3,7 +3,7 @@
 T in [0, 1] is the normalised cam angle, S(T) in [0, 1] the normalised lift.
 Split points 0 <= T1 <= ... <= T6 <= 1 (T0 = 0, T7 = 1) cut [0, 1] into seven
 segments; with F_i = (T_i - T_{i-1}) / (pi/2) and x = (T - T_{i-1}) / F_i the
-acceleration A = d2S/dT2 is (MODEL.md section 1; the seed's *code*, not its
+acceleration A = d2S/dT2 is (docs/model.md section 1; the blog post's *code*, not its
 printed table, which has sign errors on segments 3, 5 and 7):
 
     1 [0, T1]    +Amp sin x        5 (T4, T5]  -Amm sin x

@@ -9,7 +9,7 @@
     mcv50                   1/16   1/16   1/4   3/4   15/16   15/16
     paper                   1/8    1/8    1/4   3/4   7/8     7/8
 
-Sources: MODEL.md section 1 for the five classical members.  `mcv50` is the
+Sources: docs/model.md section 1 for the five classical members.  `mcv50` is the
 modified constant-velocity curve with a 50 % constant-velocity part (T4 - T3
 = 1/2) whose ramps are modified-sine shaped (quarter sine over 1/16, quarter
 cosine over 3/16, the 1:3 ratio of the modified sine), the "MCV50" of Makino's
@@ -17,7 +17,7 @@ universal cam curve tables (H. Makino, cam-mechanism handbooks; the same table
 is reproduced in index-drive makers' catalogues); these T reproduce its
 tabulated Vm = 1.28, Am = 8.01, Jm = 201.4, (AV)m = 5.73 (checked in
 tests/test_characteristics.py).  `paper` is the law of the paper's profile
-(seed 002, section 2.1; MODEL.md section 2).
+(the paper's section 2.1; docs/model.md section 2).
 
 This is the one table of named laws: the parameter choices of the FMU
 (``rise_law``/``return_law``), the CLI's ``--preset`` and the docs derive
