@@ -108,7 +108,7 @@ class CheckReport:
             "undercut_ranges_deg": [[deg(a), deg(b)] for a, b in self.undercut_ranges],
             "groove_undercut": self.groove_undercut,
             "groove_undercut_ranges_deg": [[deg(a), deg(b)] for a, b in self.groove_undercut_ranges],
-            "limits": {"max_pressure_angle_deg": deg(lim.max_pressure_angle),
+            "limits": {"max_pressure_angle_deg": round(deg(lim.max_pressure_angle), 9),
                        "min_radius_of_curvature_mm": mm(_min_radius(lim, self.roller_radius)),
                        "groove": lim.groove},
             "ok": self.ok,

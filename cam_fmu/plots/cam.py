@@ -59,9 +59,10 @@ def plot_cam(cam: DiscCam, path: str | Path, report: CheckReport | None = None, 
         ux, uy = cam.contour(t, "inner")
         ax.plot(ux * mm, uy * mm, color="tab:red", lw=3, label="undercut")
     ax.plot([0], [0], "k+", ms=10)
-    ax.annotate("", xy=(0.25 * r_b * mm, 0.0), xytext=(0.0, 0.0),
+    e_mm = -cam.offset * mm                                  # the follower axis is y = -e
+    ax.annotate("", xy=(0.25 * r_b * mm, e_mm), xytext=(0.0, e_mm),
                 arrowprops=dict(arrowstyle="->", color="0.3"))
-    ax.text(0.26 * r_b * mm, 0.0, "X (follower)", fontsize=8, va="center", color="0.3")
+    ax.text(0.26 * r_b * mm, e_mm, "X (follower axis, y = -e)", fontsize=8, va="center", color="0.3")
     ax.set_aspect("equal")
     ax.set_xlabel("x  [mm]  (cam frame at θ = 0; cam turns counterclockwise)")
     ax.set_ylabel("y  [mm]")
