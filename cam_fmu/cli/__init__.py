@@ -20,6 +20,7 @@ from typing import Sequence
 
 SUBCOMMANDS: tuple[str, ...] = (
     "curve",      # characteristic values and plots of a motion law
+    "contour",    # disc cam geometry, design checks, CSV/DXF export
     "simulate",   # run a scene: CSV + figure
     "bench",      # speed-accuracy benchmark of cam.fmu through fmpy
     "host_env",   # environment line for native FMU hosts (diagnostic)

@@ -27,7 +27,7 @@ import numpy as np
 from .motion_law import MotionLaw, golden_max
 from .presets import law
 
-__all__ = ["CamProgram", "paper_program"]
+__all__ = ["CamProgram", "ProgramBase", "paper_program"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -41,7 +41,47 @@ def _as_law(spec: LawSpec, what: str) -> MotionLaw:
         raise ValueError(f"{what} law: {exc}") from None
 
 
-class CamProgram:
+class ProgramBase:
+    """What every cam program offers on top of `derivatives`, `evaluate` and
+    `breakpoints`: the in-line pressure angle and its maximum.  Subclasses:
+    CamProgram (laws and dwells) and motion_table.TableProgram (a user table)."""
+
+    def pressure_angle(self, theta, base_radius: float):
+        """Pressure angle [rad] of the in-line roller follower,
+        tan(alpha) = (ds/dtheta) / (r_b + s); signed (negative on the return).
+        `base_radius` r_b [m] is the base-circle radius of the roller-centre
+        (pitch) curve.  Scalar theta -> float, array -> array."""
+        if not base_radius > 0.0:
+            raise ValueError(f"base_radius must be > 0 [m], got {base_radius!r}")
+        if np.ndim(theta) == 0:
+            s, ds, _, _ = self.derivatives(float(theta))
+            return math.atan(ds / (base_radius + s))
+        s, ds, _, _ = self.evaluate(theta)
+        return np.arctan(ds / (base_radius + s))
+
+    def breakpoints_passed(self, start: float, end: float) -> list[float]:
+        """Breakpoint angles [rad] passed going from start to end, in the order passed."""
+        points = self.__dict__.get("_breakpoints")
+        if points is None:
+            points = self._breakpoints = self.breakpoints()
+        return crossed(points, start, end)
+
+    def max_pressure_angle(self, base_radius: float) -> tuple[float, float]:
+        """(max |alpha| [rad], theta [rad] where it occurs) over one cycle."""
+        n = 4096
+        grid = np.unique(np.concatenate([np.linspace(0.0, TWO_PI, n, endpoint=False),
+                                         np.array(self.breakpoints())]))
+        alpha = np.abs(self.pressure_angle(grid, base_radius))
+        k = int(np.argmax(alpha))
+        best_t, best = float(grid[k]), float(alpha[k])
+        a, b = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, len(grid) - 1)])
+        t, v = golden_max(lambda t: abs(self.pressure_angle(t, base_radius)), a, b, 1e-12)
+        if v > best:
+            best_t, best = t, v
+        return best, best_t
+
+
+class CamProgram(ProgramBase):
     """Rise, upper dwell, return, lower dwell; angles in rad summing to 2 pi, lift in m."""
 
     def __init__(self, rise_law: LawSpec, return_law: LawSpec, lift: float,
@@ -145,38 +185,6 @@ class CamProgram:
             if not out or p - out[-1] > 1e-12:
                 out.append(p)
         return tuple(out)
-
-    def breakpoints_passed(self, start: float, end: float) -> list[float]:
-        """Breakpoint angles [rad] passed going from start to end, in the order passed."""
-        return crossed(self._breakpoints, start, end)
-
-    # -- pressure angle ------------------------------------------------------------
-    def pressure_angle(self, theta, base_radius: float):
-        """Pressure angle [rad] of the in-line roller follower,
-        tan(alpha) = (ds/dtheta) / (r_b + s); signed (negative on the return).
-        `base_radius` r_b [m] is the base-circle radius of the roller-centre
-        (pitch) curve.  Scalar theta -> float, array -> array."""
-        if not base_radius > 0.0:
-            raise ValueError(f"base_radius must be > 0 [m], got {base_radius!r}")
-        if np.ndim(theta) == 0:
-            s, ds, _, _ = self.derivatives(float(theta))
-            return math.atan(ds / (base_radius + s))
-        s, ds, _, _ = self.evaluate(theta)
-        return np.arctan(ds / (base_radius + s))
-
-    def max_pressure_angle(self, base_radius: float) -> tuple[float, float]:
-        """(max |alpha| [rad], theta [rad] where it occurs) over one cycle."""
-        n = 4096
-        grid = np.unique(np.concatenate([np.linspace(0.0, TWO_PI, n, endpoint=False),
-                                         np.array(self.breakpoints())]))
-        alpha = np.abs(self.pressure_angle(grid, base_radius))
-        k = int(np.argmax(alpha))
-        best_t, best = float(grid[k]), float(alpha[k])
-        a, b = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, len(grid) - 1)])
-        t, v = golden_max(lambda t: abs(self.pressure_angle(t, base_radius)), a, b, 1e-12)
-        if v > best:
-            best_t, best = t, v
-        return best, best_t
 
 
 def crossed(points, start: float, end: float) -> list[float]:

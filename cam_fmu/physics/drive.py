@@ -15,9 +15,10 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..kinematics.cam_program import CamProgram
+from ..kinematics.cam_program import CamProgram, ProgramBase
+from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import law_spec, resolve
+from .parameters import ParameterError, law_spec, resolve
 
 
 def sign(x: float) -> float:
@@ -41,6 +42,24 @@ def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_sup
     return mu * (n_support - n0) / (1.0 + mu * sk)
 
 
+def build_program(p: Mapping[str, Any]) -> ProgramBase:
+    """The cam program the parameters describe: the user's motion table, else laws and angles.
+
+    Raises ParameterError naming the parameters when they make no program.
+    """
+    if p["motion_table"].strip():
+        try:
+            return program_from_table_text(p["motion_table"])
+        except ValueError as exc:
+            raise ParameterError(f"parameter 'motion_table': {exc}") from None
+    try:
+        return CamProgram(law_spec(p, "rise"), law_spec(p, "return"), p["lift"],
+                          p["rise_angle"], p["upper_dwell"], p["return_angle"], p["lower_dwell"])
+    except ValueError as exc:
+        raise ParameterError(f"parameters 'rise_law'/'rise_T1'..'rise_T6', 'return_law'/'return_T1'..'return_T6': "
+                             f"{exc}") from None
+
+
 @dataclass
 class LoadState:
     """Everything the drive equation produces at one instant (SI units)."""
@@ -61,10 +80,7 @@ class DriveModel:
     def __init__(self, params: Mapping[str, Any] | None = None) -> None:
         p = resolve(params)
         self.params = p
-        self.program = CamProgram(
-            law_spec(p, "rise"), law_spec(p, "return"), p["lift"],
-            p["rise_angle"], p["upper_dwell"], p["return_angle"], p["lower_dwell"],
-        )
+        self.program = build_program(p)
         self.R = p["R"]
         self.L = p["L"] if p["inductance"] else 0.0
         self.c_e = p["c_e"]

@@ -1,0 +1,154 @@
+"""`cam-fmu contour`: disc-cam geometry, design checks and export for manufacturing."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from ._program_options import add_law_options, add_program_options, build_program, rise_law
+
+PROG = "cam-fmu contour"
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "contour",
+        help="disc cam with a roller follower: contour, curvature, undercut, pressure angle, export",
+        description="Geometry of a disc cam with a translating roller follower (in-line or offset) "
+                    "for a cam program or a motion table: pitch curve, cam contour, radius of "
+                    "curvature, undercut, pressure angle; checks with warnings, the smallest base "
+                    "radius that passes them, peak follower motion at a cam speed, CSV/DXF export "
+                    "and a figure.  Conventions: docs/cam_design.md.")
+    add_law_options(p)
+    add_program_options(p, "cam program (defaults: the paper's profile)")
+    p.add_argument("--table", metavar="FILE.csv",
+                   help="motion table 'angle_deg, lift_mm' (header line, periodic over 360 deg) "
+                        "instead of the law options; interpolated by a periodic cubic spline")
+    g = p.add_argument_group("follower and checks")
+    g.add_argument("--roller-radius-mm", type=float, required=True, help="roller radius r_r [mm], 0 < r_r < r_b")
+    g.add_argument("--offset-mm", type=float, default=0.0,
+                   help="follower offset e [mm], |e| < r_b; e > 0 lowers the pressure angle on the rise")
+    g.add_argument("--max-pressure-angle-deg", type=float, default=30.0,
+                   help="pressure angle limit [deg] (default 30)")
+    g.add_argument("--min-radius-mm", type=float, default=None,
+                   help="smallest allowed radius of curvature of the contour on convex parts [mm] "
+                        "(default: the roller radius)")
+    g.add_argument("--groove", action="store_true",
+                   help="grooved cam: also check and export the outer wall")
+    g.add_argument("--rpm", type=float, default=None, help="cam speed [rpm] for peak follower v, a, j")
+    o = p.add_argument_group("output")
+    o.add_argument("--json", action="store_true", help="print one JSON object instead of a report")
+    o.add_argument("--points", type=int, default=3600, help="points per curve in the exports (default 3600)")
+    o.add_argument("--export-csv", metavar="FILE.csv", help="write the contour (x_mm, y_mm, closed)")
+    o.add_argument("--export-dxf", metavar="FILE.dxf",
+                   help="write closed polylines on layers CONTOUR, PITCH, BASE_CIRCLE (mm)")
+    o.add_argument("--plot", metavar="FILE.png", help="write the cam figure")
+    return p
+
+
+def _error(msg: str) -> int:
+    print(f"{PROG}: error: {msg}", file=sys.stderr)
+    return 2
+
+
+def _build(args):
+    from ..kinematics.design_checks import Limits
+    from ..kinematics.disc_cam import DiscCam
+
+    if args.table is not None:
+        from ..kinematics.motion_table import program_from_table_text
+        try:
+            with open(args.table) as f:
+                text = f.read()
+        except OSError as exc:
+            raise ValueError(f"--table: cannot read {args.table!r}: {exc.strerror}") from None
+        program, name = program_from_table_text(text), f"table {args.table}"
+    else:
+        name, m = rise_law(args)
+        program = build_program(args, m)
+    for opt, v in (("--base-radius-mm", args.base_radius_mm), ("--roller-radius-mm", args.roller_radius_mm)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise ValueError(f"{opt} must be a number > 0, got {v:g}")
+    if not math.isfinite(args.offset_mm) or abs(args.offset_mm) >= args.base_radius_mm:
+        raise ValueError(f"--offset-mm must satisfy |e| < r_b = {args.base_radius_mm:g} mm, got {args.offset_mm:g}")
+    if args.roller_radius_mm >= args.base_radius_mm:
+        raise ValueError(f"--roller-radius-mm {args.roller_radius_mm:g} must be < --base-radius-mm "
+                         f"{args.base_radius_mm:g} (r_b is the prime-circle radius, to the roller centre; "
+                         f"the cam's base circle r_b - r_r would vanish)")
+    if args.rpm is not None and not (math.isfinite(args.rpm) and args.rpm > 0.0):
+        raise ValueError(f"--rpm must be a number > 0, got {args.rpm:g}")
+    if not (0.0 < args.max_pressure_angle_deg < 90.0):
+        raise ValueError(f"--max-pressure-angle-deg must lie in (0, 90), got {args.max_pressure_angle_deg:g}")
+    if args.min_radius_mm is not None and not (math.isfinite(args.min_radius_mm) and args.min_radius_mm >= 0.0):
+        raise ValueError(f"--min-radius-mm must be a number >= 0, got {args.min_radius_mm:g}")
+    if args.points < 16:
+        raise ValueError(f"--points must be >= 16, got {args.points}")
+    cam = DiscCam(program, args.base_radius_mm * 1e-3, args.roller_radius_mm * 1e-3, args.offset_mm * 1e-3)
+    limits = Limits(math.radians(args.max_pressure_angle_deg),
+                    None if args.min_radius_mm is None else args.min_radius_mm * 1e-3, args.groove)
+    return name, cam, limits
+
+
+def _text(name, cam, d) -> str:
+    f = lambda v: "-" if v is None else f"{v:.6g}"  # noqa: E731
+    lines = [f"cam: {name}; r_b = {d['base_radius_mm']:g} mm (prime circle), r_r = {d['roller_radius_mm']:g} mm, "
+             f"e = {d['offset_mm']:g} mm, base circle of the contour {d['base_circle_radius_mm']:.6g} mm",
+             f"max pressure angle            {f(d['max_pressure_angle_deg'])} deg at theta = "
+             f"{f(d['max_pressure_angle_at_deg'])} deg",
+             f"min radius of curvature       {f(d['min_radius_of_curvature_mm'])} mm (contour, convex) at theta = "
+             f"{f(d['min_radius_of_curvature_at_deg'])} deg; pitch {f(d['min_pitch_radius_of_curvature_mm'])} mm",
+             f"min concave radius (pitch)    {f(d['min_concave_radius_of_curvature_mm'])} mm at theta = "
+             f"{f(d['min_concave_radius_of_curvature_at_deg'])} deg",
+             f"undercut                      {'yes' if d['undercut'] else 'no'}"
+             + "".join(f"  [{a:.5g}, {b:.5g}] deg" for a, b in d["undercut_ranges_deg"]),
+             f"smallest r_b meeting the checks {f(d['smallest_base_radius_mm'])} mm"
+             + ("" if d.get("smallest_base_radius_error") is None else f" ({d['smallest_base_radius_error']})")]
+    if "speed" in d:
+        sp = d["speed"]
+        jerk = "unbounded (acceleration jumps)" if sp["jerk_unbounded"] else \
+            f"{sp['peak_jerk_m_s3']:.6g} m/s^3 at theta = {sp['peak_jerk_at_deg']:.6g} deg"
+        lines += [f"at {sp['rpm']:g} rpm: peak velocity {sp['peak_velocity_m_s']:.6g} m/s at theta = "
+                  f"{sp['peak_velocity_at_deg']:.6g} deg, acceleration {sp['peak_acceleration_m_s2']:.6g} m/s^2 "
+                  f"at theta = {sp['peak_acceleration_at_deg']:.6g} deg, jerk {jerk}"]
+    lines += [f"warning: {w['message']}" for w in d["warnings"]]
+    for key in ("csv", "dxf", "plot"):
+        if key in d.get("files", {}):
+            lines.append(f"{key} written to {d['files'][key]}")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    from ..kinematics.design_checks import check_design, smallest_base_radius
+
+    try:
+        name, cam, limits = _build(args)
+    except ValueError as exc:
+        return _error(str(exc))
+    report = check_design(cam, limits)
+    d = report.to_json_dict()
+    try:
+        r_min, _ = smallest_base_radius(cam.program, cam.roller_radius, cam.offset, limits, tol=1e-6)
+        d["smallest_base_radius_mm"], d["smallest_base_radius_error"] = r_min * 1e3, None
+    except ValueError as exc:
+        d["smallest_base_radius_mm"], d["smallest_base_radius_error"] = None, str(exc)
+    if args.rpm is not None:
+        from ..kinematics.physical import follower_peaks
+        d["speed"] = follower_peaks(cam.program, args.rpm).to_json_dict()
+    files = {}
+    try:
+        if args.export_csv:
+            from ..kinematics.export import write_contour_csv
+            files["csv"] = str(write_contour_csv(args.export_csv, cam, args.points))
+        if args.export_dxf:
+            from ..kinematics.export import write_dxf
+            files["dxf"] = str(write_dxf(args.export_dxf, cam, args.points, groove=args.groove))
+        if args.plot:
+            from ..plots.cam import plot_cam
+            files["plot"] = str(plot_cam(cam, args.plot, report, title=f"Disc cam: {name}", groove=args.groove))
+    except OSError as exc:
+        return _error(f"cannot write {exc.filename!r}: {exc.strerror}")
+    d["files"] = files
+    print(json.dumps(d) if args.json else _text(name, cam, d))
+    return 0

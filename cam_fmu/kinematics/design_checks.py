@@ -1,0 +1,270 @@
+"""Design checks of a disc cam: pressure angle, radius of curvature, undercut;
+warnings that say where; the smallest prime-circle radius that passes.
+
+Checks (limits in `Limits`, defaults in brackets):
+
+- pressure angle: max |alpha| over the cycle <= max_pressure_angle [30 deg,
+  the usual limit for a translating follower];
+- radius of curvature: on the convex parts of the inner contour (the plate
+  cam's surface, where the roller stress is highest) rho_inner = rho_p - r_r
+  >= min_radius_of_curvature [default: r_r, i.e. rho_p >= 2 r_r, the rule of
+  thumb of keeping the pitch curve's radius at two roller radii or more];
+- undercut: the inner contour must not reverse, rho_p outside (0, r_r); with
+  ``groove=True`` also the outer wall, rho_p outside (-r_r, 0).
+
+Extremes are found on a grid of 7200 angles plus both sides of every
+breakpoint, then refined by golden-section search on the exact expressions
+(angles to ~1e-9 rad); undercut ranges by bisection on rho_p = r_r.
+Units: m and rad (the report's ``to_json_dict`` converts to mm and deg).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .disc_cam import DiscCam, Program
+from .motion_law import golden_max
+
+__all__ = ["Limits", "CheckReport", "DesignWarning", "check_design", "smallest_base_radius"]
+
+TWO_PI = 2.0 * math.pi
+GRID = 7200
+
+
+@dataclass(frozen=True)
+class Limits:
+    """max_pressure_angle [rad]; min_radius_of_curvature [m] of the inner contour
+    on convex parts (None: the roller radius); groove: check the outer wall too."""
+
+    max_pressure_angle: float = math.radians(30.0)
+    min_radius_of_curvature: float | None = None
+    groove: bool = False
+
+    def __post_init__(self):
+        a = self.max_pressure_angle
+        if not (math.isfinite(a) and 0.0 < a < 0.5 * math.pi):
+            raise ValueError(f"max_pressure_angle must lie in (0, 90) deg, got {math.degrees(a)!r} deg")
+        r = self.min_radius_of_curvature
+        if r is not None and not (math.isfinite(r) and r >= 0.0):
+            raise ValueError(f"min_radius_of_curvature must be a finite number >= 0 mm, got {r * 1e3!r} mm")
+
+
+@dataclass(frozen=True)
+class DesignWarning:
+    check: str                      # "pressure_angle", "radius_of_curvature", "undercut", "groove_undercut"
+    message: str
+    at: tuple[float, ...] = ()      # angles [rad] where it occurs (range ends for undercut)
+
+    def to_json_dict(self) -> dict:
+        return {"check": self.check, "message": self.message,
+                "at_deg": [math.degrees(a) for a in self.at]}
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """Results of `check_design`: values [m, rad], where they occur, warnings."""
+
+    base_radius: float
+    roller_radius: float
+    offset: float
+    max_pressure_angle: float
+    max_pressure_angle_at: float
+    min_pitch_radius: float              # smallest rho_p on convex parts
+    min_radius_of_curvature: float       # inner contour there: min_pitch_radius - r_r (< 0: undercut)
+    min_radius_at: float
+    min_concave_radius: float | None     # smallest |rho_p| on concave parts (None: nowhere concave)
+    min_concave_radius_at: float | None
+    undercut: bool
+    undercut_ranges: tuple[tuple[float, float], ...]
+    groove_undercut: bool
+    groove_undercut_ranges: tuple[tuple[float, float], ...]
+    limits: Limits
+    warnings: tuple[DesignWarning, ...] = field(default_factory=tuple)
+
+    @property
+    def ok(self) -> bool:
+        return not self.warnings
+
+    def to_json_dict(self) -> dict:
+        deg, mm = math.degrees, (lambda v: None if v is None else v * 1e3)
+        lim = self.limits
+        return {
+            "base_radius_mm": mm(self.base_radius),
+            "roller_radius_mm": mm(self.roller_radius),
+            "offset_mm": mm(self.offset),
+            "base_circle_radius_mm": mm(self.base_radius - self.roller_radius),
+            "max_pressure_angle_deg": deg(self.max_pressure_angle),
+            "max_pressure_angle_at_deg": deg(self.max_pressure_angle_at),
+            "min_radius_of_curvature_mm": mm(self.min_radius_of_curvature),
+            "min_radius_of_curvature_at_deg": deg(self.min_radius_at),
+            "min_pitch_radius_of_curvature_mm": mm(self.min_pitch_radius),
+            "min_concave_radius_of_curvature_mm": mm(self.min_concave_radius),
+            "min_concave_radius_of_curvature_at_deg":
+                None if self.min_concave_radius_at is None else deg(self.min_concave_radius_at),
+            "undercut": self.undercut,
+            "undercut_ranges_deg": [[deg(a), deg(b)] for a, b in self.undercut_ranges],
+            "groove_undercut": self.groove_undercut,
+            "groove_undercut_ranges_deg": [[deg(a), deg(b)] for a, b in self.groove_undercut_ranges],
+            "limits": {"max_pressure_angle_deg": round(deg(lim.max_pressure_angle), 9),
+                       "min_radius_of_curvature_mm": mm(_min_radius(lim, self.roller_radius)),
+                       "groove": lim.groove},
+            "ok": self.ok,
+            "warnings": [w.to_json_dict() for w in self.warnings],
+        }
+
+
+def _min_radius(limits: Limits, roller_radius: float) -> float:
+    r = limits.min_radius_of_curvature
+    return roller_radius if r is None else r
+
+
+def _grid(program: Program) -> np.ndarray:
+    bp = np.array(program.breakpoints(), dtype=float)
+    extra = np.concatenate([bp, bp + 1e-9, bp - 1e-9]) % TWO_PI
+    return np.unique(np.concatenate([np.linspace(0.0, TWO_PI, GRID, endpoint=False), extra]))
+
+
+def _refined_max(f, grid: np.ndarray, values: np.ndarray) -> tuple[float, float]:
+    """(max value, angle) of f: grid maximum, then golden search between its neighbours."""
+    k = int(np.argmax(values))
+    best_v, best_t = float(values[k]), float(grid[k])
+    n = len(grid)
+    a = float(grid[k - 1]) if k > 0 else float(grid[-1]) - TWO_PI
+    b = float(grid[k + 1]) if k < n - 1 else float(grid[0]) + TWO_PI
+    t, v = golden_max(f, a, b, 1e-10)
+    if v > best_v:
+        best_v, best_t = v, t % TWO_PI
+    return best_v, best_t
+
+
+def _ranges(grid: np.ndarray, mask: np.ndarray, g) -> tuple[tuple[float, float], ...]:
+    """Angle ranges [rad] where mask holds, ends refined by bisection on the sign
+    of g(theta) (g > 0 inside).  Angles reduced to [0, 2 pi): a range across
+    0 deg comes out as (start, end) with start > end."""
+    if not mask.any():
+        return ()
+    if mask.all():
+        return ((0.0, TWO_PI),)
+    n = len(grid)
+    k0 = int(np.argmin(mask))                        # an angle outside every range
+    order = (np.arange(n) + k0) % n
+    th = grid[order] + np.where(order < k0, TWO_PI, 0.0)   # unwrapped, increasing
+    m = mask[order]
+
+    def edge(out: float, inside: float) -> float:
+        for _ in range(60):
+            mid = 0.5 * (out + inside)
+            if g(mid) > 0.0:
+                inside = mid
+            else:
+                out = mid
+        return 0.5 * (out + inside)
+
+    result = []
+    k = 0
+    while k < n:
+        if not m[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < n and m[j + 1]:
+            j += 1
+        end_out = th[j + 1] if j + 1 < n else th[0] + TWO_PI
+        result.append((edge(float(th[k - 1]), float(th[k])) % TWO_PI,
+                       edge(float(end_out), float(th[j])) % TWO_PI))
+        k = j + 1
+    return tuple(result)
+
+
+def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
+    """Run the checks on `cam` and return the values, where they occur and the warnings."""
+    limits = limits or Limits()
+    r_r = cam.roller_radius
+    grid = _grid(cam.program)
+
+    alpha = np.abs(cam.pressure_angle(grid))
+    a_max, a_at = _refined_max(lambda t: abs(cam.pressure_angle(t)), grid, alpha)
+
+    kappa = cam.pitch_curvature(grid)
+    k_max, k_at = _refined_max(cam.pitch_curvature, grid, kappa)       # most convex point
+    rho_min = 1.0 / k_max                                               # k_max > 0: a closed curve bulges somewhere
+    kc_max, kc_at = _refined_max(lambda t: -cam.pitch_curvature(t), grid, -kappa)
+    concave = kc_max > 0.0
+    inv_r = 1.0 / r_r
+    under = _ranges(grid, kappa > inv_r, lambda t: cam.pitch_curvature(t) - inv_r)
+    if limits.groove:
+        groove = _ranges(grid, kappa < -inv_r, lambda t: -cam.pitch_curvature(t) - inv_r)
+    else:
+        groove = ()
+
+    warnings = []
+    if a_max > limits.max_pressure_angle:
+        warnings.append(DesignWarning(
+            "pressure_angle",
+            f"max pressure angle {math.degrees(a_max):.4g} deg at theta = {math.degrees(a_at):.5g} deg "
+            f"exceeds the limit {math.degrees(limits.max_pressure_angle):.4g} deg "
+            f"(raise the base radius or offset the follower)", (a_at,)))
+    rho_c = rho_min - r_r
+    rho_lim = _min_radius(limits, r_r)
+    if under:
+        spans = ", ".join(f"{math.degrees(a):.5g}..{math.degrees(b):.5g} deg" for a, b in under)
+        warnings.append(DesignWarning(
+            "undercut",
+            f"undercut: the contour reverses where the pitch curve's radius of curvature is below "
+            f"the roller radius {r_r * 1e3:.4g} mm (smallest {rho_min * 1e3:.4g} mm at theta = "
+            f"{math.degrees(k_at):.5g} deg), at theta = {spans}",
+            tuple(x for ab in under for x in ab)))
+    elif rho_c < rho_lim:
+        warnings.append(DesignWarning(
+            "radius_of_curvature",
+            f"min radius of curvature of the contour {rho_c * 1e3:.4g} mm at theta = "
+            f"{math.degrees(k_at):.5g} deg is below the limit {rho_lim * 1e3:.4g} mm", (k_at,)))
+    if groove:
+        spans = ", ".join(f"{math.degrees(a):.5g}..{math.degrees(b):.5g} deg" for a, b in groove)
+        warnings.append(DesignWarning(
+            "groove_undercut",
+            f"groove undercut: the outer wall reverses where the concave pitch curve's radius is "
+            f"below the roller radius {r_r * 1e3:.4g} mm, at theta = {spans}",
+            tuple(x for ab in groove for x in ab)))
+    return CheckReport(
+        base_radius=cam.base_radius, roller_radius=r_r, offset=cam.offset,
+        max_pressure_angle=a_max, max_pressure_angle_at=a_at,
+        min_pitch_radius=rho_min, min_radius_of_curvature=rho_c, min_radius_at=k_at,
+        min_concave_radius=(1.0 / kc_max) if concave else None,
+        min_concave_radius_at=kc_at if concave else None,
+        undercut=bool(under), undercut_ranges=under,
+        groove_undercut=bool(groove), groove_undercut_ranges=groove,
+        limits=limits, warnings=tuple(warnings))
+
+
+def smallest_base_radius(program: Program, roller_radius: float, offset: float = 0.0,
+                         limits: Limits | None = None, tol: float = 1e-6) -> tuple[float, CheckReport]:
+    """Smallest prime-circle radius r_b [m] (to `tol`) at which `check_design`
+    gives no warning, and its report.  Bisection: assumes that a design which
+    passes keeps passing at a larger r_b (true of the pressure angle; of the
+    curvature for the usual laws).  Raises ValueError if none up to 1000 m."""
+    limits = limits or Limits()
+
+    def report(r_b):
+        return check_design(DiscCam(program, r_b, roller_radius, offset), limits)
+
+    lo = max(roller_radius, abs(offset)) * (1.0 + 1e-9) + 1e-12
+    hi = 2.0 * lo
+    rep = report(hi)
+    while not rep.ok:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1000.0:
+            raise ValueError("no base radius up to 1000 m meets the limits "
+                             f"({', '.join(w.check for w in rep.warnings)})")
+        rep = report(hi)
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        r = report(mid)
+        if r.ok:
+            hi, rep = mid, r
+        else:
+            lo = mid
+    return hi, rep

@@ -1,0 +1,120 @@
+"""`cam-fmu contour`: JSON fields and values, undercut as a result, exports, the
+motion-table route, and one-line errors with exit status 2."""
+
+import json
+import math
+
+import ezdxf
+import numpy as np
+import pytest
+
+from cam_fmu.cli import main
+from cam_fmu.kinematics.cam_program import CamProgram, paper_program
+
+UNDERCUT = ["--preset", "cycloidal", "--rise-deg", "60", "--upper-dwell-deg", "120", "--return-deg", "60",
+            "--lift-mm", "40", "--base-radius-mm", "30", "--roller-radius-mm", "25"]
+
+
+def run(capsys, *argv):
+    rc = main(["contour", *argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def test_json_paper_cam(capsys):
+    rc, out, err = run(capsys, "--roller-radius-mm", "20", "--rpm", "60", "--json")
+    assert rc == 0 and err == ""
+    d = json.loads(out)
+    for key in ("min_radius_of_curvature_mm", "min_radius_of_curvature_at_deg", "undercut",
+                "undercut_ranges_deg", "max_pressure_angle_deg", "max_pressure_angle_at_deg",
+                "warnings", "smallest_base_radius_mm", "speed", "limits"):
+        assert key in d
+    # in-line follower: CamProgram's own pressure-angle maximum (an independent code path)
+    a, at = paper_program().max_pressure_angle(0.1)
+    assert d["max_pressure_angle_deg"] == pytest.approx(math.degrees(a), abs=1e-7)
+    assert min(abs(d["max_pressure_angle_at_deg"] - math.degrees(at)),
+               abs(d["max_pressure_angle_at_deg"] - (360 - math.degrees(at)))) < 1e-3
+    # closed form at theta = 0 (s = s' = s'' = 0): rho_p = r_b, contour r_b - r_r
+    assert d["min_pitch_radius_of_curvature_mm"] == pytest.approx(100.0, rel=1e-12)
+    assert d["min_radius_of_curvature_mm"] == pytest.approx(80.0, rel=1e-12)
+    assert d["undercut"] is False and d["ok"] is True and d["warnings"] == []
+    assert d["speed"]["peak_velocity_m_s"] == pytest.approx(0.070 * 2 * math.pi, rel=1e-12)
+    assert d["smallest_base_radius_mm"] < 100.0
+
+
+def test_undercut_is_a_result_not_an_error(capsys):
+    rc, out, _ = run(capsys, *UNDERCUT, "--json")
+    assert rc == 0
+    d = json.loads(out)
+    assert d["undercut"] is True and d["ok"] is False
+    assert d["min_radius_of_curvature_mm"] < 0
+    assert {w["check"] for w in d["warnings"]} == {"undercut", "pressure_angle"}
+    assert all(0 <= a < b < 360 for a, b in d["undercut_ranges_deg"])
+    assert d["smallest_base_radius_mm"] > 30.0
+    rc, out, _ = run(capsys, *UNDERCUT)                       # the text report says so too
+    assert rc == 0 and "undercut                      yes" in out and "warning: undercut" in out
+
+
+def test_offset_pressure_angle_in_json(capsys):
+    _, out, _ = run(capsys, "--roller-radius-mm", "20", "--offset-mm", "15", "--json")
+    d = json.loads(out)
+    prog = paper_program()
+    th = np.linspace(0, 2 * math.pi, 100001)
+    s, s1, _, _ = prog.evaluate(th)
+    alpha = np.degrees(np.abs(np.arctan((s1 - 0.015) / (math.sqrt(0.1 ** 2 - 0.015 ** 2) + s))))
+    assert d["max_pressure_angle_deg"] == pytest.approx(alpha.max(), abs=1e-5)
+    assert d["max_pressure_angle_deg"] > 30 and d["warnings"][0]["check"] == "pressure_angle"
+
+
+def test_exports_and_plot(tmp_path, capsys):
+    csv, dxf, png = tmp_path / "c.csv", tmp_path / "c.dxf", tmp_path / "fig" / "c.png"
+    rc, out, _ = run(capsys, "--roller-radius-mm", "20", "--points", "360", "--export-csv", str(csv),
+                     "--export-dxf", str(dxf), "--plot", str(png))
+    assert rc == 0 and f"csv written to {csv}" in out
+    rows = csv.read_text().splitlines()
+    pts = np.array([[float(v) for v in r.split(",")] for r in rows[1:]])
+    assert rows[0] == "x_mm,y_mm" and len(pts) == 361 and np.array_equal(pts[0], pts[-1])
+    lw = {e.dxf.layer: e for e in ezdxf.readfile(dxf).modelspace()}
+    assert np.allclose([v[:2] for v in lw["CONTOUR"].get_points("xy")], pts[:-1], atol=1e-12)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_motion_table_route(tmp_path, capsys):
+    prog = CamProgram("cycloidal", "modified_sine", 0.03, math.radians(100), math.radians(40),
+                      math.radians(120), math.radians(100))
+    deg = np.arange(0.0, 360.0, 0.5)
+    s = prog.evaluate(np.radians(deg))[0] * 1e3
+    table = tmp_path / "motion.csv"
+    table.write_text("angle_deg,lift_mm\n" + "\n".join(f"{a:g},{float(v)!r}" for a, v in zip(deg, s)) + "\n")
+    rc, out, _ = run(capsys, "--table", str(table), "--base-radius-mm", "60", "--roller-radius-mm", "10",
+                     "--rpm", "100", "--json")
+    assert rc == 0
+    d = json.loads(out)
+    a, _ = prog.max_pressure_angle(0.06)
+    assert d["max_pressure_angle_deg"] == pytest.approx(math.degrees(a), abs=1e-4)
+    w = 2 * math.pi * 100 / 60
+    assert d["speed"]["peak_velocity_m_s"] == pytest.approx(2 * 0.03 / math.radians(100) * w, rel=1e-4)
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["--roller-radius-mm", "120"], "--roller-radius-mm 120 must be < --base-radius-mm 100"),
+    (["--roller-radius-mm", "0"], "--roller-radius-mm must be a number > 0"),
+    (["--roller-radius-mm", "10", "--offset-mm", "-100"], "--offset-mm must satisfy |e| < r_b = 100 mm"),
+    (["--roller-radius-mm", "10", "--rpm", "0"], "--rpm must be a number > 0"),
+    (["--roller-radius-mm", "10", "--max-pressure-angle-deg", "90"], "--max-pressure-angle-deg must lie in (0, 90)"),
+    (["--roller-radius-mm", "10", "--preset", "nope"], "known presets: cycloidal"),
+    (["--roller-radius-mm", "10", "--table", "/nonexistent/t.csv"], "--table: cannot read"),
+    (["--roller-radius-mm", "10", "--export-csv", "/proc/nope/x.csv"], "cannot write"),
+])
+def test_errors_are_one_line_exit_2(capsys, argv, fragment):
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2 and out == ""
+    assert err.startswith("cam-fmu contour: error: ") and fragment in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_bad_table_is_an_error(tmp_path, capsys):
+    t = tmp_path / "t.csv"
+    t.write_text("angle_deg,lift_mm\n0,0\n90,5\n90,6\n")
+    rc, _, err = run(capsys, "--roller-radius-mm", "10", "--table", str(t))
+    assert rc == 2 and "angles must increase strictly" in err
