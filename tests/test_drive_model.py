@@ -220,13 +220,15 @@ def test_constant_speed_both_formulations_agree(mounting, monkeypatch):
 
 # ------------------------------------------------------ invalid parameters
 @pytest.mark.parametrize("overrides, name, allowed", [
-    (dict(R=0.0), "R", "(0, 10000] Ohm"),
+    (dict(R=0.0), "R", "[0.001, 10000] Ohm"),  # physical ranges (issue 9): no 5e-324 Ohm
     (dict(mu=-1.0), "mu", "[0, 0.5]"),
-    (dict(J_m=-1e-5), "J_m", "(0, 100]"),
+    (dict(J_m=-1e-5), "J_m", "[1e-09, 100]"),
+    (dict(J_m=5e-324), "J_m", "[1e-09, 100]"),
     (dict(c=0.5), "c", "[0, 0.1] m"),
     (dict(solver="heun"), "solver", "'euler', 'rk4', 'rk45', 'etdrk4'"),
     (dict(formulation="lagrange"), "formulation", "'consistent', 'paper'"),
-    (dict(L=float("nan")), "L", "[0, 10] H"),
+    (dict(L=float("nan")), "L", "0 or [1e-09, 10] H"),
+    (dict(L=5e-324), "L", "0 or [1e-09, 10] H"),
 ])
 @pytest.mark.parametrize("cls", [DriveModel, DriveSimulator])
 def test_invalid_parameter_names_itself_and_range(cls, overrides, name, allowed):

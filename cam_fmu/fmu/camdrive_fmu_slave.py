@@ -101,13 +101,11 @@ class CamDriveSlave(Fmi2Slave):
         return lambda: self._inputs[name]
 
     def _input_setter(self, name: str):
-        unit = {n: u for n, u, _s, _d in _variables.INPUTS}[name]
-
         def setter(value: Any) -> None:
-            number = float(value)
-            if not math.isfinite(number):
-                self._fail(f"input {name!r} = {number!r} [{unit}] is not finite: allowed any finite value (-inf, inf) {unit}")
-            self._inputs[name] = number
+            try:
+                self._inputs[name] = _variables.check_input(name, value)
+            except (TypeError, ValueError) as exc:
+                self._fail(str(exc))
         return setter
 
     def _output_getter(self, name: str):

@@ -25,7 +25,7 @@ from typing import Any, Mapping
 
 from ..physics.drive import DriveModel
 from ..physics.formulations import formulation_for
-from ..physics.variables import INPUT_STARTS, INPUTS, OUTPUTS
+from ..physics.variables import INPUT_STARTS, INPUTS, OUTPUTS, check_input
 from ..solvers import SOLVERS, SimulationError
 from ..solvers.hybrid import HybridIntegrator
 
@@ -102,7 +102,7 @@ class DriveSimulator:
 
 
 def _finite(name: str, value: float) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise SimulationError(f"input {name!r} = {value!r}: allowed any finite value")
-    return value
+    try:
+        return check_input(name, value)
+    except ValueError as exc:
+        raise SimulationError(str(exc)) from None

@@ -25,7 +25,7 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 from ..physics import parameters
-from ..physics.variables import INPUTS, OUTPUTS
+from ..physics.variables import INPUT_RANGES, INPUTS, OUTPUTS
 
 # SI base-unit exponents of the units used by the model (FMI 2.0 BaseUnit attributes).
 BASE_UNITS: Dict[str, Dict[str, int]] = {
@@ -55,9 +55,10 @@ def variable_rows() -> List[Dict[str, Any]]:
     """Every FMU variable in value-reference order (the slave registers inputs, outputs, parameters)."""
     rows: List[Dict[str, Any]] = []
     for name, unit, start, desc in INPUTS:
+        low, high = INPUT_RANGES[name]
         rows.append(dict(name=name, type="Real", causality="input", variability="continuous", initial=None,
-                         unit=unit, start=float(start), min=None, max=None, description=desc,
-                         allowed="any finite value"))
+                         unit=unit, start=float(start), min=low, max=high, description=desc,
+                         allowed=f"[{low:g}, {high:g}] {unit}"))
     for name, unit, desc in OUTPUTS:
         rows.append(dict(name=name, type="Real", causality="output", variability="continuous",
                          initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
@@ -68,7 +69,8 @@ def variable_rows() -> List[Dict[str, Any]]:
                    unit=spec.unit if spec.kind == "real" else "", start=spec.default,
                    min=None, max=None, description=spec.description, allowed=spec.allowed())
         if spec.kind == "real":
-            row["min"] = spec.low if math.isfinite(spec.low) else None
+            low = 0.0 if spec.zero_ok else spec.low
+            row["min"] = low if math.isfinite(low) else None
             row["max"] = spec.high if math.isfinite(spec.high) else None
         rows.append(row)
     return rows

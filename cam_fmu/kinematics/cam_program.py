@@ -59,12 +59,22 @@ class ProgramBase:
         s, ds, _, _ = self.evaluate(theta)
         return np.arctan(ds / (base_radius + s))
 
-    def breakpoints_passed(self, start: float, end: float) -> list[float]:
-        """Breakpoint angles [rad] passed going from start to end, in the order passed."""
+    def _points(self) -> tuple[float, ...]:
         points = self.__dict__.get("_breakpoints")
         if points is None:
             points = self._breakpoints = self.breakpoints()
-        return crossed(points, start, end)
+        return points
+
+    def breakpoints_passed(self, start: float, end: float) -> list[float]:
+        """Breakpoint angles [rad] passed going from start to end, in the order passed.
+
+        The list grows with the angle swept: for one step use ``first_breakpoint_passed``.
+        """
+        return crossed(self._points(), start, end)
+
+    def first_breakpoint_passed(self, start: float, end: float) -> float | None:
+        """The first breakpoint angle [rad] strictly between start and end, or None (O(1) in the angle swept)."""
+        return first_crossed(self._points(), start, end)
 
     def max_pressure_angle(self, base_radius: float) -> tuple[float, float]:
         """(max |alpha| [rad], theta [rad] where it occurs) over one cycle."""
@@ -200,6 +210,32 @@ def crossed(points, start: float, end: float) -> list[float]:
             angle += TWO_PI
     out.sort(reverse=end < start)
     return out
+
+
+def first_crossed(points, start: float, end: float) -> float | None:
+    """The first of the periodic points (in [0, 2 pi)) passed going from start to end [rad], or None.
+
+    Strictly between start and end, like ``crossed``; its cost does not grow with |end - start|.
+    """
+    if end > start:
+        best = math.inf
+        for p in points:
+            angle = p + math.ceil((start - p) / TWO_PI) * TWO_PI
+            if angle <= start:
+                angle += TWO_PI
+            if angle < best:
+                best = angle
+        return best if best < end else None
+    if end < start:
+        best = -math.inf
+        for p in points:
+            angle = p + math.floor((start - p) / TWO_PI) * TWO_PI
+            if angle >= start:
+                angle -= TWO_PI
+            if angle > best:
+                best = angle
+        return best if best > end else None
+    return None
 
 
 def paper_program(A: float = 0.035) -> CamProgram:

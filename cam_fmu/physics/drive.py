@@ -42,6 +42,25 @@ def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_sup
     return mu * (n_support - n0) / (1.0 + mu * sk)
 
 
+def check_self_locking(program: ProgramBase, mu: float, r_b: float) -> None:
+    """Raise ParameterError when the follower would jam in its guide somewhere on the cam.
+
+    The cam pushes the follower through a contact force inclined by the pressure
+    angle alpha; the guide's friction grows with the side component N tan(alpha).
+    Where mu |tan(alpha)| >= 1, no contact force can move the follower (the
+    friction equation has no solution with a non-negative force): the drive
+    self-locks there (docs/model.md section 4).
+    """
+    alpha, theta = program.max_pressure_angle(r_b)
+    locking = mu * math.tan(alpha)
+    if locking >= 1.0 - 1e-12:
+        raise ParameterError(
+            f"parameters 'mu' = {mu!r} and 'r_b' = {r_b!r} m make the follower self-lock in its guide: "
+            f"mu tan(alpha) = {locking:.4g} >= 1 at theta = {math.degrees(theta):.4g} deg "
+            f"(pressure angle alpha = {math.degrees(alpha):.4g} deg); allowed: mu tan(max alpha) < 1 "
+            f"(lower mu below {1.0 / math.tan(alpha):.4g} or raise r_b)")
+
+
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
     """The cam program the parameters describe: the user's motion table, else laws and angles.
 
@@ -101,6 +120,8 @@ class DriveModel:
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
+        if self.mu > 0.0:
+            check_self_locking(self.program, self.mu, self.r_b)
 
     # ----------------------------------------------------------- mechanics
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True) -> float:

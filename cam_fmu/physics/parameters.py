@@ -32,6 +32,7 @@ class ParameterSpec:
     low: float = -math.inf
     high: float = math.inf
     low_open: bool = False  # True: the lower bound itself is not allowed
+    zero_ok: bool = False  # True: 0 is allowed besides [low, high] (0 switches the quantity off)
     choices: tuple[str, ...] = ()
 
     def allowed(self) -> str:
@@ -41,7 +42,8 @@ class ParameterSpec:
         if self.kind == "string":
             return "one of " + ", ".join(repr(c) for c in self.choices)
         left = "(" if self.low_open else "["
-        return f"{left}{self.low:g}, {self.high:g}]" + (f" {self.unit}" if self.unit not in ("", "1") else "")
+        zero = "0 or " if self.zero_ok else ""
+        return f"{zero}{left}{self.low:g}, {self.high:g}]" + (f" {self.unit}" if self.unit not in ("", "1") else "")
 
     def check(self, value: Any) -> Any:
         """Return the value converted to its kind, or raise ParameterError."""
@@ -63,6 +65,8 @@ class ParameterSpec:
         except (TypeError, ValueError):
             raise ParameterError(f"parameter {self.name!r} = {value!r} is not a number: allowed {self.allowed()}") from None
         too_low = number <= self.low if self.low_open else number < self.low
+        if self.zero_ok and number == 0.0:
+            return 0.0
         if not math.isfinite(number) or too_low or number > self.high:
             raise ParameterError(f"parameter {self.name!r} = {number!r} [{self.unit}] is outside the allowed range {self.allowed()}")
         return number
@@ -77,18 +81,18 @@ EFFECTS = ("shaft_friction", "guide_friction", "gravity", "follower_inertia", "b
 
 _P = ParameterSpec
 _MODEL = (
-    _P("R", "Ohm", 19.0, "armature resistance", low=0.0, high=1e4, low_open=True),
-    _P("L", "H", 0.0, "armature inductance (0: neglected, as in the paper)", low=0.0, high=10.0),
-    _P("c_e", "V/(rad/s)", 0.146, "back-EMF constant", low=0.0, high=100.0, low_open=True),
-    _P("c_m", "N.m/A", 0.015 * KGF, "torque constant (the paper's 0.015 is kgf m/A)", low=0.0, high=100.0, low_open=True),
-    _P("J_m", "kg.m2", 4.41e-5, "motor, encoder and cam inertia", low=0.0, high=100.0, low_open=True),
+    _P("R", "Ohm", 19.0, "armature resistance", low=1e-3, high=1e4),
+    _P("L", "H", 0.0, "armature inductance (0: neglected, as in the paper)", low=1e-9, high=10.0, zero_ok=True),
+    _P("c_e", "V/(rad/s)", 0.146, "back-EMF constant", low=1e-6, high=100.0),
+    _P("c_m", "N.m/A", 0.015 * KGF, "torque constant (the paper's 0.015 is kgf m/A)", low=1e-6, high=100.0),
+    _P("J_m", "kg.m2", 4.41e-5, "motor, encoder and cam inertia", low=1e-9, high=100.0),
     _P("M_f", "N.m", 0.012, "shaft friction torque (Coulomb)", low=0.0, high=1e3),
     _P("m", "kg", 0.4, "follower mass", low=0.0, high=1e4),
     _P("G", "N", 4.0, "follower weight", low=0.0, high=1e5),
     _P("mu", "1", 0.001, "guide friction coefficient", low=0.0, high=0.5),
     _P("gamma", "rad", math.pi, "angle of gravity to Z (pi: horizontal mounting)", low=-2 * math.pi, high=2 * math.pi),
     _P("beta", "rad", 0.0, "angle of gravity's XY component to the rise direction X", low=-2 * math.pi, high=2 * math.pi),
-    _P("r_b", "m", 0.1, "base-circle radius (keeps the paper profile's pressure angle under 30 deg)", low=0.0, high=10.0, low_open=True),
+    _P("r_b", "m", 0.1, "base-circle radius (keeps the paper profile's pressure angle under 30 deg)", low=1e-4, high=10.0),
     _P("c", "m", 0.0, "clearance of the follower (backlash half-width, paper eqs. 6-8)", low=0.0, high=0.1),
     _P("theta0", "rad", 0.0, "initial cam angle", low=-1e6, high=1e6),
     _P("omega0", "rad/s", 0.0, "initial angular velocity", low=-1e4, high=1e4),
@@ -102,10 +106,10 @@ _PROGRAM = (
     _P("return_law", "", "paper", "motion law of the return: a preset name or 'custom' (then return_T1..return_T6)", kind="string", choices=LAW_CHOICES),
     *(_P(f"return_T{k}", "1", v, f"split point T{k} of a custom return law", low=0.0, high=1.0)
       for k, v in enumerate((0.125, 0.125, 0.25, 0.75, 0.875, 0.875), start=1)),
-    _P("lift", "m", 1.5 * math.pi * PAPER_A, "lift h (paper: 3 pi A / 2 with A = 35 mm)", low=0.0, high=10.0, low_open=True),
-    _P("rise_angle", "rad", math.pi, "cam angle of the rise", low=0.0, high=2 * math.pi, low_open=True),
+    _P("lift", "m", 1.5 * math.pi * PAPER_A, "lift h (paper: 3 pi A / 2 with A = 35 mm)", low=1e-6, high=10.0),
+    _P("rise_angle", "rad", math.pi, "cam angle of the rise", low=1e-3, high=2 * math.pi),
     _P("upper_dwell", "rad", 0.0, "cam angle of the upper dwell", low=0.0, high=2 * math.pi),
-    _P("return_angle", "rad", math.pi, "cam angle of the return", low=0.0, high=2 * math.pi, low_open=True),
+    _P("return_angle", "rad", math.pi, "cam angle of the return", low=1e-3, high=2 * math.pi),
     _P("lower_dwell", "rad", 0.0, "cam angle of the lower dwell", low=0.0, high=2 * math.pi),
     _P("motion_table", "", "", "a user motion table as CSV text 'angle_deg,lift_mm' with a header line "
        "(periodic cubic spline; when given, the laws, lift and angles above are not used)", kind="string"),
@@ -120,10 +124,10 @@ _MODE = (
 
 _SOLVER = (
     _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole)", kind="string", choices=SOLVERS),
-    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step)", low=0.0, high=10.0, low_open=True),
+    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step)", low=1e-9, high=10.0),
     _P("rtol", "1", 1e-10, "relative tolerance of 'rk45'", low=1e-14, high=0.1),
     _P("atol", "1", 1e-12, "absolute tolerance of 'rk45' (on rad, rad/s, A)", low=1e-16, high=1.0),
-    _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4)", low=1.0, high=1e9),
+    _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4); bounds the work of one step", low=1.0, high=1e6),
 )
 
 PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER

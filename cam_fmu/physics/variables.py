@@ -26,10 +26,27 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("s_cam", "m", "cam profile lift at the contact (before backlash)"),
     ("voltage", "V", "armature voltage: u (voltage drive) or the voltage needed (speed drive)"),
 )
+# Allowed range of each input [its unit]: far beyond any real drive, finite so that
+# the arithmetic stays finite (a value outside is an error naming the input and the range).
+INPUT_RANGES: dict[str, tuple[float, float]] = {
+    "u": (-1e4, 1e4),
+    "omega_ref": (-1e4, 1e4),
+    "omega_dot_ref": (-1e8, 1e8),
+}
 INPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in INPUTS)
 INPUT_STARTS: dict[str, float] = {row[0]: row[2] for row in INPUTS}
 OUTPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in OUTPUTS)
 UNITS: dict[str, str] = {row[0]: row[1] for row in INPUTS + OUTPUTS}  # type: ignore[operator]
+
+
+def check_input(name: str, value: float) -> float:
+    """The input as a float, or ValueError naming it and its allowed range."""
+    number = float(value)
+    low, high = INPUT_RANGES[name]
+    if not (low <= number <= high):  # NaN fails too
+        raise ValueError(f"input {name!r} = {number!r} [{UNITS[name]}] is outside the allowed range "
+                         f"[{low:g}, {high:g}] {UNITS[name]}")
+    return number
 
 
 def output_record(**values: Any) -> dict[str, float]:

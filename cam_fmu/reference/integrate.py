@@ -217,7 +217,7 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         h = float(t1 - t0)
         steps = max(1, math.ceil(h / p["h_max"] - 1e-9))
         for j in range(steps):
-            scheme.step(h / steps, u.value(float(t0) + j * h / steps))
+            scheme.step(h / steps, u.value(float(t0) + j * h / steps), int(p["max_steps"]))
         rows.append(scheme.outputs())
     return _collect(rows, grid)
 

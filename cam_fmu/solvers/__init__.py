@@ -8,11 +8,11 @@ with any of them (events, profile breakpoints, the work bound max_steps).
 """
 from __future__ import annotations
 
-from .base import SimulationError, Stepper
+from .base import SimulationError, StepRejected, Stepper
 from .dopri import DormandPrince45
 from .etd import ETDRK4
 from .explicit import RK4, Euler
 
 SOLVERS: dict[str, type[Stepper]] = {cls.name: cls for cls in (Euler, RK4, DormandPrince45, ETDRK4)}
 
-__all__ = ["SOLVERS", "SimulationError", "Stepper"]
+__all__ = ["SOLVERS", "SimulationError", "StepRejected", "Stepper"]

@@ -16,8 +16,7 @@ Vector = Sequence[float]
 Derivative = Callable[[Vector], tuple]
 
 
-class SimulationError(RuntimeError):
-    """The simulation cannot go on correctly; the message names the setting."""
+from ..errors import SimulationError, StepRejected  # noqa: F401  (re-exported: the solvers raise them)
 
 
 class HybridSystem(Protocol):
@@ -33,7 +32,7 @@ class HybridSystem(Protocol):
     def settle(self, y: list, u: float, mode: Any) -> None: ...
     def stuck_state(self, y: Vector, u: float, dt: float) -> list[float]: ...
     def stiffness_rate(self, y: Vector, mode: Any, electrical: bool) -> float: ...
-    def breakpoints_passed(self, start: float, end: float) -> list[float]: ...
+    def first_breakpoint_passed(self, start: float, end: float) -> float | None: ...
 
 
 class Stepper:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from .base import Derivative, SimulationError, Stepper, Vector
+from .base import Derivative, StepRejected, Stepper, Vector
 
 # Dormand-Prince 5(4) tableau (Hairer, Norsett, Wanner, Solving ODE I, table 5.2).
 _C = (0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0, 1.0)
@@ -57,8 +57,11 @@ class DormandPrince45(Stepper):
         return dopri_step(f, y, dt)[0]
 
     def attempt(self, f: Derivative, y: Vector, remaining: float, k1: tuple | None, time: float,
-                caps: tuple[float, ...]) -> tuple[float, list[float], tuple]:
+                caps: tuple[float, ...], span: float) -> tuple[float, list[float], tuple]:
         """One accepted step: (dt [s], y_new, f(y_new)); raises SimulationError below the smallest step.
+
+        The smallest step is 1e-12 of ``span``, the communication step [s]: relative to the
+        step's own time scale, never to the absolute time (a master may start at t = 1.7e9 s).
 
         ``caps[k]`` bounds the magnitude that scales slot k's error: theta grows
         without bound but enters the physics mod 2 pi, so its error is scaled by
@@ -66,7 +69,7 @@ class DormandPrince45(Stepper):
         |theta|, rk45 lost 1e-4 rad within 1 s at 100 V, ~100 turns).
         """
         dt = min(self.h_next, remaining, self.h_max)
-        floor = 1e-14 * max(1.0, time)
+        floor = 1e-12 * span
         atol, rtol = self.atol, self.rtol
         while True:
             y5, err, k7 = dopri_step(f, y, dt, k1)
@@ -85,6 +88,7 @@ class DormandPrince45(Stepper):
                 norm = 1e10
             dt *= max(0.1, 0.9 * norm ** -0.2)
             if dt < floor:
-                raise SimulationError(
+                raise StepRejected(
                     f"solver 'rk45' cannot meet rtol = {rtol:g}, atol = {atol:g}: its step fell "
-                    f"below {floor:g} s at t = {time:g} s")
+                    f"below {floor:g} s (1e-12 of the communication step) at t = {time:g} s: loosen rtol/atol, "
+                    "or check the inputs and parameters for a near-singular drive")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .base import HybridSystem, SimulationError, Stepper
+from .base import HybridSystem, StepRejected, Stepper
 from .events import locate
 
 
@@ -47,16 +47,15 @@ class HybridIntegrator:
                 break  # nothing evolves until the input changes
             steps += 1
             if steps > self.max_steps:
-                raise SimulationError(
+                raise StepRejected(
                     f"solver {stepper.name!r} needed more than max_steps = {self.max_steps} internal steps "
-                    f"in one communication step of {h:g} s at t = {time + t:g} s: raise max_steps, "
-                    "loosen rtol/atol or use 'etdrk4' for a stiff electrical pole")
+                    f"in one communication step of {h:g} s at t = {time + t:g} s: {self._advice(system)}")
             remaining = h - t
             if mode.stuck:
                 dt = remaining
                 y_new = system.stuck_state(y, u, dt)
             elif stepper.adaptive:
-                dt, y_new, k1 = stepper.attempt(f, y, remaining, k1, time, system.error_caps)
+                dt, y_new, k1 = stepper.attempt(f, y, remaining, k1, time + t, system.error_caps, h)
                 cut, y_cut = self._stop_at_breakpoint(system, f, y, y_new, dt, u, mode)
                 if cut != dt:  # ends on a breakpoint: its FSAL derivative belonged to the longer step
                     dt, y_new, k1 = cut, y_cut, None
@@ -76,6 +75,17 @@ class HybridIntegrator:
         self.fsal = None if k1 is None or mode.stuck else (k1, u)
         return y, steps
 
+    def _advice(self, system: HybridSystem) -> str:
+        """What to change when the work bound is hit, for this solver."""
+        stepper = self.stepper
+        if stepper.adaptive:
+            text = "raise max_steps, loosen rtol/atol or shorten the communication step"
+            if system.has_current and not stepper.exact_electrical_pole:
+                text += "; with L > 0 the electrical pole is stiff: use solver 'etdrk4'"
+            return text
+        return (f"raise max_steps or h_max (now {stepper.h_max:g} s), or shorten the communication step; "
+                f"{stepper.name!r} takes steps no longer than its stability limit")
+
     def _fixed_step_size(self, system: HybridSystem, y, mode) -> float:
         """h_max, cut to the explicit method's stability limit at this state [s]."""
         stepper = self.stepper
@@ -94,10 +104,10 @@ class HybridIntegrator:
         at the same cost). The step is cut at the located crossing (just past
         it), so every step sees one smooth piece of the profile.
         """
-        crossed_points = system.breakpoints_passed(y[0], y_new[0])
-        if not crossed_points:
+        target = system.first_breakpoint_passed(y[0], y_new[0])
+        if target is None:
             return dt, y_new
-        target, direction = crossed_points[0], mode.direction
+        direction = mode.direction
         stepper = self.stepper
 
         def gap(state):
@@ -112,6 +122,12 @@ class HybridIntegrator:
             return None
         after = system.event_values(y_new, u, mode)
         names = system.event_names(mode)
+        # A function already at or below zero at the step's start is decided by where it goes:
+        # into the event (g1 < 0, or it started below zero) fires it at once; away from it (g1 > 0
+        # from exactly 0) does not. A zero at the start is never lost.
+        for k, (g0, g1) in enumerate(zip(before, after)):
+            if g0 < 0.0 or (g0 == 0.0 and g1 < 0.0):
+                return names[k], 0.0, list(y)
         fired = [k for k, (g0, g1) in enumerate(zip(before, after)) if g0 > 0.0 and g1 <= 0.0]
         if not fired:
             return None

@@ -143,9 +143,9 @@ class HybridDrive:
         s1 = model.program.derivatives(y[THETA])[1]
         return model.c_m / (model.J_m + (model.m * s1 * s1 if mode.contact != 0 else 0.0))
 
-    def breakpoints_passed(self, start: float, end: float) -> list[float]:
-        """Profile breakpoints [rad] between two angles, in the order passed."""
-        return self.model.program.breakpoints_passed(start, end)
+    def first_breakpoint_passed(self, start: float, end: float) -> float | None:
+        """The first profile breakpoint [rad] strictly between two angles, or None."""
+        return self.model.program.first_breakpoint_passed(start, end)
 
     # ------------------------------------------------------------ events
     def event_names(self, mode: Mode) -> tuple[str, ...]:
@@ -224,13 +224,20 @@ class HybridDrive:
             direction = 1.0 if forward >= backward else -1.0
         if direction == 0.0:
             return
-        mode.stuck = False
-        mode.direction = direction
+        leaves = False
         if self.backlash and mode.contact != 0:
             s, s1, _, _ = model.program.derivatives(y[THETA])
-            if mode.contact * s1 * direction < 0.0:  # the cam leaves the follower
-                mode.s_free = s - model.c * mode.contact
-                mode.contact = 0
+            leaves = mode.contact * s1 * direction < 0.0  # the cam would leave the follower
+            # Starting that way is consistent only if the shaft, rid of the follower, still
+            # accelerates that way: else (gravity pulled the cam back, but without the
+            # follower the motor pulls it forward) it stays at rest instead of chattering.
+            if leaves and direction * model.omega_dot(y[THETA], 0.0, torque, direction, False) <= 0.0:
+                return
+        mode.stuck = False
+        mode.direction = direction
+        if leaves:
+            mode.s_free = s - model.c * mode.contact
+            mode.contact = 0
 
     # ----------------------------------------------------------- outputs
     def outputs(self, y, u: float, mode: Mode, omega_dot: float | None = None) -> dict[str, float]:

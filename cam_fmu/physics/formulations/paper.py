@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ...errors import StepRejected
 from ..contact import play
 from ..drive import DriveModel, sign, solve_guide_friction
 from ..variables import output_record
@@ -63,9 +64,20 @@ class PaperScheme:
             return None
         return model.M_f * sign(net)
 
-    def step(self, T: float, u: float) -> None:
-        """Steps 2-8 for one calculation step T [s] under the voltage u [V]."""
+    def step(self, T: float, u: float, budget: int | None = None) -> int:
+        """Steps 2-8 for one calculation step T [s] under the voltage u [V]; returns the RK4 sub-steps taken.
+
+        Raises StepRejected, before any change, when the step needs more than ``budget``
+        sub-steps (default: the parameter max_steps).
+        """
         model = self.model
+        n = rk4_substeps(model, self.J, T)
+        if n > (int(model.params["max_steps"]) if budget is None else budget):
+            raise StepRejected(
+                f"the paper formulation needs {n} RK4 sub-steps in one calculation step of {T:g} s "
+                f"(motor rate {model.motor.electrical_rate(self.J):.3g} 1/s, L = {model.L:g} H), more than "
+                f"max_steps allows: lower h_max, raise max_steps, or use formulation 'consistent' "
+                f"(with solver 'etdrk4' for a stiff electrical pole)")
         self.voltage = u
         L = model.L
         motor = model.motor
@@ -109,6 +121,7 @@ class PaperScheme:
         # Step 8: eq. (4).
         self.J = model.J_m + model.m * X * X
         self.M = model.M_f * sign(self.omega) + self.M_l
+        return n
 
     def outputs(self) -> dict[str, float]:
         s_cam = self.model.program.derivatives(self.theta)[0]
@@ -116,26 +129,41 @@ class PaperScheme:
                              v=self.v, a=self.a, alpha=self.alpha, s_cam=s_cam, voltage=self.voltage)
 
 
+def rk4_substeps(model: DriveModel, J: float, T: float) -> int:
+    """RK4 sub-steps that keep one calculation step T [s] inside RK4's stability limit.
+
+    The motor's own rate (the back-EMF damping c_e c_m / (R J), or the electrical
+    pole with L > 0) times the sub-step stays at or below 2. At the paper's T = 1 ms
+    this is 1 (J = J_m: rate 25.6 1/s); with T = 1 s it is 13 instead of a step that
+    diverged and was clipped to omega = 0 (the cam never moved).
+    """
+    return max(1, math.ceil(T * model.motor.electrical_rate(J) / 2.0))
+
+
 def _rk4_motor(model: DriveModel, omega: float, M: float, J: float, u: float, T: float) -> float:
-    """RK4 on eq. (12): omega_dot = (c_m u - R M - c_e c_m omega) / (R J)."""
+    """RK4 on eq. (12): omega_dot = (c_m u - R M - c_e c_m omega) / (R J), in rk4_substeps sub-steps."""
     R, cm, ce = model.R, model.c_m, model.c_e
+    n = rk4_substeps(model, J, T)
+    h = T / n
 
     def f(w: float) -> float:
         return (cm * u - R * M - ce * cm * w) / (R * J)
 
-    k1 = f(omega)
-    k2 = f(omega + 0.5 * T * k1)
-    k3 = f(omega + 0.5 * T * k2)
-    k4 = f(omega + T * k3)
-    return omega + T / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    for _ in range(n):
+        k1 = f(omega)
+        k2 = f(omega + 0.5 * h * k1)
+        k3 = f(omega + 0.5 * h * k2)
+        k4 = f(omega + h * k3)
+        omega = omega + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return omega
 
 
-def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J: float, u: float, T: float) -> tuple[float, float]:
-    """RK4 on eqs. (9)-(10) with L > 0, sub-stepped inside RK4's stability limit."""
+def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J: float, u: float,
+                         T: float) -> tuple[float, float]:
+    """RK4 on eqs. (9)-(10) with L > 0, in rk4_substeps sub-steps (inside RK4's stability limit)."""
     motor = model.motor
     cm, current_rate = motor.c_m, motor.current_rate
-    rate = motor.electrical_rate(J)
-    n = max(1, math.ceil(T * rate / 2.0))
+    n = rk4_substeps(model, J, T)
     h = T / n
 
     def f(w: float, c: float) -> tuple[float, float]:
@@ -158,6 +186,7 @@ class PaperVoltage(Formulation):
         p = model.params
         self.scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
         self.h_max = p["h_max"]
+        self.max_steps = int(p["max_steps"])
         self.u = u
 
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
@@ -165,9 +194,16 @@ class PaperVoltage(Formulation):
 
     def advance(self, h: float, integrator: Any, time: float) -> int:
         n = max(1, math.ceil(h / self.h_max - 1e-9))
+        budget = self.max_steps
+        if n > budget:
+            raise StepRejected(
+                f"the paper formulation needs {n} calculation steps of h_max = {self.h_max:g} s in one "
+                f"communication step of {h:g} s at t = {time:g} s, more than max_steps = {budget}: "
+                "raise h_max or max_steps, or shorten the communication step")
+        used = 0
         for _ in range(n):
-            self.scheme.step(h / n, self.u)
-        return n
+            used += self.scheme.step(h / n, self.u, budget - used)
+        return used
 
     def outputs(self, integrator: Any) -> dict[str, float]:
         return self.scheme.outputs()
