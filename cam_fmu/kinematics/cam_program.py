@@ -24,7 +24,7 @@ from typing import Sequence, Union
 
 import numpy as np
 
-from .motion_law import MotionLaw, golden_max
+from .motion_law import SHAPE_CONST, MotionLaw, golden_max
 from .presets import law
 
 __all__ = ["CamProgram", "ProgramBase", "paper_program"]
@@ -180,6 +180,15 @@ class CamProgram(ProgramBase):
         if nan.any():
             s, ds, d2s, d3s = (np.where(nan, np.nan, q) for q in (s, ds, d2s, d3s))
         return s, ds, d2s, d3s
+
+    def feature_angle(self) -> float:
+        """The profile's finest angular detail [rad]: over both strokes, the angle over which
+        a sine or cosine segment's phase advances by one radian, or a constant segment's length."""
+        scales = []
+        for beta, stroke_law in ((self.rise_angle, self.rise_law), (self.return_angle, self.return_law)):
+            for seg in stroke_law.segments():
+                scales.append(beta * (seg.F if seg.kind != SHAPE_CONST else seg.end - seg.start))
+        return min(scales)
 
     def breakpoints(self) -> tuple[float, ...]:
         """Sorted angles in [0, 2 pi) where s'' or s''' may jump: every split

@@ -164,6 +164,10 @@ class TableProgram(ProgramBase):
             s, ds, d2s, d3s = (np.where(nan, np.nan, q) for q in (s, ds, d2s, d3s))
         return s, ds, d2s, d3s
 
+    def feature_angle(self) -> float:
+        """The shortest knot spacing [rad]: the profile's finest angular detail."""
+        return min(self.widths)
+
     def breakpoints(self) -> tuple[float, ...]:
         """The knots reduced to [0, 2 pi), sorted: s''' jumps there."""
         return tuple(sorted(math.fmod(t, TWO_PI) for t in self.angles))

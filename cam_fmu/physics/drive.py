@@ -124,12 +124,15 @@ class DriveModel:
             check_self_locking(self.program, self.mu, self.r_b)
 
     # ----------------------------------------------------------- mechanics
-    def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True) -> float:
+    def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
+                  side: float = 0.0) -> float:
         """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5).
 
         ``torque`` is the motor torque c_m i [N m]; ``direction`` is sgn(omega),
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
         False means the follower is free in the backlash gap (J = J_m, no load).
+        ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
+        branch, held between events so the right-hand side is smooth); 0 chooses it.
         """
         drive = torque - self.M_f * direction
         if not (engaged and self.follower):
@@ -146,8 +149,35 @@ class DriveModel:
         sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
         tan_a = s1 / (self.r_b + s)
         n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
-        f = solve_guide_friction(n0, self.J_m / J * tan_a, sigma, mu, self.N_g)
+        kappa = self.J_m / J * tan_a
+        if side == 0.0:
+            f = solve_guide_friction(n0, kappa, sigma, mu, self.N_g)
+        else:
+            f = mu * (side * n0 + self.N_g) / (1.0 - side * mu * sigma * kappa)
         return x0 - sigma * f * s1 / J
+
+    def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
+        """The guide's side force N_r [N] while the follower is engaged and moving (0 without guide friction).
+
+        |N_r| has a kink where N_r changes sign (the friction mu |N_r| does): the
+        integrators locate that zero as an event instead of stepping over it.
+        """
+        if self.mu == 0.0 or not self.follower:
+            return 0.0
+        s, s1, _, _ = self._profile(theta)
+        J = self.J_m + self.m * s1 * s1
+        tan_a = s1 / (self.r_b + s)
+        inertial = self.m * self._profile(theta)[2] * omega * omega - self.F_gx
+        x0 = (torque - self.M_f * direction - inertial * s1) / J
+        v_sign = s1 * direction
+        sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
+        n0 = (inertial + self.m * s1 * x0) * tan_a + self.G_y
+        kappa = self.J_m / J * tan_a
+        if side == 0.0:
+            f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g)
+        else:
+            f = self.mu * (side * n0 + self.N_g) / (1.0 - side * self.mu * sigma * kappa)
+        return n0 + sigma * kappa * f
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
         """Load torque, inertia and follower motion for a known omega_dot."""

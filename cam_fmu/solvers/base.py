@@ -32,6 +32,7 @@ class HybridSystem(Protocol):
     def settle(self, y: list, u: float, mode: Any) -> None: ...
     def stuck_state(self, y: Vector, u: float, dt: float) -> list[float]: ...
     def stiffness_rate(self, y: Vector, mode: Any, electrical: bool) -> float: ...
+    def profile_rate(self, y: Vector) -> float: ...
     def first_breakpoint_passed(self, start: float, end: float) -> float | None: ...
 
 
@@ -42,6 +43,9 @@ class Stepper:
     stability: ClassVar[float] = math.inf  # h |lambda| allowed on the negative real axis
     adaptive: ClassVar[bool] = False
     exact_electrical_pole: ClassVar[bool] = False  # the pole -R/L needs no stability cut
+    # Fixed-step methods: the cam turns at most this fraction of the profile's finest angular
+    # detail per internal step (an accuracy limit: a step cannot resolve a shorter feature).
+    resolution: ClassVar[float] = math.inf
 
     def __init__(self, settings: Mapping[str, Any]) -> None:
         self.h_max = settings["h_max"]  # s, largest internal step

@@ -28,6 +28,7 @@ class Euler(Stepper):
 
     name = "euler"
     stability = 1.0
+    resolution = 0.01  # first order: 40 % off at 100 V with 0.1 (measured), 2e-4 rad at 3.5 V with 0.01
 
     def step(self, f, y, dt, system, u, mode):
         return euler_step(f, y, dt)
@@ -38,6 +39,7 @@ class RK4(Stepper):
 
     name = "rk4"
     stability = 2.5
+    resolution = 0.1  # 100 V: 4e-3 rad of 68 (was 29 rad off with the stability limit alone)
 
     def step(self, f, y, dt, system, u, mode):
         return rk4_step(f, y, dt)

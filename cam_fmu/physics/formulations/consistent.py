@@ -25,6 +25,11 @@ from .base import Formulation
 
 THETA, OMEGA, CURRENT = 0, 1, 2  # slots of the continuous state y
 STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY = "stop", "contact", "engage_up", "engage_down", "break_away"
+SIDE = "side_force"  # the guide's side force N_r changes sign: the friction branch switches
+# N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
+# exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch
+# back and forth at one instant (it did: the reference looped at a break-away from theta = 0).
+SIDE_HYSTERESIS = 1e-9
 
 
 @dataclass
@@ -35,9 +40,10 @@ class Mode:
     direction: float = 1.0  # sgn(omega) while moving
     contact: int = 1
     s_free: float = 0.0  # m, follower position while contact == 0
+    side: float = 1.0  # sign of the guide's side force N_r (the friction branch) while engaged and moving
 
     def copy(self) -> "Mode":
-        return Mode(self.stuck, self.direction, self.contact, self.s_free)
+        return Mode(self.stuck, self.direction, self.contact, self.s_free, self.side)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -52,8 +58,10 @@ class HybridDrive:
         self.has_current = model.L > 0.0
         self.backlash = model.c > 0.0
         self.size = 3 if self.has_current else 2
+        self.guide_side = model.mu > 0.0 and model.follower  # the side force's sign is an event
         # theta enters the physics mod 2 pi: its error is scaled by at most 2 pi
         self.error_caps = (2.0 * math.pi, math.inf, math.inf)[: self.size]
+        self.feature_angle = model.program.feature_angle()  # rad
 
     # ------------------------------------------------------------ set-up
     def initial(self, theta0: float, omega0: float, i0: float) -> tuple[list[float], Mode]:
@@ -93,20 +101,22 @@ class HybridDrive:
         current_rate, quasi_static_torque = motor.current_rate, motor.quasi_static_torque
         omega_dot = model.omega_dot
         direction, engaged = mode.direction, mode.contact != 0
+        side = mode.side if self.guide_side else 0.0
         if self.has_current:
             if mode.stuck:
                 return lambda y: (0.0, 0.0, current_rate(u, y[CURRENT], y[OMEGA]))
 
             def with_current(y):
                 omega, i = y[OMEGA], y[CURRENT]
-                return (omega, omega_dot(y[THETA], omega, c_m * i, direction, engaged), current_rate(u, i, omega))
+                return (omega, omega_dot(y[THETA], omega, c_m * i, direction, engaged, side),
+                        current_rate(u, i, omega))
             return with_current
         if mode.stuck:
             return lambda y: (0.0, 0.0)
 
         def quasi_static_current(y):
             omega = y[OMEGA]
-            return (omega, omega_dot(y[THETA], omega, quasi_static_torque(u, omega), direction, engaged))
+            return (omega, omega_dot(y[THETA], omega, quasi_static_torque(u, omega), direction, engaged, side))
         return quasi_static_current
 
     def stuck_state(self, y, u: float, dt: float) -> list[float]:
@@ -137,6 +147,10 @@ class HybridDrive:
             rate += self.motor.electrical_rate(J)
         return rate
 
+    def profile_rate(self, y) -> float:
+        """|omega| / the profile's finest angular detail [1/s]: how fast the cam sweeps its features."""
+        return abs(y[OMEGA]) / self.feature_angle
+
     def torque_gain(self, y, mode: Mode) -> float:
         """d(omega_dot)/d(i) = c_m / J [1/(A s2)] at y."""
         model = self.model
@@ -151,11 +165,12 @@ class HybridDrive:
     def event_names(self, mode: Mode) -> tuple[str, ...]:
         if mode.stuck:
             return (BREAK_AWAY,) if self.has_current else ()
+        side = (SIDE,) if self.guide_side and mode.contact != 0 else ()
         if not self.backlash:
-            return (STOP,)
+            return (STOP,) + side
         if mode.contact == 0:
             return (STOP, ENGAGE_UP, ENGAGE_DOWN)
-        return (STOP, CONTACT)
+        return (STOP, CONTACT) + side
 
     def event_values(self, y, u: float, mode: Mode) -> tuple[float, ...]:
         """Values of the active event functions (> 0: nothing happens)."""
@@ -164,13 +179,27 @@ class HybridDrive:
                 return ()
             return (-self._breakaway_margin(y, u, mode),)
         stop = y[OMEGA] * mode.direction
+        side = (self._side_value(y, u, mode),) if self.guide_side and mode.contact != 0 else ()
         if not self.backlash:
-            return (stop,)
+            return (stop,) + side
         s, s1, _, _ = self.model.program.derivatives(y[THETA])
         c = self.model.c
         if mode.contact == 0:
             return (stop, mode.s_free - (s - c), (s + c) - mode.s_free)
-        return (stop, mode.contact * s1 * y[OMEGA])
+        return (stop, mode.contact * s1 * y[OMEGA]) + side
+
+    def _side_value(self, y, u: float, mode: Mode, side: float | None = None) -> float:
+        """mode.side times the side force N_r [N] on that branch: > 0 while the branch holds."""
+        side = mode.side if side is None else side
+        return side * self.model.side_force(y[THETA], y[OMEGA], self.torque(y, u), mode.direction, side) \
+            + SIDE_HYSTERESIS
+
+    def _choose_side(self, y, u: float, mode: Mode) -> None:
+        """The friction branch of the current state (where N_r = 0, the one it moves into)."""
+        if self.guide_side and mode.contact != 0 and not mode.stuck:
+            n_r = self.model.side_force(y[THETA], y[OMEGA], self.torque(y, u), mode.direction)
+            if abs(n_r) > SIDE_HYSTERESIS:
+                mode.side = -1.0 if n_r < 0.0 else 1.0
 
     def _breakaway_margin(self, y, u: float, mode: Mode) -> float:
         """> 0 when the shaft would start moving from rest [rad/s2]."""
@@ -190,6 +219,8 @@ class HybridDrive:
             # The located zero of the margin: the torque is at the threshold
             # (margin >= 0, often exactly 0 there), so the shaft starts now.
             self.settle(y, u, mode, at_threshold=True)
+        elif name == SIDE:
+            mode.side = -mode.side  # N_r passed through zero: the other friction branch
         elif name == CONTACT:
             s = model.program.derivatives(y[THETA])[0]
             mode.s_free = s - model.c * mode.contact
@@ -199,8 +230,14 @@ class HybridDrive:
             s1 = model.program.derivatives(y[THETA])[1]
             # Plastic impact: generalised momentum J_m omega (+ m s' v = 0 before) is kept.
             y[OMEGA] = model.J_m * y[OMEGA] / (model.J_m + model.m * s1 * s1)
+            self._choose_side(y, u, mode)
 
     def settle(self, y, u: float, mode: Mode, at_threshold: bool = False) -> None:
+        """At rest: stay stuck or start in the direction the torques allow; then the friction branch."""
+        self._settle_motion(y, u, mode, at_threshold)
+        self._choose_side(y, u, mode)
+
+    def _settle_motion(self, y, u: float, mode: Mode, at_threshold: bool = False) -> None:
         """At rest: stay stuck or start in the direction the torques allow.
 
         ``at_threshold``: called at a located break-away, where the margin is
