@@ -23,6 +23,7 @@ from scipy.integrate import solve_ivp
 from ..experiments.signals import Signal, constant
 from ..physics.contact import follower_along, speed_engaged
 from ..physics.drive import DriveModel
+from ..physics.formulations import formulation_name
 from ..physics.formulations.consistent import HybridDrive
 from ..physics.formulations.paper import PaperScheme
 from ..physics.formulations.speed import speed_drive_outputs
@@ -47,11 +48,8 @@ def simulate_reference(
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
     grid = _grid(stop_time, output_interval)
-    if model.drive == "speed":
-        return _speed(model, grid, omega_ref)
-    if model.formulation == "paper":
-        return _paper(model, grid, u)
-    return _Consistent(model, u, rtol, atol, energy, method).run(grid)
+    options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
+    return REFERENCES[formulation_name(model)](model, grid, u, omega_ref, options)
 
 
 def _grid(stop_time: float, output_interval: float) -> np.ndarray:
@@ -204,7 +202,12 @@ class _Consistent:
         return dict(zip(ENERGY, y[-len(ENERGY):]))
 
 
-def _paper(model: DriveModel, grid: np.ndarray, u: Signal) -> dict[str, np.ndarray]:
+def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
+    """The consistent formulation: scipy at tight tolerances, stopping at every event and breakpoint."""
+    return _Consistent(model, u, options["rtol"], options["atol"], options["energy"], options["method"]).run(grid)
+
+
+def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """The paper's algorithm with its calculation step T = h_max (it is its own reference)."""
     p = model.params
     scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
@@ -219,7 +222,7 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal) -> dict[str, np.ndarr
     return _collect(rows, grid)
 
 
-def _speed(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> dict[str, np.ndarray]:
+def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """Imposed speed: theta = theta0 + int omega_ref dt (exact for piecewise-linear signals)."""
     p = model.params
     theta = p["theta0"]
@@ -244,5 +247,8 @@ def _speed(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> dict[str, 
         rows.append(speed_drive_outputs(model, theta, omega, omega_ref.slope(t_left), s, engaged))
     return _collect(rows, grid)
 
+
+# The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/test_layout.py).
+REFERENCES = {"consistent": _consistent, "paper": _paper, "speed": _speed}
 
 __all__ = ["simulate_reference", "ENERGY", "OUTPUTS"]

@@ -21,11 +21,15 @@ FORMULATIONS: dict[str, type[Formulation]] = {
 }
 
 
+def formulation_name(model: DriveModel) -> str:
+    """The key in FORMULATIONS that the parameters ``drive`` and ``formulation`` select."""
+    return "speed" if model.drive == "speed" else model.formulation
+
+
 def formulation_for(model: DriveModel, u: float, omega_ref: float) -> Formulation:
     """The formulation the model's parameters ask for, built at the given start inputs."""
-    if model.drive == "speed":
-        return SpeedDrive(model, omega_ref)
-    return FORMULATIONS[model.formulation](model, u)
+    cls = FORMULATIONS[formulation_name(model)]
+    return cls(model, omega_ref) if cls is SpeedDrive else cls(model, u)
 
 
-__all__ = ["FORMULATIONS", "Formulation", "formulation_for"]
+__all__ = ["FORMULATIONS", "Formulation", "formulation_for", "formulation_name"]
