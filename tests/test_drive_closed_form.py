@@ -64,7 +64,7 @@ def friction_fixed_point(n0: float, tan_a: float, sigma: float, mu: float, n_g: 
     docs/model.md section 4: N cos(alpha) = m a + sigma f - F_gx, N_r = N sin(alpha) + G_y,
     so N_r = (m a - F_gx) tan(alpha) + G_y + sigma f tan(alpha) = n0 + sigma f tan(alpha).
     A contraction (factor mu |tan alpha| < 1): iterate to a fixed point, a method
-    independent of the two-branch solve in drive_model.
+    independent of the two-branch solve in physics/drive.py.
     """
     f = 0.0
     for _ in range(200):

@@ -151,10 +151,10 @@ def test_build_refuses_scipy_in_the_bundle(tmp_path):
     assert not (tmp_path / "out" / "cam.fmu").exists()
 
 
-def test_readme_variable_table_is_the_generated_one():
-    """The README's FMU variable table is `python -m cam_fmu.fmu.model_description`'s output: it cannot drift from the code."""
+def test_docs_variable_table_is_the_generated_one():
+    """docs/fmu.md's FMU variable table is `python -m cam_fmu.fmu.model_description`'s output: it cannot drift from the code."""
     from pathlib import Path
 
     from cam_fmu.fmu.model_description import markdown_table
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
-    assert markdown_table().strip() in readme
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "fmu.md").read_text(encoding="utf-8")
+    assert markdown_table().strip() in doc

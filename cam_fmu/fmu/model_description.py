@@ -12,7 +12,7 @@ only 16 significant digits. ``postprocess`` adds what the Reference FMUs have:
 - ``min``/``max`` on parameters with finite bounds, exact (repr) start values;
 - complete ``<Outputs>`` and ``<InitialUnknowns>`` (every output is 'calculated').
 
-The same table (``variable_rows``) generates the README's variable table
+The same table (``variable_rows``) generates the variable table of docs/fmu.md
 (``markdown_table``), so the documentation cannot drift from the FMU.
 """
 from __future__ import annotations
@@ -183,7 +183,7 @@ def rewrite_fmu(fmu_path: Path, **kwargs: Any) -> None:
 
 
 def markdown_table() -> str:
-    """The README's table of every FMU variable: name, causality, type, unit, default, allowed range."""
+    """The table of every FMU variable in docs/fmu.md: name, causality, type, unit, default, allowed range."""
     lines = ["| name | causality | type | unit | default | allowed | description |",
              "|---|---|---|---|---|---|---|"]
     for row in variable_rows():

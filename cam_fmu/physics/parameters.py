@@ -1,7 +1,7 @@
 """Every parameter of the cam drive: name, SI unit, default, allowed range, meaning.
 
 This table is the single source of truth: the scene files, the reference
-integration, the FMU variables and the README all use these names and units.
+integration, the FMU variables and the docs (docs/scenes.md, docs/fmu.md) all use these names and units.
 Only ``math`` is imported here: the module is bundled into the FMU.
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The drive's inputs and outputs: one table each (name, SI unit, [start,] meaning).
 
-The FMU's variables, its model description, the README/docs tables, the CSV
+The FMU's variables, its model description, the docs tables, the CSV
 headers and every formulation's output record derive from these tuples.
 ``math``-free and import-free: the FMU bundles it.
 """

@@ -4,7 +4,7 @@ The ``ecospy`` wheel ships the ``ecos`` command-line program in
 ``ecospy/binaries/ecos`` (not executable as installed: it is chmod-ed here, or
 copied to a cache directory when site-packages is read-only). It needs Debian's
 ``libtbb12``. ecos loads the FMU's binary directly, so the embedded Python needs
-the environment of :mod:`cam_fmu.host_env` (libpython preloaded).
+the environment of :mod:`cam_fmu.tools.host_env` (libpython preloaded).
 
 ``ecos simulate --path FMU --stopTime T --stepSize H`` writes ``<name>.csv`` in
 its working directory (columns ``iterations, time, instance::omega[REAL], ...``,
