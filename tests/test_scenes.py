@@ -264,3 +264,9 @@ def test_docs_document_every_parameter_and_scene():
     scenes = text.split("\n## The shipped scenes", 1)[1].split("\n## ", 1)[0]
     for name in SCENES:
         assert f"| `{name}` |" in scenes, f"docs/scenes.md scene table lacks {name}"
+
+
+def test_docs_parameter_table_is_the_generated_one():
+    """docs/scenes.md's parameter table is physics.parameters.markdown_table(): it cannot drift from the table."""
+    from cam_fmu.physics.parameters import markdown_table
+    assert markdown_table() in (ROOT / "docs" / "scenes.md").read_text(encoding="utf-8")

@@ -165,3 +165,18 @@ def law_spec(values: Mapping[str, Any], stroke: str) -> str | tuple[float, ...]:
     if name == "custom":
         return tuple(float(values[f"{stroke}_T{k}"]) for k in range(1, 7))
     return name
+
+
+def markdown_table() -> str:
+    """The docs' parameter table (name, unit, default, allowed, meaning), generated from PARAMETERS."""
+    lines = ["| name | unit | default | allowed | description |", "|---|---|---|---|---|"]
+    for p in PARAMETERS:
+        if p.kind == "real":
+            default = f"{p.default:.6g}"
+        elif p.kind == "boolean":
+            default = "true" if p.default else "false"
+        else:
+            default = f"`{p.default}`" if p.default else '`""`'
+        lines.append(f"| `{p.name}` | {p.unit or '-'} | {default} | {p.allowed().replace('|', '/')} | "
+                     f"{p.description.replace('|', '/')} |")
+    return "\n".join(lines)
