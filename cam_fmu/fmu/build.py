@@ -155,9 +155,25 @@ def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
     return sorted(f for f in files if f != script), needs_init
 
 
+def companion_scripts(package_dir: Path, script: Path) -> List[Path]:
+    """The other slave scripts of MODELS: their closures are bundled too (see ``stage``)."""
+    return [package_dir / rel for rel, _cls in MODELS.values() if (package_dir / rel) != script]
+
+
 def stage(package_dir: Path, script: Path, staging: Path) -> List[str]:
-    """Copy the slave script and the needed part of the package into ``staging``; return the bundled names."""
+    """Copy the slave script and the needed part of the package into ``staging``; return the bundled names.
+
+    Every FMU of the project bundles the union of the closures of all slave
+    scripts in MODELS: the bundled package is the top-level module ``cam_fmu``,
+    and module names are process-global, so when cam.fmu and pi_speed.fmu load
+    into one host process the first one's ``cam_fmu`` serves both (ecos and
+    libcosim crashed with a partial bundle: the second slave's class was not found).
+    """
     modules, needs_init = bundle_modules(package_dir, script)
+    for other in companion_scripts(package_dir, script):
+        more, init = bundle_modules(package_dir, other)
+        modules = sorted(set(modules) | set(more))
+        needs_init |= init
     target_pkg = staging / PACKAGE
     target_pkg.mkdir(parents=True)
     for path in modules:
@@ -208,7 +224,8 @@ def _model(model: str) -> Tuple[Path, str]:
 def sources(package_dir: Path = PACKAGE_DIR, model: str = "cam") -> list[Path]:
     """Every file whose content ends up in (or shapes) the FMU of ``model``."""
     script = package_dir / _model(model)[0]
-    return [script, *bundle_modules(package_dir, script)[0], *(package_dir / p for p in BUILD_SOURCES)]
+    bundled = [m for s in (script, *companion_scripts(package_dir, script)) for m in bundle_modules(package_dir, s)[0]]
+    return [script, *bundled, *(package_dir / p for p in BUILD_SOURCES)]
 
 
 def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> bool:
