@@ -89,6 +89,9 @@ def run(args) -> int:
         for name, T in PRESETS.items():
             print(f"{name:<{width}}  " + " ".join(f"{t:<8.6g}" for t in T))
         return 0
+    for option, value in (("--base-radius-mm", args.base_radius_mm), ("--lift-mm", args.lift_mm)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{option} {value:g}: allowed a number > 0 [mm]")
     try:
         if args.T is not None:
             name, m = "T = " + " ".join(f"{t:g}" for t in args.T), law(args.T)

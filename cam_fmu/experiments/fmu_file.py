@@ -44,6 +44,18 @@ def default_fmu_path() -> Path:
     return default_model_path("cam")
 
 
+def check_fmu_file(path: Path) -> None:
+    """FmuFileError unless ``path`` is a zip archive with a modelDescription.xml (an FMU)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            if "modelDescription.xml" not in z.namelist():
+                raise FmuFileError(f"{str(path)!r} is not an FMU: no modelDescription.xml inside")
+    except zipfile.BadZipFile:
+        raise FmuFileError(f"{str(path)!r} is not an FMU (not a zip archive)") from None
+
+
 def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None = None,
                model: str = "cam") -> Path:
     """The FMU to run: ``path`` as given (it must exist), or the default one, built when stale.
@@ -55,6 +67,7 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
         path = Path(path)
         if not path.is_file():
             raise FmuFileError(f"FMU {str(path)!r} does not exist")
+        check_fmu_file(path)
         return path
     from ..fmu.build import is_stale
 

@@ -6,6 +6,10 @@ required; but the process then holds pythonfmu FMUs (see cli.exit_after_fmu):
 call this in a subprocess (``python -m cam_fmu.tools.libcosim_host SSP STOP``
 prints the result as JSON) or leave the process with os._exit.
 
+This module imports nothing from cam_fmu (standard library, numpy and
+libcosimpy only), so that ``python -I .../libcosim_host.py`` runs the FMUs on
+their bundled code, not on a checkout's.
+
 Notes: libcosimpy's step size is an integer number of nanoseconds (a float
 1e-3 is truncated to 0); without one, libcosim takes the SSP's
 ``osp:FixedStepAlgorithm baseStepSize``. Values are read with a last-value
@@ -35,9 +39,7 @@ def simulate_ssp(ssp: str | Path, stop_time: float, variables: Sequence[str]) ->
         from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     except ImportError as exc:
         raise LibcosimError(f"libcosimpy is not installed (pip install libcosimpy): {exc}") from None
-    from ..experiments.ssp import read_ssp
-
-    system = read_ssp(ssp)
+    start_time, step_size = _experiment(ssp)
     log_output_level(CosimLogLevel.ERROR)  # its default writes debug lines to stdout
     try:
         execution = CosimExecution.from_ssp_file(str(Path(ssp).resolve()))
@@ -55,8 +57,8 @@ def simulate_ssp(ssp: str | Path, stop_time: float, variables: Sequence[str]) ->
         if var not in by_name:
             raise LibcosimError(f"{column!r}: {comp} has no variable {var!r}")
         refs[column] = (index[comp], by_name[var])
-    h = system.step_size
-    n = round((stop_time - system.start_time) / h)
+    h = step_size
+    n = round((stop_time - start_time) / h)
     rows: List[List[float]] = []
 
     def read() -> List[float]:
@@ -71,9 +73,27 @@ def simulate_ssp(ssp: str | Path, stop_time: float, variables: Sequence[str]) ->
             raise LibcosimError(f"libcosim step failed: {get_last_error_message()}")
         rows.append(read())
     data = np.array(rows)
-    result = {"time": system.start_time + h * np.arange(1, n + 1)}
+    result = {"time": start_time + h * np.arange(1, n + 1)}
     result.update({c: data[:, j] for j, c in enumerate(refs)})
     return result
+
+
+def _experiment(ssp: str | Path) -> tuple[float, float]:
+    """(startTime, baseStepSize) of the SSP's DefaultExperiment (OSP annotation)."""
+    import zipfile
+    from xml.etree import ElementTree as ET
+
+    with zipfile.ZipFile(ssp) as z:
+        root = ET.fromstring(z.read("SystemStructure.ssd"))
+    start, step = 0.0, None
+    for el in root.iter():
+        if el.tag.endswith("}DefaultExperiment"):
+            start = float(el.get("startTime", 0.0))
+        if el.tag.endswith("}FixedStepAlgorithm"):
+            step = float(el.get("baseStepSize"))
+    if step is None:
+        raise LibcosimError(f"{ssp}: no osp:FixedStepAlgorithm baseStepSize in its DefaultExperiment")
+    return start, step
 
 
 def _text(value) -> str:
