@@ -102,7 +102,7 @@ def run(args) -> int:
                 label = (label or "base") + ("+ff" if ff else "")
                 over = {} if kp is None else {"kp": kp, "ki": ki}
                 if ff is not None:
-                    over["feedforward"] = ff
+                    over["feedforward"] = 1.0 if ff else 0.0
                 variants[label] = over
     resolve(system.components.get("cam").parameters if "cam" in system.components else {})
     out = Path(args.out)

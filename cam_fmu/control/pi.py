@@ -4,7 +4,7 @@ One sample per communication step h (the sample period is the step size)::
 
     w      = omega_set (parameter) or the input omega_setpoint (external_setpoint = true)
     e      = w - omega_meas                                  speed error [rad/s]
-    u_ff   = (R / c_m) (M_load + J_load (w - w_prev) / h) + c_e w    (feedforward = true, else 0)
+    u_ff   = k_ff ((R / c_m) (M_load + J_load (w - w_prev) / h) + c_e w)   (k_ff = parameter feedforward, 0..1)
     v      = u_ff + kp e + I                                  unclamped command [V]
     u      = min(max(v, u_min), u_max)                        output clamp [V]
     I     += ki h e   unless v > u_max and e > 0, or v < u_min and e < 0   (anti-windup:
@@ -37,7 +37,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("ki", "V/rad", 20.0, "integral gain", low=0.0, high=1e6),
     _P("u_min", "V", -24.0, "lower clamp of the armature voltage", low=-1e4, high=1e4),
     _P("u_max", "V", 24.0, "upper clamp of the armature voltage", low=-1e4, high=1e4),
-    _P("feedforward", "", False, "add the load-torque feedforward (R/c_m)(M + J dw/dt) + c_e w from the inputs M_load, J_load", kind="boolean"),
+    _P("feedforward", "1", 0.0, "weight of the load-torque feedforward (R/c_m)(M + J dw/dt) + c_e w from the inputs M_load, J_load: 0 off, 1 full (a Real: ecos 0.7.2 ignores Boolean SSP parameter values)", low=0.0, high=1.0),
     _P("external_setpoint", "", False, "take the setpoint from the input omega_setpoint instead of the parameter omega_set", kind="boolean"),
     _P("R", "Ohm", 19.0, "armature resistance assumed by the feedforward", low=0.0, high=1e4, low_open=True),
     _P("c_e", "V/(rad/s)", 0.146, "back-EMF constant assumed by the feedforward", low=0.0, high=100.0, low_open=True),
@@ -100,9 +100,9 @@ class PiSpeedController:
         w = self.setpoint(omega_setpoint)
         e = w - float(omega_meas)
         u_ff = 0.0
-        if p["feedforward"]:
+        if p["feedforward"] > 0.0:
             w_dot = 0.0 if (h is None or self.w_prev is None) else (w - self.w_prev) / h
-            u_ff = p["R"] / p["c_m"] * (float(M_load) + float(J_load) * w_dot) + p["c_e"] * w
+            u_ff = p["feedforward"] * (p["R"] / p["c_m"] * (float(M_load) + float(J_load) * w_dot) + p["c_e"] * w)
         v = u_ff + p["kp"] * e + self.integral
         u = min(max(v, p["u_min"]), p["u_max"])
         return w, e, u_ff, v, u

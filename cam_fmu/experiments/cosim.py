@@ -4,8 +4,13 @@
 one communication grid (Jacobi: every FMU steps from the same connector values):
 
 1. instantiate each FMU, setupExperiment, apply the SSP's parameter values
-   (ParameterBindings), enter and exit initialisation mode;
-2. read every output: the connector values at the start time (the first step
+   (ParameterBindings), enter initialisation mode;
+2. in initialisation mode, pass every connection (output -> input) as many
+   times as there are components, so that initial outputs that depend on
+   inputs (the controller's initial output on cam's initial M and J) settle on
+   the consistent initial values (as libcosim and ecos do); exit
+   initialisation mode;
+3. read every output: the connector values at the start time (the first step
    therefore sees the controller's initial output, not 0);
 3. for each step from t to t + h: set each input from its connector, doStep
    every FMU, read the outputs: they are the values *at* t + h, and the row is
@@ -109,9 +114,6 @@ def simulate_system(ssp: str | Path | System, stop_time: float | None = None, st
         slaves[comp.name] = slave
     for slave in slaves.values():
         slave.fmu.enterInitializationMode()
-    for slave in slaves.values():
-        slave.fmu.exitInitializationMode()
-
     wires = [(slaves[c.end_element], slaves[c.end_element].var(c.end_connector, "input").valueReference,
               f"{c.start_element}.{c.start_connector}") for c in system.connections]
     names = [f"{c.start_element}.{c.start_connector}" for c in system.connections]
@@ -124,6 +126,14 @@ def simulate_system(ssp: str | Path | System, stop_time: float | None = None, st
         readers.setdefault(comp, []).append((column, slaves[comp].var(var).valueReference))
     columns = [c for pairs in readers.values() for c, _ in pairs]
     data = np.empty((n + 1, len(columns)))
+    sources = {f"{c.start_element}.{c.start_connector}": (slaves[c.start_element],
+               slaves[c.start_element].var(c.start_connector).valueReference) for c in system.connections}
+    for _ in range(len(slaves)):  # initial values through the connections (see step 2)
+        for slave, vr, src in wires:
+            src_slave, src_vr = sources[src]
+            slave.fmu.setReal([vr], src_slave.fmu.getReal([src_vr]))
+    for slave in slaves.values():
+        slave.fmu.exitInitializationMode()
 
     def read() -> dict[str, float]:
         values: dict[str, float] = {}
@@ -183,6 +193,16 @@ def reference_loop(system: System, stop_time: float | None = None, step_size: fl
         out = {f"cam.{k}": v for k, v in cam.outputs().items()}
         out.update({f"controller.{k}": v for k, v in ctrl.outputs().items()})
         return out
+
+    for _ in range(2):  # initialisation: connections passed once per component, as the master does
+        for c in system.connections:
+            src = read()[f"{c.start_element}.{c.start_connector}"]
+            if c.end_element == "cam":
+                cam_inputs[c.end_connector] = src
+                cam.set_inputs(**cam_inputs)
+            else:
+                ctrl_inputs[c.end_connector] = src
+                ctrl.initialize(**ctrl_inputs)
 
     columns = list(dict.fromkeys(f"{c.start_element}.{c.start_connector}" for c in system.connections))
     values = read()
