@@ -45,13 +45,16 @@ def run(args) -> int:
     from ..experiments.fmu_file import ensure_fmu
     from ..experiments.progress import ProgressBar
     from ..experiments.scenes import find_scene
-    from ..experiments.sweep import SweepError, cases, parse_vary, plot_table, run_sweep, write_table
+    from ..experiments.sweep import METRICS, SweepError, cases, parse_vary, plot_table, run_sweep, write_table
 
     scene = find_scene(args.scene)  # checked here: a bad scene fails before any worker starts
     if args.stop_time is not None:
         scene = scene.with_stop_time(args.stop_time)
     varies = [parse_vary(text) for text in args.vary]
     metrics = [m.strip() for m in args.metric.split(",") if m.strip()]
+    bad = [m for m in metrics if m not in METRICS]
+    if bad or not metrics:
+        raise SweepError(f"--metric {','.join(bad) or args.metric!r}: allowed {', '.join(METRICS)}")
     n_cases = len(cases(varies))
     if args.workers is not None and args.workers < 1:
         raise SweepError(f"--workers {args.workers}: allowed >= 1")
