@@ -54,7 +54,7 @@ def run(args) -> int:
     metrics = [m.strip() for m in args.metric.split(",") if m.strip()]
     bad = [m for m in metrics if m not in METRICS]
     if bad or not metrics:
-        raise SweepError(f"--metric {','.join(bad) or args.metric!r}: allowed {', '.join(METRICS)}")
+        raise SweepError(f"--metric {','.join(bad) or repr(args.metric)}: allowed {', '.join(METRICS)}")
     n_cases = len(cases(varies))
     if args.workers is not None and args.workers < 1:
         raise SweepError(f"--workers {args.workers}: allowed >= 1")
