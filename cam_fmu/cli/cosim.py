@@ -5,7 +5,7 @@ project's fixed-step co-simulation master (experiments.cosim.simulate_system)
 and writes DIR/<system>.csv (every connector, unit headers) and
 DIR/<system>.png (speed error and armature voltage). With --gains and/or
 --feedforward it runs the speed loop once per combination (labels
-``kp=2,ki=20`` and ``kp=2,ki=20+ff``), writes one CSV per run, one figure and
+``kp=2 ki=20`` and ``kp=2 ki=20+ff``), writes one CSV per run, one figure and
 DIR/<system>_ripple.csv: the peak-to-peak speed ripple of each run over the
 second half of the run.
 """
@@ -98,7 +98,7 @@ def run(args) -> int:
         variants = {}
         for ff in ffs:
             for kp, ki in gains:
-                label = "" if kp is None else f"kp={kp:g},ki={ki:g}"
+                label = "" if kp is None else f"kp={kp:g} ki={ki:g}"
                 label = (label or "base") + ("+ff" if ff else "")
                 over = {} if kp is None else {"kp": kp, "ki": ki}
                 if ff is not None:
@@ -116,7 +116,8 @@ def run(args) -> int:
         stop = args.stop_time if args.stop_time is not None else sysk.stop_time
         bar = _progress(f"{label or system.name}")
         result = simulate_system(sysk, stop, args.step_size, progress=bar)
-        name = system.name if not label else f"{system.name}__{label.replace('=', '').replace(',', '_').replace('+', '_')}"
+        stem = label.replace("=", "").replace(" ", "_").replace("+", "_")
+        name = system.name if not label else f"{system.name}__{stem}"
         path = write_csv(result, out / f"{name}.csv")
         key = label or system.name
         runs[key] = result
