@@ -77,7 +77,7 @@ def test_runs_inherit_the_scene_and_override_it():
 # ------------------------------------------------------------------- the CLI
 def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
     with path.open() as fh:
-        header = next(csv.reader(fh))
+        header = [name.split(" [", 1)[0] for name in next(csv.reader(fh))]  # 'omega [rad/s]' -> 'omega'
     return header, np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
 
 

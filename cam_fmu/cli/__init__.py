@@ -24,6 +24,8 @@ SUBCOMMANDS: tuple[str, ...] = (
     "simulate",   # run a scene: CSV + figure
     "bench",      # speed-accuracy benchmark of cam.fmu through fmpy
     "host_env",   # environment line for native FMU hosts (diagnostic)
+    "cosim",      # run an SSP (the speed loop) on the project's co-simulation master
+    "sweep",      # parameter sweeps of a scene on dask.distributed
 )
 
 
@@ -39,6 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 FMU_SLAVE_MODULE = "camdrive_fmu_slave"  # imported into this process when cam.fmu is loaded here
+FMU_SLAVE_MODULES = (FMU_SLAVE_MODULE, "pi_speed_fmu_slave")  # any of them loaded: leave with os._exit
 
 
 def exit_after_fmu(status: int) -> int:
@@ -49,16 +52,57 @@ def exit_after_fmu(status: int) -> int:
     double-linked list" after all the work is done (seen once in about 60 runs,
     under load). Output is flushed first; nothing is lost.
     """
-    if FMU_SLAVE_MODULE in sys.modules:
+    if any(name in sys.modules for name in FMU_SLAVE_MODULES):
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)
     return status
 
 
+class CliError(Exception):
+    """A user error any subcommand may raise: reported as one line, exit 2."""
+
+
+def _expected_errors() -> tuple[type[BaseException], ...]:
+    """Exceptions that mean bad input (files, values, scenes, FMUs), never a bug: one line, exit 2."""
+    errors: list[type[BaseException]] = [CliError, OSError, UnicodeDecodeError, ValueError]
+    for module, name in (("..experiments.fmu_file", "FmuFileError"), ("..experiments.runner", "EngineError"),
+                         ("..experiments.cosim", "CosimError"), ("..fmu.build", "BuildError")):
+        try:
+            errors.append(getattr(importlib.import_module(module, __name__), name))
+        except ImportError:  # pragma: no cover - a module missing is itself a bug, reported below
+            pass
+    return tuple(errors)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    return exit_after_fmu(args._run(args))
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        status = args._run(args)
+    except KeyboardInterrupt:
+        print(f"cam-fmu {args.command}: interrupted", file=sys.stderr)
+        status = 130
+    except _expected_errors() as exc:
+        status = report_error(args.command, exc)
+    except Exception as exc:  # noqa: BLE001 - FMU and engine failures (fmpy's FMICallException...)
+        if type(exc).__module__.split(".")[0] in ("fmpy", "cam_fmu", "zipfile", "xml", "tomllib"):
+            status = report_error(args.command, exc)
+        else:
+            raise
+    return exit_after_fmu(status)
+
+
+def report_error(command: str, exc: BaseException) -> int:
+    """``cam-fmu CMD: error: <one line>`` on stderr; exit status 2."""
+    text = str(exc).strip() or type(exc).__name__
+    if isinstance(exc, UnicodeDecodeError):
+        text = f"not a text file (cannot decode byte 0x{exc.object[exc.start]:02x} at position {exc.start})"
+    elif isinstance(exc, OSError) and exc.filename is not None:
+        text = f"{exc.strerror or exc}: {exc.filename}"
+    line = " ".join(text.split())
+    print(f"cam-fmu {command.replace('_', '-')}: error: {line}", file=sys.stderr)
+    return 2
 
 
 if __name__ == "__main__":

@@ -54,6 +54,9 @@ def run(args) -> int:
         for name, T in PRESETS.items():
             print(f"{name:<{width}}  " + " ".join(f"{t:<8.6g}" for t in T))
         return 0
+    for option, value in (("--base-radius-mm", args.base_radius_mm), ("--lift-mm", args.lift_mm)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{option} {value:g}: allowed a number > 0 [mm]")
     try:
         name, m = rise_law(args)
         program = build_program(args, m) if (args.plot or not args.json) else None

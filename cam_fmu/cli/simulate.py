@@ -3,7 +3,9 @@
 Writes DIR/<scene>.csv (the primary run), DIR/<scene>__<label>.csv (each
 further run) and DIR/<scene>.png (the scene's figure). CSV columns: time, then
 theta, omega, s, i, M, J, then the remaining outputs of physics.variables.OUTPUTS, all in
-SI units (s, rad, rad/s, m, A, N m, kg m^2, m/s, m/s^2, rad, m, V).
+SI units, named in the header: ``time [s],theta [rad],omega [rad/s],...``
+(experiments.columns; the units come from physics.variables.UNITS).
+``--set NAME=VALUE`` (repeatable) overrides a parameter in every run of the scene.
 """
 from __future__ import annotations
 
@@ -28,6 +30,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", default="out", help="output directory (default: out)")
     p.add_argument("--fmu", metavar="FILE.fmu", default=None, help="FMU to run with --engine fmu (default: models/cam.fmu in a checkout, else a user cache)")
     p.add_argument("--stop-time", type=float, default=None, metavar="T", help="override the scene's stop_time [s]")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="override a parameter in every run (repeatable), e.g. --set m=0.6 --set rise_law=cycloidal")
     p.add_argument("--no-plot", action="store_true", help="write the CSV files only")
     return p
 
@@ -42,12 +46,33 @@ def columns(result) -> list[str]:
 
 
 def write_csv(result, path: Path) -> Path:
-    import numpy as np
+    from ..experiments.columns import write_csv as write_with_units
 
-    names = columns(result)
-    data = np.column_stack([np.asarray(result[name], dtype=float) for name in names])
-    np.savetxt(path, data, delimiter=",", header=",".join(names), comments="", fmt="%.12g")
-    return path
+    return write_with_units(result, path, columns(result))
+
+
+def apply_sets(scene, sets: list[str]):
+    """The scene with ``NAME=VALUE`` overrides in [parameters] and in every run (checked as in a scene file)."""
+    import copy
+
+    from ..experiments.scenes import scene_from_dict
+    from ..physics.parameters import BY_NAME
+    from .cosim import parse_assignment
+
+    if not sets:
+        return scene
+    raw = copy.deepcopy(scene.raw)
+    params = dict(raw.get("parameters", {}))
+    for text in sets:
+        name, value = parse_assignment(text)
+        if name not in BY_NAME or name == "drive":
+            raise ValueError(f"--set {text!r}: unknown parameter {name!r} (the drive is the scene's key 'drive'); "
+                             f"known: {', '.join(n for n in BY_NAME if n != 'drive')}")
+        params[name] = BY_NAME[name].check(value)
+        for entry in raw.get("runs", []):
+            entry.pop(name, None)
+    raw["parameters"] = params
+    return scene_from_dict(raw, name=scene.name, path=scene.path)
 
 
 def csv_path(out: Path, scene_name: str, label: str | None) -> Path:
@@ -58,15 +83,17 @@ def run(args) -> int:
     from ..experiments.runner import EngineError, run_scene
     from ..experiments.scenes import SceneError, find_scene
 
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {args.out!r} exists and is not a directory")
     try:
-        scene = find_scene(args.scene)
+        scene = apply_sets(find_scene(args.scene), args.set)
         if args.stop_time is not None:
             scene = scene.with_stop_time(args.stop_time)
         results = run_scene(scene, args.engine, args.fmu)
     except (SceneError, EngineError, ValueError) as exc:
         print(f"cam-fmu simulate: error: {exc}", file=sys.stderr)
         return 2
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for k, (label, result) in enumerate(results.items()):
         path = write_csv(result, csv_path(out, scene.name, None if k == 0 else label))

@@ -28,18 +28,36 @@ def source_checkout() -> Path | None:
     return root if (root / "build_fmu.py").is_file() and (root / "pyproject.toml").is_file() else None
 
 
-def default_fmu_path() -> Path:
-    """models/cam.fmu in a checkout, else the user-cache copy for this package version."""
+def default_model_path(name: str = "cam", suffix: str = ".fmu") -> Path:
+    """models/<name><suffix> in a checkout, else the user-cache copy for this package version."""
     root = source_checkout()
     if root is not None:
-        return root / "models" / "cam.fmu"
+        return root / "models" / f"{name}{suffix}"
     from .. import __version__
 
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"
-    return cache / f"cam-{__version__}.fmu"
+    return cache / f"{name}-{__version__}{suffix}"
 
 
-def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
+def default_fmu_path() -> Path:
+    """models/cam.fmu in a checkout, else the user-cache copy for this package version."""
+    return default_model_path("cam")
+
+
+def check_fmu_file(path: Path) -> None:
+    """FmuFileError unless ``path`` is a zip archive with a modelDescription.xml (an FMU)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as z:
+            if "modelDescription.xml" not in z.namelist():
+                raise FmuFileError(f"{str(path)!r} is not an FMU: no modelDescription.xml inside")
+    except zipfile.BadZipFile:
+        raise FmuFileError(f"{str(path)!r} is not an FMU (not a zip archive)") from None
+
+
+def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None = None,
+               model: str = "cam") -> Path:
     """The FMU to run: ``path`` as given (it must exist), or the default one, built when stale.
 
     The build runs in a subprocess (it imports the slave as a top-level module
@@ -49,20 +67,40 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
         path = Path(path)
         if not path.is_file():
             raise FmuFileError(f"FMU {str(path)!r} does not exist")
+        check_fmu_file(path)
         return path
     from ..fmu.build import is_stale
 
-    path = default_fmu_path()
-    if not is_stale(path):
+    path = default_model_path(model)
+    if not is_stale(path, model=model):
         return path
     if log is not None:
         log(f"# building {path} (missing or older than its sources)")
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_", dir=path.parent) as tmp:
-        dest = Path(tmp) / "cam.fmu"
-        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--dest", str(dest)],
+        dest = Path(tmp) / f"{model}.fmu"
+        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--model", model, "--dest", str(dest)],
                               capture_output=True, text=True, cwd=str(PACKAGE_DIR.parent), timeout=600)
         if proc.returncode != 0 or not dest.is_file():
             raise FmuFileError(f"building {path} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
         os.replace(dest, path)  # atomic: a process reading the old file keeps it
     return path
+
+
+def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
+    """The speed-loop SSP: ``path`` as given (it must exist), or models/speed_loop.ssp, rebuilt when
+    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale)."""
+    if path is not None:
+        path = Path(path)
+        if not path.is_file():
+            raise FmuFileError(f"SSP file {str(path)!r} does not exist")
+        return path
+    from ..fmu.build import MODELS, SSP_NAME, build_ssp
+
+    fmus = {name: ensure_fmu(None, log, name) for name in MODELS}
+    path = default_model_path(SSP_NAME, ".ssp")
+    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in fmus.values()):
+        return path
+    if log is not None:
+        log(f"# writing {path}")
+    return build_ssp(path, fmus["cam"], fmus["pi_speed"])

@@ -103,6 +103,10 @@ def load_scene(path: str | Path) -> Scene:
         raise SceneError(f"scene file {str(path)!r} does not exist") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError:
+        raise SceneError(f"{path}: not a scene file (not UTF-8 text; a scene is a .toml file)") from None
+    except IsADirectoryError:
+        raise SceneError(f"{path}: is a directory, not a scene file (.toml)") from None
     return scene_from_dict(data, name=path.stem, path=path)
 
 

@@ -1,7 +1,10 @@
-"""Build cam.fmu (FMI 2.0 co-simulation) with pythonfmu 0.7.0.
+"""Build cam.fmu, pi_speed.fmu (FMI 2.0 co-simulation, pythonfmu 0.7.0) and speed_loop.ssp.
 
-    python build_fmu.py                          # -> models/cam.fmu (source checkout)
+    python build_fmu.py                          # -> models/cam.fmu, models/pi_speed.fmu, models/speed_loop.ssp
     python -m cam_fmu.fmu.build --dest /tmp/x/cam.fmu
+    python -m cam_fmu.fmu.build --model pi_speed --dest /tmp/x/pi_speed.fmu
+
+Every FMU in MODELS is built the same way (its own slave script and module name):
 
 What goes into the FMU (under resources/):
 - the slave script ``cam_fmu/fmu/camdrive_fmu_slave.py`` (imported by the FMU as
@@ -36,6 +39,12 @@ from typing import Dict, Iterable, List, Set, Tuple
 PACKAGE = "cam_fmu"
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 SLAVE_SCRIPT = Path("fmu") / "camdrive_fmu_slave.py"  # relative to the package
+# Every FMU the project builds: model name -> (slave script relative to the package, slave class).
+MODELS: Dict[str, Tuple[Path, str]] = {
+    "cam": (SLAVE_SCRIPT, "CamDriveSlave"),
+    "pi_speed": (Path("fmu") / "pi_speed_fmu_slave.py", "PiSpeedSlave"),
+}
+SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
 # Files that shape the FMU beside the bundled closure (their change makes a built FMU stale).
 BUILD_SOURCES = (Path("fmu") / "build.py", Path("fmu") / "model_description.py")
 ALLOWED_THIRD_PARTY = {"numpy", "pythonfmu"}
@@ -146,9 +155,25 @@ def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
     return sorted(f for f in files if f != script), needs_init
 
 
+def companion_scripts(package_dir: Path, script: Path) -> List[Path]:
+    """The other slave scripts of MODELS: their closures are bundled too (see ``stage``)."""
+    return [package_dir / rel for rel, _cls in MODELS.values() if (package_dir / rel) != script]
+
+
 def stage(package_dir: Path, script: Path, staging: Path) -> List[str]:
-    """Copy the slave script and the needed part of the package into ``staging``; return the bundled names."""
+    """Copy the slave script and the needed part of the package into ``staging``; return the bundled names.
+
+    Every FMU of the project bundles the union of the closures of all slave
+    scripts in MODELS: the bundled package is the top-level module ``cam_fmu``,
+    and module names are process-global, so when cam.fmu and pi_speed.fmu load
+    into one host process the first one's ``cam_fmu`` serves both (ecos and
+    libcosim crashed with a partial bundle: the second slave's class was not found).
+    """
     modules, needs_init = bundle_modules(package_dir, script)
+    for other in companion_scripts(package_dir, script):
+        more, init = bundle_modules(package_dir, other)
+        modules = sorted(set(modules) | set(more))
+        needs_init |= init
     target_pkg = staging / PACKAGE
     target_pkg.mkdir(parents=True)
     for path in modules:
@@ -169,7 +194,7 @@ sys.path[:0] = [sys.argv[1]]
 import {module} as slave_module
 import cam_fmu
 assert cam_fmu.__file__.startswith(sys.argv[1]), cam_fmu.__file__
-slave = slave_module.CamDriveSlave(instance_name="check", resources=sys.argv[1])
+slave = slave_module.{cls}(instance_name="check", resources=sys.argv[1])
 slave.exit_initialization_mode()
 assert slave.do_step(0.0, 1e-3) is True
 forbidden = sorted(m for m in sys.modules if m.split(".")[0] in {forbidden!r})
@@ -177,9 +202,9 @@ print(json.dumps({{"forbidden": forbidden, "modules": sorted(m for m in sys.modu
 """
 
 
-def check_bundle(staging: Path, module: str) -> dict:
+def check_bundle(staging: Path, module: str, cls: str = "CamDriveSlave") -> dict:
     """Import and step the staged slave in an isolated interpreter: proves the bundle is complete."""
-    code = CHECK_BUNDLE.format(module=module, forbidden=sorted(FORBIDDEN))
+    code = CHECK_BUNDLE.format(module=module, cls=cls, forbidden=sorted(FORBIDDEN))
     proc = subprocess.run([sys.executable, "-I", "-c", code, str(staging)], capture_output=True, text=True,
                           cwd=staging, timeout=120)
     if proc.returncode != 0:
@@ -190,42 +215,53 @@ def check_bundle(staging: Path, module: str) -> dict:
     return info
 
 
-def sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
-    """Every file whose content ends up in (or shapes) the FMU."""
-    script = package_dir / SLAVE_SCRIPT
-    return [script, *bundle_modules(package_dir, script)[0], *(package_dir / p for p in BUILD_SOURCES)]
+def _model(model: str) -> Tuple[Path, str]:
+    if model not in MODELS:
+        raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
+    return MODELS[model]
 
 
-def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR) -> bool:
+def sources(package_dir: Path = PACKAGE_DIR, model: str = "cam") -> list[Path]:
+    """Every file whose content ends up in (or shapes) the FMU of ``model``."""
+    script = package_dir / _model(model)[0]
+    bundled = [m for s in (script, *companion_scripts(package_dir, script)) for m in bundle_modules(package_dir, s)[0]]
+    return [script, *bundled, *(package_dir / p for p in BUILD_SOURCES)]
+
+
+def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> bool:
     """True when ``fmu`` is missing or older than one of its sources."""
     fmu = Path(fmu)
     if not fmu.is_file():
         return True
-    newest = max(p.stat().st_mtime for p in sources(package_dir) if p.is_file())
+    newest = max(p.stat().st_mtime for p in sources(package_dir, model) if p.is_file())
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, package_dir: Path | None = None, verbose: bool = False) -> Path:
-    """Build the FMU at ``dest`` (a path ending in .fmu) and return it."""
+def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, model: str = "cam") -> Path:
+    """Build the FMU of ``model`` (a key of MODELS) at ``dest`` (a path ending in .fmu) and return it."""
     package_dir = Path(package_dir or PACKAGE_DIR).resolve()
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
         raise BuildError(f"--dest must end in .fmu: {dest}")
     from pythonfmu.builder import FmuBuilder  # heavy import, only when building
 
-    from . import model_description
-    from .camdrive_fmu_slave import DEFAULT_EXPERIMENT, DESCRIPTION
+    import importlib
 
-    script = package_dir / SLAVE_SCRIPT
+    from . import model_description
+
+    rel_script, cls = _model(model)
+    slave_module = importlib.import_module(f"{__package__}.{rel_script.stem}")
+    DEFAULT_EXPERIMENT, DESCRIPTION = slave_module.DEFAULT_EXPERIMENT, slave_module.DESCRIPTION
+    script = package_dir / rel_script
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         staging = Path(tmp) / "stage"
         staging.mkdir()
         bundled = stage(package_dir, script, staging)
-        info = check_bundle(staging, script.stem)
+        info = check_bundle(staging, script.stem, cls)
         if verbose:
             print("bundled:", ", ".join(bundled))
             print("modules imported at run time:", ", ".join(info["modules"]))
-        out = Path(tmp) / "out" / "cam.fmu"
+        out = Path(tmp) / "out" / f"{model}.fmu"
         out.parent.mkdir()
         FmuBuilder.build_FMU(
             staging / script.name,
@@ -239,27 +275,44 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False) ->
             description=DESCRIPTION,
             default_experiment=(DEFAULT_EXPERIMENT.start_time, DEFAULT_EXPERIMENT.stop_time,
                                 DEFAULT_EXPERIMENT.step_size),
+            rows=model_description.ROWS[model](),
         )
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(out, dest)
     return dest
 
 
+def build_ssp(dest: Path, cam: Path, pi_speed: Path) -> Path:
+    """models/speed_loop.ssp from the two built FMUs (experiments.ssp.speed_loop_system)."""
+    from ..experiments.ssp import SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER, speed_loop_system, write_ssp
+
+    system = speed_loop_system(SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER)
+    return write_ssp(system, {"cam": cam, "controller": pi_speed}, dest)
+
+
 def main(argv: List[str] | None = None) -> int:
-    from ..experiments.fmu_file import default_fmu_path
+    from ..experiments.fmu_file import default_model_path
 
     parser = argparse.ArgumentParser(prog="build_fmu.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dest", type=Path, default=None,
-                        help="FMU file to write (default: models/cam.fmu in a source checkout, else a user cache)")
+                        help="build one FMU (--model, default cam) into this file; without --dest: "
+                             "cam.fmu, pi_speed.fmu and speed_loop.ssp into models/ in a source checkout "
+                             "(else a user cache)")
+    parser.add_argument("--model", choices=sorted(MODELS), default="cam", help="the FMU --dest builds")
     parser.add_argument("--package-dir", type=Path, default=None, help=argparse.SUPPRESS)
     parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules")
     args = parser.parse_args(argv)
     try:
-        path = build(args.dest or default_fmu_path(), args.package_dir, args.verbose)
+        if args.dest is not None:
+            print(build(args.dest, args.package_dir, args.verbose, args.model))
+            return 0
+        built = {name: build(default_model_path(name), args.package_dir, args.verbose, name) for name in MODELS}
+        for path in built.values():
+            print(path)
+        print(build_ssp(default_model_path(SSP_NAME, ".ssp"), built["cam"], built["pi_speed"]))
     except BuildError as exc:
         print(f"build_fmu: error: {exc}", file=sys.stderr)
         return 1
-    print(path)
     return 0
 
 

@@ -34,6 +34,7 @@ BASE_UNITS: Dict[str, Dict[str, int]] = {
     "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
     "H": {"kg": 1, "m": 2, "s": -2, "A": -2},
     "V/(rad/s)": {"kg": 1, "m": 2, "s": -2, "A": -1, "rad": -1},
+    "V/rad": {"kg": 1, "m": 2, "s": -3, "A": -1, "rad": -1},
     "N.m/A": {"kg": 1, "m": 2, "s": -2, "A": -1},
     "kg.m2": {"kg": 1, "m": 2},
     "N.m": {"kg": 1, "m": 2, "s": -2},
@@ -76,6 +77,34 @@ def variable_rows() -> List[Dict[str, Any]]:
     return rows
 
 
+def controller_rows() -> List[Dict[str, Any]]:
+    """Every variable of pi_speed.fmu (control.pi's tables) in value-reference order."""
+    from ..control import pi
+
+    rows: List[Dict[str, Any]] = []
+    for name, unit, start, desc in pi.INPUTS:
+        rows.append(dict(name=name, type="Real", causality="input", variability="continuous", initial=None,
+                         unit=unit, start=float(start), min=None, max=None, description=desc,
+                         allowed="any finite value"))
+    for name, unit, desc in pi.OUTPUTS:
+        rows.append(dict(name=name, type="Real", causality="output", variability="discrete",
+                         initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
+                         allowed="(output)"))
+    for spec in pi.PARAMETERS:
+        kind = {"real": "Real", "boolean": "Boolean", "string": "String"}[spec.kind]
+        row = dict(name=spec.name, type=kind, causality="parameter", variability="fixed", initial="exact",
+                   unit=spec.unit if spec.kind == "real" else "", start=spec.default, min=None, max=None,
+                   description=spec.description, allowed=spec.allowed())
+        if spec.kind == "real":
+            row["min"] = spec.low if math.isfinite(spec.low) else None
+            row["max"] = spec.high if math.isfinite(spec.high) else None
+        rows.append(row)
+    return rows
+
+
+ROWS = {"cam": variable_rows, "pi_speed": controller_rows}  # model name -> its variable table
+
+
 def _fmt(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
@@ -84,8 +113,9 @@ def _fmt(value: Any) -> str:
     return str(value)
 
 
-def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Optional[str] = None) -> bytes:
-    """Return the completed modelDescription.xml."""
+def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Optional[str] = None,
+                rows: Optional[List[Dict[str, Any]]] = None) -> bytes:
+    """Return the completed modelDescription.xml (``rows``: the model's variable table, default cam.fmu's)."""
     root = ET.fromstring(xml_bytes)
     for element in root.iter():  # drop pythonfmu's pretty-printing whitespace before re-indenting
         if element.text is not None and not element.text.strip():
@@ -94,7 +124,7 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
             element.tail = None
     if description:
         root.set("description", description)
-    rows = {row["name"]: row for row in variable_rows()}
+    rows = {row["name"]: row for row in (variable_rows() if rows is None else rows)}
 
     # UnitDefinitions right after CoSimulation (schema order).
     for old in root.findall("UnitDefinitions"):

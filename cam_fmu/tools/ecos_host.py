@@ -84,10 +84,11 @@ def missing_libraries(binary: Path) -> List[str]:
     return [line.split("=>")[0].strip() for line in out.splitlines() if "not found" in line]
 
 
-def read_csv(path: Path) -> Dict[str, np.ndarray]:
+def read_csv(path: Path, keep_instance: bool = False) -> Dict[str, np.ndarray]:
     """ecos' numeric CSV columns as {'iterations', 'time', '<variable>': array}.
 
-    'instance::omega[REAL]' becomes 'omega'; STRING columns are left out.
+    'instance::omega[REAL]' becomes 'omega' ('instance.omega' with ``keep_instance``,
+    for systems whose instances share variable names); STRING columns are left out.
     """
     with open(path, encoding="utf-8", newline="") as fh:
         rows = list(csv.reader(fh))
@@ -96,7 +97,7 @@ def read_csv(path: Path) -> Dict[str, np.ndarray]:
     for k, h in enumerate(header):
         if h.endswith("[STRING]"):
             continue
-        name = h.split("::", 1)[-1]
+        name = h.replace("::", ".", 1) if keep_instance else h.split("::", 1)[-1]
         if name.endswith("]") and "[" in name:
             name = name[: name.rindex("[")]
         try:
