@@ -35,18 +35,19 @@ STATE_CASES = {
 
 # name: (start values, input signal spec, variable the message must name, text the message must contain)
 ERROR_CASES = {
-    "R_negative": ({"R": -1.0}, None, "'R'", "(0, 10000]"),
-    "J_m_zero": ({"J_m": 0.0}, None, "'J_m'", "(0, 100]"),
-    "h_max_too_large": ({"h_max": 100.0}, None, "'h_max'", "(0, 10]"),
+    "R_negative": ({"R": -1.0}, None, "'R'", "[0.001, 10000]"),  # physical ranges (issue 9)
+    "J_m_zero": ({"J_m": 0.0}, None, "'J_m'", "[1e-09, 100]"),
+    "h_max_too_large": ({"h_max": 100.0}, None, "'h_max'", "[1e-09, 10]"),
     "mu_nan": ({"mu": float("nan")}, None, "'mu'", "[0, 0.5]"),
     "unknown_preset": ({"rise_law": "bogus"}, None, "'rise_law'", "'cycloidal'"),
     "unknown_solver": ({"solver": "bogus"}, None, "'solver'", "'rk45'"),
     "unknown_drive": ({"drive": "torque"}, None, "'drive'", "'speed'"),
     "angles_not_2pi": ({"rise_angle": 2.0}, None, "'rise_angle'", "2 pi"),
     "max_steps_exceeded": ({"solver": "rk4", "h_max": 1e-5, "max_steps": 1.0}, None, "max_steps", "max_steps = 1"),
-    "u_nan": ({}, ("u", float("nan")), "'u'", "finite"),
-    "u_inf": ({}, ("u", float("inf")), "'u'", "finite"),
-    "omega_ref_nan": ({"drive": "speed"}, ("omega_ref", float("nan")), "'omega_ref'", "finite"),
+    "u_nan": ({}, ("u", float("nan")), "'u'", "[-10000, 10000]"),  # inputs have finite ranges (issue 9)
+    "u_inf": ({}, ("u", float("inf")), "'u'", "[-10000, 10000]"),
+    "u_1e300": ({}, ("u", 1e300), "'u'", "[-10000, 10000]"),
+    "omega_ref_nan": ({"drive": "speed"}, ("omega_ref", float("nan")), "'omega_ref'", "[-10000, 10000]"),
 }
 
 

@@ -78,7 +78,7 @@ def run(args) -> int:
     from ..experiments.ssp import read_ssp
     from ..physics.parameters import BY_NAME, resolve
 
-    system = read_ssp(ensure_ssp(args.ssp, log=lambda m: print(m, file=sys.stderr)))
+    system = read_ssp(ensure_ssp(args.ssp, log=print))  # progress on stdout: stderr carries only the error line
     for text in args.set:
         name, value = parse_assignment(text)
         comp, _, var = name.partition(".")
