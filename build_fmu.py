@@ -165,8 +165,8 @@ CHECK_BUNDLE = r"""
 import json, sys
 sys.path[:0] = [sys.argv[1]]
 import {module} as slave_module
-import cam_fmu
-assert cam_fmu.__file__.startswith(sys.argv[1]), cam_fmu.__file__
+import {package} as bundled_package
+assert bundled_package.__file__.startswith(sys.argv[1]), bundled_package.__file__
 slave = slave_module.CamDriveSlave(instance_name="check", resources=sys.argv[1])
 slave.exit_initialization_mode()
 assert slave.do_step(0.0, 1e-3) is True
@@ -175,9 +175,9 @@ print(json.dumps({{"forbidden": forbidden, "modules": sorted(m for m in sys.modu
 """
 
 
-def check_bundle(staging: Path, module: str) -> dict:
+def check_bundle(staging: Path, module: str, package: str = PACKAGE) -> dict:
     """Import and step the staged slave in an isolated interpreter: proves the bundle is complete."""
-    code = CHECK_BUNDLE.format(module=module, forbidden=sorted(FORBIDDEN))
+    code = CHECK_BUNDLE.format(module=module, package=package, forbidden=sorted(FORBIDDEN))
     proc = subprocess.run([sys.executable, "-I", "-c", code, str(staging)], capture_output=True, text=True,
                           cwd=staging, timeout=120)
     if proc.returncode != 0:
@@ -199,22 +199,25 @@ def build(dest: Path = DEFAULT_DEST, package_dir: Path | None = None, verbose: b
     from pythonfmu.builder import FmuBuilder  # noqa: E402  (heavy import, only when building)
     from cam_fmu import fmu_xml  # noqa: E402
     from cam_fmu.camdrive_fmu_slave import DESCRIPTION, DEFAULT_EXPERIMENT  # noqa: E402
+    from cam_fmu.fmu.native import compile as native  # noqa: E402
 
     script = package_dir / SLAVE_SCRIPT
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         staging = Path(tmp) / "stage"
         staging.mkdir()
         bundled = stage(package_dir, script, staging)
-        info = check_bundle(staging, script.stem)
+        names = native.privatize(staging, PACKAGE, script.stem)  # private names: cam_fmu_<hash>, ...
+        binary = native.build_binary(Path(tmp) / "native" / "cam.so")  # fails early without a C compiler
+        info = check_bundle(staging, names.slave_module, names.package)
         if verbose:
             print("bundled:", ", ".join(bundled))
             print("modules imported at run time:", ", ".join(info["modules"]))
         out = Path(tmp) / "out" / "cam.fmu"
         out.parent.mkdir()
         FmuBuilder.build_FMU(
-            staging / script.name,
+            staging / f"{names.slave_module}.py",
             dest=out,
-            project_files=[staging / PACKAGE],
+            project_files=[staging / names.package],
             canGetAndSetFMUstate=True,   # --handle-state
             canSerializeFMUstate=True,   # --serialize-state
         )
@@ -224,6 +227,7 @@ def build(dest: Path = DEFAULT_DEST, package_dir: Path | None = None, verbose: b
             default_experiment=(DEFAULT_EXPERIMENT.start_time, DEFAULT_EXPERIMENT.stop_time,
                                 DEFAULT_EXPERIMENT.step_size),
         )
+        native.install(out, names, binary)  # our linux64 binary, python.txt, private pythonfmu
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(out, dest)
     return dest
@@ -237,7 +241,7 @@ def main(argv: List[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         path = build(args.dest, args.package_dir, args.verbose)
-    except BuildError as exc:
+    except (BuildError, RuntimeError) as exc:
         print(f"build_fmu: error: {exc}", file=sys.stderr)
         return 1
     print(path)
