@@ -60,7 +60,16 @@ DEFAULT_EXPERIMENT = DefaultExperiment(start_time=0.0, stop_time=2.0, step_size=
 
 
 class FmuError(RuntimeError):
-    """An error reported to the importer; the message names the variable and the allowed range."""
+    """An error reported to the importer; the message names the variable and the allowed range.
+
+    cam.fmu's linux64 binary returns fmi2Error for it (and for any other exception),
+    with the text in the log (category logStatusError)."""
+
+
+class StepDiscarded(FmuError):
+    """The step cannot be completed at this size (max_steps, step floor): fmi2Discard, retry a shorter step."""
+
+    fmi_status = "discard"
 
 
 class CamDriveSlave(Fmi2Slave):
@@ -133,7 +142,7 @@ class CamDriveSlave(Fmi2Slave):
         return setter
 
     # ----------------------------------------------------------------- helpers
-    def _fail(self, message: str) -> None:
+    def _fail(self, message: str, error: type = FmuError) -> None:
         """Report an error: log it, print it to stderr, raise (pythonfmu returns fmi2Fatal).
 
         pythonfmu 0.7.0 forwards the queued ``self.log`` message (status fmi2Error,
@@ -144,7 +153,7 @@ class CamDriveSlave(Fmi2Slave):
         """
         self.log(message, Fmi2Status.error)
         print(f"[cam.fmu {self.instance_name}] error: {message}", file=sys.stderr, flush=True)
-        raise FmuError(message)
+        raise error(message)
 
     def _build(self) -> None:
         try:
@@ -180,7 +189,11 @@ class CamDriveSlave(Fmi2Slave):
         try:  # inputs were checked in their setters, and are again in DriveSimulator.do_step
             self._sim.do_step(current_time, step_size, **self._inputs)
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
-            self._fail(f"at t = {current_time!r} s: {exc}")
+            # Interim until the engine raises StepDiscarded itself: its max_steps / step-floor refusals
+            # mean "not at this step size" (fmi2Discard), everything else is fmi2Error.
+            discard = getattr(exc, "fmi_status", None) == "discard" or "max_steps" in str(exc) \
+                or "fell below" in str(exc)
+            self._fail(f"at t = {current_time!r} s: {exc}", StepDiscarded if discard else FmuError)
         self._publish(self._sim, self._sim.outputs())
         return True  # a falsy return would become a silent fmi2Discard
 
