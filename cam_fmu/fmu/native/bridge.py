@@ -102,11 +102,9 @@ class Instance:
             del queue[:]
         if extra is not None:
             status, text = extra
-            if messages is None:
-                messages = []
-            # the slave may have logged the same text before raising: report it once
-            if not any(s >= status and t == text for s, _c, t in messages):
-                messages.append((status, _CATEGORY[status], text))
+            # the slave may have logged the same text before raising: report it once, with the call's status
+            messages = [m for m in (messages or ()) if m[2] != text]
+            messages.append((status, _CATEGORY[status], text))
         return messages
 
     def _run(self, fn, *args):

@@ -144,7 +144,6 @@ static void logf_(Instance *c, fmi2Status status, const char *category, const ch
     va_start(ap, fmt);
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
-    if (status >= fmi2Error) snprintf(c->last_error, sizeof c->last_error, "%s", text);
     if (status == fmi2OK && !c->logging_on) return;
     emit(c->logger, c->env, c->name, status, category, text);
 }
@@ -632,6 +631,7 @@ static fmi2Status invoke(Instance *c, const char *method, PyObject **payload, co
         fetch_error(why, sizeof why);
         if (res) p_Py_DecRef(res);
         c->fatal = 1;
+        snprintf(c->last_error, sizeof c->last_error, "%s", why);
         logf_(c, fmi2Fatal, "logStatusFatal", "%s: the Python interpreter failed: %s", method, why);
         return fmi2Fatal;
     }
@@ -648,6 +648,7 @@ static fmi2Status invoke(Instance *c, const char *method, PyObject **payload, co
             long s = ms ? p_PyLong_AsLong(ms) : 0;
             if (!text || !cat) { p_PyErr_Clear(); continue; }
             if (s < 0 || s > fmi2Fatal) s = fmi2OK;
+            if (s >= fmi2Discard && status >= fmi2Discard) snprintf(c->last_error, sizeof c->last_error, "%s", text);
             logf_(c, (fmi2Status)s, cat, "%s", text);
         }
     }
