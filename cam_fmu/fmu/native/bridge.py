@@ -18,7 +18,8 @@ variables is one Python call, not n.
 
 Isolation: the private package and the slave module are imported from their
 files by name (``importlib``), without ever touching ``sys.path``; ``unload``
-removes exactly the ``sys.modules`` names they added.
+takes exactly the ``sys.modules`` names they added away again after the last
+instance was freed (``detach``) and puts them back for the next one (``attach``).
 """
 from __future__ import annotations
 
@@ -66,13 +67,29 @@ def load(package: str, slave_module: str, resources: str):
     return classes[0]
 
 
-def unload(package: str, slave_module: str) -> int:
-    """Forget the modules of this FMU (after its last instance was freed); return how many were removed."""
+_detached: dict = {}
+
+
+def detach(package: str, slave_module: str) -> int:
+    """After the last instance was freed: take this FMU's names out of sys.modules; return how many.
+
+    The C side keeps the bridge and the slave class, so the next fmi2Instantiate calls
+    ``attach`` instead of importing everything again (fast, and nothing to leak)."""
     names = _own_names(package, slave_module)
     for name in names:
-        sys.modules.pop(name, None)
-    _added_modules.clear()
+        _detached[name] = sys.modules.pop(name)
     return len(names)
+
+
+def attach() -> int:
+    """Put the names taken away by ``detach`` back into sys.modules (lazy relative imports need them)."""
+    count = 0
+    for name, module in _detached.items():
+        if name not in sys.modules:
+            sys.modules[name] = module
+            count += 1
+    _detached.clear()
+    return count
 
 
 def _text(exc: BaseException) -> str:

@@ -558,7 +558,17 @@ static int load_bridge(const char *resources, char *err, size_t errsize)
 {
     char path[PATH_MAX + 16];
     PyObject *globals, *res, *fn, *pair = NULL;
-    if (g_bridge) return 0;
+    if (g_bridge) {   /* imported before, detached after the last instance: re-register the names */
+        PyObject *attach = p_PyObject_GetAttrString(g_bridge, "attach");
+        PyObject *r = attach ? p_PyObject_CallObject(attach, NULL) : NULL;
+        if (attach) p_Py_DecRef(attach);
+        if (!r) {
+            fetch_error(err, errsize);
+            return -1;
+        }
+        p_Py_DecRef(r);
+        return 0;
+    }
     g_package[0] = g_slave[0] = 0;
     snprintf(path, sizeof path, "%s/native.txt", resources);
     if (read_keyvalues(path, native_kv, NULL) != 0 || !g_package[0] || !g_slave[0]) {
@@ -590,19 +600,33 @@ static int load_bridge(const char *resources, char *err, size_t errsize)
     return 0;
 }
 
-/* After the last instance: forget the FMU's modules (GIL held). */
-static void unload_bridge(void)
+/* After the last instance: take the FMU's names out of sys.modules (GIL held).  The bridge and the
+ * class stay referenced here, so the next fmi2Instantiate re-attaches them instead of importing. */
+static void detach_bridge(void)
 {
     if (g_bridge) {
-        PyObject *fn = p_PyObject_GetAttrString(g_bridge, "unload");
+        PyObject *fn = p_PyObject_GetAttrString(g_bridge, "detach");
         PyObject *r = fn ? call(fn, "(ss)", g_package, g_slave) : NULL;
         if (r) p_Py_DecRef(r);
         if (fn) p_Py_DecRef(fn);
         if (p_PyErr_Occurred()) p_PyErr_Clear();
     }
-    if (g_class) p_Py_DecRef(g_class);
-    if (g_bridge) p_Py_DecRef(g_bridge);
-    g_class = g_bridge = NULL;
+}
+
+/* Library unload (dlclose by the host, or process exit).  Only in a Python host whose interpreter still
+ * runs (fmpy's freeLibrary): drop our references so the FMU's modules can be collected.  After
+ * Py_Finalize (process exit of a Python host) and in native hosts (our interpreter is never finalised)
+ * nothing is done: no Python code runs from the ELF destructor. */
+__attribute__((destructor)) static void on_library_unload(void)
+{
+    if (!g_python_ready || g_python_owned || !g_bridge || !p_Py_IsInitialized()) return;
+    {
+        PyGILState_STATE gil = p_PyGILState_Ensure();
+        p_Py_DecRef(g_class);
+        p_Py_DecRef(g_bridge);
+        g_class = g_bridge = NULL;
+        p_PyGILState_Release(gil);
+    }
 }
 
 /* ------------------------------------------------------------------ calling the bridge */
@@ -782,11 +806,12 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
         g_live--;
         goto fail;
     }
-    logf_(c, fmi2OK, "logAll", "cam.fmu: Python %.10s (%s), module %s", p_Py_GetVersion(), mode, g_slave);
+    logf_(c, fmi2OK, "logAll", "cam.fmu: Python %.*s (%s), module %s", (int)strcspn(p_Py_GetVersion(), " "),
+          p_Py_GetVersion(), mode, g_slave);
     p_PyGILState_Release(gil);
     return c;
 fail:
-    if (g_live == 0) unload_bridge();
+    if (g_live == 0) detach_bridge();
     p_PyGILState_Release(gil);
     free(c->name);
     c->magic = 0;
@@ -807,7 +832,7 @@ EXPORT void fmi2FreeInstance(fmi2Component comp)
         }
         if (g_live <= 0) {
             g_live = 0;
-            unload_bridge();
+            detach_bridge();
         }
         p_PyGILState_Release(gil);
     }
