@@ -64,8 +64,9 @@ def compile_host(dest: Path) -> Path:
     return dest
 
 
-VALGRIND_OPTIONS = ["--error-limit=no", "--num-callers=30", "--leak-check=full", "--show-leak-kinds=definite",
-                    "--errors-for-leak-kinds=definite", f"--suppressions={SUPPRESSIONS}"]
+VALGRIND_OPTIONS = ["--error-limit=no", "--num-callers=40", "--leak-check=full", "--show-leak-kinds=definite",
+                    "--errors-for-leak-kinds=none", f"--suppressions={SUPPRESSIONS}"]
+OWN_CODE = ("fmi2_python.c", "/cam.so")  # frames of cam.fmu's binary in a valgrind stack
 
 
 def valgrind_prefix(log: Path, trace_children: bool = False) -> List[str]:
@@ -79,7 +80,11 @@ def valgrind_summary(log: Path) -> dict:
     """Errors (after the suppressions) and definitely lost bytes from a valgrind log (all processes)."""
     text = log.read_text(errors="replace") if log.is_file() else ""
     errors = sum(int(m) for m in re.findall(r"ERROR SUMMARY: (\d+) errors", text))
-    lost = sum(int(m.replace(",", "")) for m in re.findall(r"definitely lost: ([\d,]+) bytes", text))
+    # definitely lost blocks allocated by cam.fmu's binary (numpy's module init leaks a few at every exit)
+    records = re.split(r"\n==\d+== \n", text)
+    own_lost = [r for r in records if "definitely lost in loss record" in r and any(o in r for o in OWN_CODE)]
+    lost = sum(int(re.search(r"([\d,]+) (?:\(\S+ direct, \S+ indirect\) )?bytes", r).group(1).replace(",", ""))
+               for r in own_lost)
     kinds = sorted(set(re.findall(r"==\d+== (Invalid [a-z]+ of size \d+|Invalid free|Mismatched free"
                                   r"|Use of uninitialised value[^\n]*|Conditional jump[^\n]*)", text)))
     return {"errors": errors, "definitely_lost": lost, "kinds": kinds, "summaries": text.count("ERROR SUMMARY"),
@@ -105,6 +110,10 @@ def run_python(code: str, *args: str, cwd: Optional[Path] = None, env: Optional[
     proc = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd, env=env,
                           timeout=timeout)
     assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
-    lines = [line for line in proc.stdout.splitlines() if line.startswith(("{", "["))]
-    assert lines, proc.stdout[-3000:] + proc.stderr[-3000:]
-    return json.loads(lines[-1])
+    for line in reversed(proc.stdout.splitlines()):
+        if line.startswith(("{", "[")):
+            try:
+                return json.loads(line)
+            except json.JSONDecodeError:
+                continue  # a host's own log line
+    raise AssertionError("no JSON result\n" + proc.stdout[-3000:] + proc.stderr[-3000:])
