@@ -21,6 +21,11 @@ Before zipping, the staged bundle is imported in an isolated interpreter
 (``python -I``, nothing of this checkout on sys.path) to prove it is complete.
 After zipping, modelDescription.xml is completed by ``cam_fmu.fmu_xml``
 (units, initial, InitialUnknowns, DefaultExperiment...).
+
+linux64: ``cam_fmu.fmu.native.compile`` stages the bundle under private names
+(``cam_fmu_<hash>``, ``camdrive_fmu_slave_<hash>``), compiles the project's own
+FMI wrapper with the system C compiler (no compiler: the build stops) and puts it,
+``resources/python.txt`` and ``resources/native.txt`` into the FMU (docs/fmu.md).
 """
 from __future__ import annotations
 

@@ -13,7 +13,11 @@ in one process).
 Imports at run time: pythonfmu, ``cam_fmu.parameters`` and ``cam_fmu.simulator``
 (numpy at most). Never scipy: it crashes native hosts at Py_Finalize.
 
-Errors. pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
+Errors. On linux64, cam.fmu's own binary (cam_fmu/fmu/native, docs/fmu.md) maps an
+exception raised here to fmi2Error with its text in the log (``logStatusError``),
+and ``StepDiscarded`` to fmi2Discard; the instance stays recoverable (fmi2Reset,
+fmi2SetFMUstate). The rest of this paragraph describes pythonfmu's win64 binary:
+pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
 an FMI call (fmi2SetReal/Boolean/String, fmi2EnterInitializationMode,
 fmi2ExitInitializationMode, fmi2DoStep, fmi2Get*, state calls) into
 ``pythonfmu::fatal_error``: the call returns **fmi2Fatal** and the wrapper logs

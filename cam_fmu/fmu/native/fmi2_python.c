@@ -99,6 +99,7 @@ static int g_python_owned = 0;      /* we started the interpreter (native host) 
 static PyObject *g_bridge = NULL;   /* <package>._fmi_bridge */
 static PyObject *g_class = NULL;    /* the slave class */
 static int g_live = 0;              /* live instances (guarded by the GIL) */
+static int (*p_is_finalizing)(void) = NULL;  /* Py_IsFinalizing (3.13+) or _Py_IsFinalizing, if exported */
 static char g_package[128];
 static char g_slave[128];
 
@@ -340,11 +341,20 @@ static int load_api(void *handle, char *err, size_t errsize)
     }
     PY_FUNCTIONS(LOAD_PTR)
 #undef LOAD_PTR
+    p_is_finalizing = (int (*)(void))dlsym(handle, "Py_IsFinalizing");
+    if (!p_is_finalizing) p_is_finalizing = (int (*)(void))dlsym(handle, "_Py_IsFinalizing");
     return 0;
+}
+
+/* The interpreter runs and is not shutting down: Python may be called (from any thread). */
+static int python_usable(void)
+{
+    return g_python_ready && p_Py_IsInitialized() && !(p_is_finalizing && p_is_finalizing());
 }
 
 static void reset_api(void)
 {
+    p_is_finalizing = NULL;
 #define CLEAR_PTR(name) p_##name = NULL;
     PY_FUNCTIONS(CLEAR_PTR)
 #undef CLEAR_PTR
@@ -619,7 +629,7 @@ static void detach_bridge(void)
  * nothing is done: no Python code runs from the ELF destructor. */
 __attribute__((destructor)) static void on_library_unload(void)
 {
-    if (!g_python_ready || g_python_owned || !g_bridge || !p_Py_IsInitialized()) return;
+    if (g_python_owned || !g_bridge || !python_usable()) return;
     {
         PyGILState_STATE gil = p_PyGILState_Ensure();
         p_Py_DecRef(g_class);
@@ -824,7 +834,7 @@ EXPORT void fmi2FreeInstance(fmi2Component comp)
     Instance *c = comp;
     if (!c || c->magic != INSTANCE_MAGIC) return;
     c->magic = 0;
-    if (g_python_ready && p_Py_IsInitialized()) {
+    if (python_usable()) {   /* during a Python host's shutdown, leave its objects to it */
         PyGILState_STATE gil = p_PyGILState_Ensure();
         if (c->inst) {
             p_Py_DecRef(c->inst);
