@@ -326,3 +326,31 @@ def test_isolated_from_host_cam_fmu_and_other_builds(cam_fmu_path, tmp_path):
     assert len(r["private_while_alive"]) == 4, r        # 2 packages + 2 slave modules, all distinct
     assert r["omegas"][0] == r["omegas"][1] and r["omegas"][0] > 0
     assert r["added_after_free"] == [] and r["path_unchanged"], r
+
+
+FATAL = r"""
+import json, sys
+from fmpy import read_model_description, extract
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+md = read_model_description(sys.argv[1])
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[1]), modelIdentifier="cam", instanceName="a")
+fmu.instantiate(); fmu.setupExperiment(startTime=0.0); fmu.enterInitializationMode(); fmu.exitInitializationMode()
+package = dict(x.split("=", 1) for x in open(str(fmu.unzipDirectory) + "/resources/native.txt").read().split())["package"]
+bridge = sys.modules[package + "._fmi_bridge"]
+bridge.Instance.do_step = lambda self, t, h: None          # the bridge itself broken: not (status, payload, messages)
+statuses = []
+for call in (lambda: fmu.doStep(0.0, 1e-3), lambda: fmu.getReal([3]), lambda: fmu.reset()):
+    try:
+        call(); statuses.append(0)
+    except FMICallException as exc:
+        statuses.append(int(exc.status))
+fmu.freeInstance()                                          # never crashes, whatever came before
+print(json.dumps({"statuses": statuses}))
+"""
+
+
+def test_fatal_only_when_the_bridge_breaks_and_free_survives(cam_fmu_path, tmp_path):
+    shutil.copyfile(cam_fmu_path, tmp_path / "cam.fmu")
+    r = run_python(FATAL, str(tmp_path / "cam.fmu"), cwd=tmp_path)
+    assert r["statuses"] == [4, 4, 4]
