@@ -4,10 +4,19 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-# libtbb12: needed by the FMU host `ecos`. Only touch apt when it is missing.
-if ! dpkg-query -W -f='${Status}' libtbb12 2>/dev/null | grep -q "install ok installed"; then
+# Debian packages, installed only when missing (apt is not touched otherwise):
+# - gcc:      compiles cam.fmu's own linux64 binary (cam_fmu/fmu/native/fmi2_python.c) and the test host;
+# - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
+# - libtbb12: needed by the FMU host `ecos`.
+missing=()
+for pkg in gcc valgrind libtbb12; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
+        missing+=("$pkg")
+    fi
+done
+if [ "${#missing[@]}" -gt 0 ]; then
     apt-get update
-    apt-get install -y libtbb12
+    apt-get install -y "${missing[@]}"
 fi
 
 python -m pip install -e ".[test]"

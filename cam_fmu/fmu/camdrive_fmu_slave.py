@@ -13,7 +13,11 @@ in one process).
 Imports at run time: pythonfmu, ``cam_fmu.physics.parameters``,
 ``cam_fmu.physics.variables`` and ``cam_fmu.fmu.engine`` (numpy at most). Never scipy: it crashes native hosts at Py_Finalize.
 
-Errors. pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
+Errors. On linux64, cam.fmu's own binary (cam_fmu/fmu/native, docs/fmu.md) maps an
+exception raised here to fmi2Error with its text in the log (``logStatusError``),
+and ``StepDiscarded`` to fmi2Discard; the instance stays recoverable (fmi2Reset,
+fmi2SetFMUstate). The rest of this paragraph describes pythonfmu's win64 binary:
+pythonfmu 0.7.0's C++ wrapper turns *every* Python exception raised in
 an FMI call (fmi2SetReal/Boolean/String, fmi2EnterInitializationMode,
 fmi2ExitInitializationMode, fmi2DoStep, fmi2Get*, state calls) into
 ``pythonfmu::fatal_error``: the call returns **fmi2Fatal** and the wrapper logs
@@ -62,7 +66,16 @@ DEFAULT_EXPERIMENT = DefaultExperiment(start_time=0.0, stop_time=2.0, step_size=
 
 
 class FmuError(RuntimeError):
-    """An error reported to the importer; the message names the variable and the allowed range."""
+    """An error reported to the importer; the message names the variable and the allowed range.
+
+    cam.fmu's linux64 binary returns fmi2Error for it (and for any other exception),
+    with the text in the log (category logStatusError)."""
+
+
+class StepDiscarded(FmuError):
+    """The step cannot be completed at this size (max_steps, step floor): fmi2Discard, retry a shorter step."""
+
+    fmi_status = "discard"
 
 
 class CamDriveSlave(Fmi2Slave):
@@ -133,7 +146,7 @@ class CamDriveSlave(Fmi2Slave):
         return setter
 
     # ----------------------------------------------------------------- helpers
-    def _fail(self, message: str) -> None:
+    def _fail(self, message: str, error: type = FmuError) -> None:
         """Report an error: log it, print it to stderr, raise (pythonfmu returns fmi2Fatal).
 
         pythonfmu 0.7.0 forwards the queued ``self.log`` message (status fmi2Error,
@@ -144,7 +157,7 @@ class CamDriveSlave(Fmi2Slave):
         """
         self.log(message, Fmi2Status.error)
         print(f"[cam.fmu {self.instance_name}] error: {message}", file=sys.stderr, flush=True)
-        raise FmuError(message)
+        raise error(message)
 
     def _build(self) -> None:
         try:
@@ -180,7 +193,10 @@ class CamDriveSlave(Fmi2Slave):
         try:  # inputs were checked in their setters, and are again in DriveSimulator.do_step
             self._sim.do_step(current_time, step_size, **self._inputs)
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
-            self._fail(f"at t = {current_time!r} s: {exc}")
+            # The engine's StepRejected (max_steps, step floor) means "not at this step size":
+            # fmi2Discard, with the state as before the step; everything else is fmi2Error.
+            discard = getattr(exc, "fmi_status", None) == "discard"
+            self._fail(f"at t = {current_time!r} s: {exc}", StepDiscarded if discard else FmuError)
         self._publish(self._sim, self._sim.outputs())
         return True  # a falsy return would become a silent fmi2Discard
 

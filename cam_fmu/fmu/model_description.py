@@ -184,6 +184,10 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
         raise ValueError(f"variables missing from the FMU: {sorted(missing)}")
 
     # ModelStructure: every output in Outputs and InitialUnknowns (all are 'calculated').
+    # Outputs: dependencies="" - no direct feedthrough: a new input (u, omega_ref) changes no output
+    # before the next fmi2DoStep, so a master need not iterate a loop closed around cam.fmu.
+    # InitialUnknowns: no dependencies attribute (= may depend on every input and parameter), which
+    # is the truth: the initial i and voltage follow the inputs set before initialisation.
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
@@ -191,7 +195,7 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
     out_node = ET.SubElement(structure, "Outputs")
     init_node = ET.SubElement(structure, "InitialUnknowns")
     for name in sorted(outputs, key=index_of.get):
-        ET.SubElement(out_node, "Unknown", index=str(index_of[name]))
+        ET.SubElement(out_node, "Unknown", index=str(index_of[name]), dependencies="")
         ET.SubElement(init_node, "Unknown", index=str(index_of[name]))
 
     text = ET.tostring(root, encoding="UTF-8")

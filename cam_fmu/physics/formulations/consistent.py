@@ -19,6 +19,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from ...errors import StepRejected
 from ..drive import DriveModel
 from ..variables import output_record
 from .base import Formulation
@@ -315,7 +316,13 @@ class ConsistentVoltage(Formulation):
         self.hybrid.settle(self.y, u, self.mode)  # at rest: stuck, or starting now
 
     def advance(self, h: float, integrator: Any, time: float) -> int:
-        self.y, steps = integrator.advance(self.hybrid, self.y, self.mode, self.u, h, time)
+        mode_before = self.mode.copy()
+        try:
+            self.y, steps = integrator.advance(self.hybrid, self.y, self.mode, self.u, h, time)
+        except StepRejected:
+            self.mode = mode_before  # a rejected step leaves the state as before it (fmi2Discard)
+            integrator.fsal = None
+            raise
         return steps
 
     def outputs(self, integrator: Any) -> dict[str, float]:

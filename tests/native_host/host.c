@@ -1,0 +1,245 @@
+/*
+ * A minimal native FMI 2.0 co-simulation host, as real tools load FMUs:
+ * dlopen(RTLD_NOW | RTLD_LOCAL), fmi2Instantiate, run, fmi2FreeInstance,
+ * dlclose, exit.  No libpython is linked or preloaded.
+ *
+ *   host <binary.so> <resources-dir> COMMAND...
+ *
+ * Commands (run in order; each prints one JSON line; the logger prints
+ * {"log": status, "category": ..., "msg": ...} lines):
+ *   inst                 fmi2Instantiate (loggingOn = false: errors must still reach the logger)
+ *   init                 fmi2SetupExperiment(0) + Enter/ExitInitializationMode
+ *   setr VR VALUE        fmi2SetReal of one variable (VALUE may be nan)
+ *   sets VR TEXT         fmi2SetString of one variable
+ *   getr VR,VR,...       one fmi2GetReal of all listed variables
+ *   step N H             N x fmi2DoStep of size H (stops at the first non-OK status)
+ *   save / restore       fmi2GetFMUstate / fmi2SetFMUstate (one slot)
+ *   serial               serialise the saved state, deserialise it, and make that the saved state
+ *   reset / term / free  fmi2Reset / fmi2Terminate / fmi2FreeInstance
+ *   laststatus           fmi2GetBooleanStatus(fmi2Terminated) and fmi2GetRealStatus(fmi2LastSuccessfulTime)
+ *   cycles N             N x (fmi2Instantiate + fmi2FreeInstance); prints RSS after 20 and after N
+ * At the end: fmi2FreeInstance if still instantiated, dlclose, {"exit": 0}, return 0.
+ */
+#include <dlfcn.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef void *fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef void (*Logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
+typedef struct {
+    Logger logger;
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void (*stepFinished)(void *, fmi2Status);
+    void *componentEnvironment;
+} Callbacks;
+
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (; s && *s; s++) {
+        unsigned char ch = (unsigned char)*s;
+        if (ch == '"' || ch == '\\') printf("\\%c", ch);
+        else if (ch < 0x20) printf("\\u%04x", ch);
+        else putchar(ch);
+    }
+    putchar('"');
+}
+
+static void logger(void *env, const char *name, fmi2Status status, const char *category, const char *message, ...)
+{
+    char text[8192];
+    va_list ap;
+    (void)env;
+    (void)name;
+    va_start(ap, message);
+    vsnprintf(text, sizeof text, message, ap);
+    va_end(ap);
+    printf("{\"log\": %d, \"category\": ", (int)status);
+    json_string(category);
+    printf(", \"msg\": ");
+    json_string(text);
+    printf("}\n");
+    fflush(stdout);
+}
+
+static long rss_kb(void)
+{
+    long pages = 0, resident = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+        fclose(f);
+    }
+    return resident * 4;
+}
+
+#define SYM(name) name##_t name = (name##_t)dlsym(lib, #name)
+typedef fmi2Component (*fmi2Instantiate_t)(const char *, int, const char *, const char *, const Callbacks *, int, int);
+typedef void (*fmi2FreeInstance_t)(fmi2Component);
+typedef fmi2Status (*fmi2SetupExperiment_t)(fmi2Component, int, double, double, int, double);
+typedef fmi2Status (*fmi2EnterInitializationMode_t)(fmi2Component);
+typedef fmi2Status (*fmi2ExitInitializationMode_t)(fmi2Component);
+typedef fmi2Status (*fmi2Terminate_t)(fmi2Component);
+typedef fmi2Status (*fmi2Reset_t)(fmi2Component);
+typedef fmi2Status (*fmi2SetReal_t)(fmi2Component, const fmi2ValueReference *, size_t, const double *);
+typedef fmi2Status (*fmi2GetReal_t)(fmi2Component, const fmi2ValueReference *, size_t, double *);
+typedef fmi2Status (*fmi2SetString_t)(fmi2Component, const fmi2ValueReference *, size_t, const char *const *);
+typedef fmi2Status (*fmi2DoStep_t)(fmi2Component, double, double, int);
+typedef fmi2Status (*fmi2GetFMUstate_t)(fmi2Component, fmi2FMUstate *);
+typedef fmi2Status (*fmi2SetFMUstate_t)(fmi2Component, fmi2FMUstate);
+typedef fmi2Status (*fmi2FreeFMUstate_t)(fmi2Component, fmi2FMUstate *);
+typedef fmi2Status (*fmi2SerializedFMUstateSize_t)(fmi2Component, fmi2FMUstate, size_t *);
+typedef fmi2Status (*fmi2SerializeFMUstate_t)(fmi2Component, fmi2FMUstate, char *, size_t);
+typedef fmi2Status (*fmi2DeSerializeFMUstate_t)(fmi2Component, const char *, size_t, fmi2FMUstate *);
+typedef fmi2Status (*fmi2GetBooleanStatus_t)(fmi2Component, int, int *);
+typedef fmi2Status (*fmi2GetRealStatus_t)(fmi2Component, int, double *);
+
+int main(int argc, char **argv)
+{
+    void *lib;
+    char uri[4200];
+    Callbacks cb = {logger, calloc, free, NULL, NULL};
+    fmi2Component c = NULL;
+    fmi2FMUstate saved = NULL;
+    double time = 0.0;
+    if (argc < 3) {
+        fprintf(stderr, "usage: host <binary.so> <resources-dir> COMMAND...\n");
+        return 2;
+    }
+    lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        printf("{\"dlopen\": ");
+        json_string(dlerror());
+        printf("}\n");
+        return 3;
+    }
+    SYM(fmi2Instantiate); SYM(fmi2FreeInstance); SYM(fmi2SetupExperiment); SYM(fmi2EnterInitializationMode);
+    SYM(fmi2ExitInitializationMode); SYM(fmi2Terminate); SYM(fmi2Reset); SYM(fmi2SetReal); SYM(fmi2GetReal);
+    SYM(fmi2SetString); SYM(fmi2DoStep); SYM(fmi2GetFMUstate); SYM(fmi2SetFMUstate); SYM(fmi2FreeFMUstate);
+    SYM(fmi2SerializedFMUstateSize); SYM(fmi2SerializeFMUstate); SYM(fmi2DeSerializeFMUstate);
+    SYM(fmi2GetBooleanStatus); SYM(fmi2GetRealStatus);
+    if (!fmi2Instantiate || !fmi2DoStep || !fmi2GetBooleanStatus || !fmi2DeSerializeFMUstate) {
+        printf("{\"dlsym\": \"missing FMI functions\"}\n");
+        return 3;
+    }
+    snprintf(uri, sizeof uri, "file://%s", argv[2]);
+
+    for (int k = 3; k < argc; k++) {
+        const char *cmd = argv[k];
+        fmi2Status s = fmi2OK;
+        if (!strcmp(cmd, "inst")) {
+            c = fmi2Instantiate("host", 1, "", uri, &cb, 0, 0);
+            printf("{\"cmd\": \"inst\", \"ok\": %s}\n", c ? "true" : "false");
+            if (!c) break;
+            continue;
+        } else if (!strcmp(cmd, "cycles")) {
+            int n = atoi(argv[++k]);
+            long after20 = 0;
+            for (int i = 0; i < n; i++) {
+                fmi2Component x = fmi2Instantiate("cycle", 1, "", uri, &cb, 0, 0);
+                if (!x) { printf("{\"cmd\": \"cycles\", \"failed_at\": %d}\n", i); break; }
+                fmi2FreeInstance(x);
+                if (i == 19) after20 = rss_kb();
+            }
+            printf("{\"cmd\": \"cycles\", \"n\": %d, \"rss_after_20_kb\": %ld, \"rss_end_kb\": %ld}\n", n, after20,
+                   rss_kb());
+            continue;
+        } else if (!strcmp(cmd, "free")) {
+            if (c && saved) fmi2FreeFMUstate(c, &saved);
+            fmi2FreeInstance(c);   /* also after fmi2Error/fmi2Fatal, and with NULL */
+            c = NULL;
+            saved = NULL;
+        } else if (!c) {
+            printf("{\"cmd\": \"%s\", \"error\": \"no instance\"}\n", cmd);
+            continue;
+        } else if (!strcmp(cmd, "init")) {
+            s = fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0);
+            if (s == fmi2OK) s = fmi2EnterInitializationMode(c);
+            if (s == fmi2OK) s = fmi2ExitInitializationMode(c);
+            time = 0.0;
+        } else if (!strcmp(cmd, "setr")) {
+            fmi2ValueReference vr = (fmi2ValueReference)atoi(argv[++k]);
+            double v = strtod(argv[++k], NULL);
+            s = fmi2SetReal(c, &vr, 1, &v);
+        } else if (!strcmp(cmd, "sets")) {
+            fmi2ValueReference vr = (fmi2ValueReference)atoi(argv[++k]);
+            const char *v = argv[++k];
+            s = fmi2SetString(c, &vr, 1, &v);
+        } else if (!strcmp(cmd, "getr")) {
+            fmi2ValueReference vrs[64];
+            double values[64];
+            size_t n = 0;
+            char *list = strdup(argv[++k]);
+            for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
+            free(list);
+            s = fmi2GetReal(c, vrs, n, values);
+            printf("{\"cmd\": \"getr\", \"status\": %d, \"values\": [", (int)s);
+            for (size_t i = 0; i < n; i++) printf(i ? ", %.17g" : "%.17g", isfinite(values[i]) ? values[i] : 1e308);
+            printf("]}\n");
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(cmd, "step")) {
+            int n = atoi(argv[++k]);
+            double h = strtod(argv[++k], NULL);
+            int done = 0;
+            for (; done < n; done++) {
+                s = fmi2DoStep(c, time, h, 1);
+                if (s != fmi2OK) break;
+                time += h;
+            }
+            printf("{\"cmd\": \"step\", \"status\": %d, \"steps\": %d, \"time\": %.17g}\n", (int)s, done, time);
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(cmd, "save")) {
+            s = fmi2GetFMUstate(c, &saved);
+        } else if (!strcmp(cmd, "restore")) {
+            s = fmi2SetFMUstate(c, saved);
+        } else if (!strcmp(cmd, "serial")) {
+            size_t size = 0;
+            char *buf;
+            fmi2FMUstate copy = NULL;
+            s = fmi2SerializedFMUstateSize(c, saved, &size);
+            buf = malloc(size ? size : 1);
+            if (s == fmi2OK) s = fmi2SerializeFMUstate(c, saved, buf, size);
+            if (s == fmi2OK) s = fmi2DeSerializeFMUstate(c, buf, size, &copy);
+            free(buf);
+            if (s == fmi2OK) {
+                fmi2FreeFMUstate(c, &saved);
+                saved = copy;
+            }
+        } else if (!strcmp(cmd, "reset")) {
+            s = fmi2Reset(c);
+            time = 0.0;
+        } else if (!strcmp(cmd, "term")) {
+            s = fmi2Terminate(c);
+        } else if (!strcmp(cmd, "laststatus")) {
+            int terminated = -1;
+            double last = -1.0;
+            fmi2Status s1 = fmi2GetBooleanStatus(c, 3 /* fmi2Terminated */, &terminated);
+            fmi2Status s2 = fmi2GetRealStatus(c, 2 /* fmi2LastSuccessfulTime */, &last);
+            printf("{\"cmd\": \"laststatus\", \"status\": %d, \"terminated\": %d, \"last_time\": %.17g}\n",
+                   (int)(s1 > s2 ? s1 : s2), terminated, last);
+            fflush(stdout);
+            continue;
+        } else {
+            printf("{\"cmd\": \"%s\", \"error\": \"unknown command\"}\n", cmd);
+            continue;
+        }
+        printf("{\"cmd\": \"%s\", \"status\": %d}\n", cmd, (int)s);
+        fflush(stdout);
+    }
+    if (c) {
+        if (saved) fmi2FreeFMUstate(c, &saved);
+        fmi2FreeInstance(c);
+    }
+    dlclose(lib);
+    printf("{\"exit\": 0}\n");
+    return 0;
+}

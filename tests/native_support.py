@@ -1,0 +1,119 @@
+"""Helpers for the tests of cam.fmu's own linux64 binary (tests/test_native_*.py).
+
+Tools that CI installs (gcc, valgrind, ecos + libtbb12, libcosimpy) are required:
+a missing one FAILS the test, it never skips.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence
+from xml.etree import ElementTree as ET
+
+import pytest
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+HOST_C = HERE / "native_host" / "host.c"
+SUPPRESSIONS = HERE / "native_host" / "valgrind.supp"
+EMPTY_ENV = {"PATH": "/usr/bin:/bin"}  # what `env -i PATH=/usr/bin:/bin` leaves
+
+
+def require(tool: str) -> str:
+    path = shutil.which(tool)
+    if not path:
+        pytest.fail(f"{tool} is not installed: CI installs it (./setup.sh); the native-host tests need it")
+    return path
+
+
+def ecos_path() -> Path:
+    try:
+        import ecospy
+    except ImportError:
+        pytest.fail("ecospy is not installed (pip install -e '.[test]')")
+    exe = Path(ecospy.__file__).parent / "binaries" / "ecos"
+    if not exe.is_file():
+        pytest.fail(f"no ecos binary at {exe}")
+    exe.chmod(exe.stat().st_mode | 0o111)
+    return exe
+
+
+def extract(fmu: Path, dest: Path) -> Path:
+    dest.mkdir(parents=True, exist_ok=True)
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(dest)
+    return dest
+
+
+def value_references(fmu_dir: Path) -> Dict[str, int]:
+    root = ET.parse(fmu_dir / "modelDescription.xml").getroot()
+    return {sv.get("name"): int(sv.get("valueReference")) for sv in root.iter("ScalarVariable")}
+
+
+def compile_host(dest: Path) -> Path:
+    gcc = require("gcc")
+    proc = subprocess.run([gcc, "-O1", "-g", "-Wall", "-o", str(dest), str(HOST_C), "-ldl", "-lm"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    return dest
+
+
+VALGRIND_OPTIONS = ["--error-limit=no", "--num-callers=40", "--leak-check=full", "--show-leak-kinds=definite",
+                    "--errors-for-leak-kinds=none", f"--suppressions={SUPPRESSIONS}"]
+OWN_CODE = ("fmi2_python.c", "/cam.so")  # frames of cam.fmu's binary in a valgrind stack
+
+
+def valgrind_prefix(log: Path, trace_children: bool = False) -> List[str]:
+    cmd = [require("valgrind"), *VALGRIND_OPTIONS, f"--log-file={log}"]
+    if trace_children:
+        cmd.append("--trace-children=yes")
+    return cmd
+
+
+def valgrind_summary(log: Path) -> dict:
+    """Errors (after the suppressions) and definitely lost bytes from a valgrind log (all processes)."""
+    text = log.read_text(errors="replace") if log.is_file() else ""
+    errors = sum(int(m) for m in re.findall(r"ERROR SUMMARY: (\d+) errors", text))
+    # definitely lost blocks allocated by cam.fmu's binary (numpy's module init leaks a few at every exit)
+    records = re.split(r"\n==\d+== \n", text)
+    own_lost = [r for r in records if "definitely lost in loss record" in r and any(o in r for o in OWN_CODE)]
+    lost = sum(int(re.search(r"([\d,]+) (?:\(\S+ direct, \S+ indirect\) )?bytes", r).group(1).replace(",", ""))
+               for r in own_lost)
+    kinds = sorted(set(re.findall(r"==\d+== (Invalid [a-z]+ of size \d+|Invalid free|Mismatched free"
+                                  r"|Use of uninitialised value[^\n]*|Conditional jump[^\n]*)", text)))
+    return {"errors": errors, "definitely_lost": lost, "kinds": kinds, "summaries": text.count("ERROR SUMMARY"),
+            "excerpt": text[-6000:]}
+
+
+def run_host(host: Path, fmu_dir: Path, *commands: str, env: Optional[dict] = None,
+             prefix: Sequence[str] = (), timeout: float = 900) -> dict:
+    """Run the C host; return its exit code, the JSON lines (commands, log messages) and stderr."""
+    proc = subprocess.run([*prefix, str(host), str(fmu_dir / "binaries" / "linux64" / "cam.so"),
+                           str(fmu_dir / "resources"), *commands],
+                          capture_output=True, text=True, env=EMPTY_ENV if env is None else env, timeout=timeout)
+    lines = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
+    return {"rc": proc.returncode, "lines": lines, "cmds": [x for x in lines if "cmd" in x],
+            "logs": [x for x in lines if "log" in x], "stderr": proc.stderr, "stdout": proc.stdout}
+
+
+def run_python(code: str, *args: str, cwd: Optional[Path] = None, env: Optional[dict] = None,
+               timeout: float = 900) -> dict:
+    """Run ``python -c code args`` (PYTHONPATH/PYTHONHOME removed) and return its last JSON line ({...} or [...])."""
+    if env is None:
+        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    proc = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd, env=env,
+                          timeout=timeout)
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    for line in reversed(proc.stdout.splitlines()):
+        if line.startswith(("{", "[")):
+            try:
+                return json.loads(line)
+            except json.JSONDecodeError:
+                continue  # a host's own log line
+    raise AssertionError("no JSON result\n" + proc.stdout[-3000:] + proc.stderr[-3000:])
