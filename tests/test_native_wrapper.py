@@ -120,7 +120,7 @@ def test_status_protocol_error_is_recoverable(fmu_dir, host, vr):
     assert _status(r, "restore") == [0] and _status(r, "reset") == [0]
     errors = [x for x in r["logs"] if x["log"] == 3]
     assert all(x["category"] == "logStatusError" for x in errors)
-    assert any("'u'" in x["msg"] and "finite" in x["msg"] for x in errors)   # logged with loggingOn = false
+    assert any("'u'" in x["msg"] and "allowed range" in x["msg"] for x in errors)   # logged with loggingOn = false
     assert any("'R'" in x["msg"] and "(0, 10000]" in x["msg"] for x in errors)
     assert any("not allowed after fmi2Error" in x["msg"] for x in errors)
     assert not [x for x in r["logs"] if x["log"] == 4]                    # never fmi2Fatal
@@ -307,7 +307,7 @@ def test_isolated_from_host_cam_fmu_and_other_builds(cam_fmu_path, tmp_path):
     # a second, different build (one bundled file differs -> different hash -> different private names)
     pkg = tmp_path / "src" / "cam_fmu"
     shutil.copytree(ROOT / "cam_fmu", pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    sim = pkg / "simulator.py"
+    sim = pkg / "fmu" / "engine.py"
     sim.write_text(sim.read_text(encoding="utf-8") + "\n# second build\n", encoding="utf-8")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--package-dir", str(pkg),
@@ -318,8 +318,9 @@ def test_isolated_from_host_cam_fmu_and_other_builds(cam_fmu_path, tmp_path):
     fake = tmp_path / "hostsite" / "cam_fmu"
     fake.mkdir(parents=True)
     (fake / "__init__.py").write_text("USED = False\n")
-    (fake / "simulator.py").write_text("raise RuntimeError('the host cam_fmu was imported by the FMU')\n")
-    (fake / "parameters.py").write_text("raise RuntimeError('the host cam_fmu was imported by the FMU')\n")
+    for sub in ("fmu", "physics"):  # the host's own cam_fmu, which the FMU must never import
+        (fake / sub).mkdir()
+        (fake / sub / "__init__.py").write_text("raise RuntimeError('the host cam_fmu was imported by the FMU')\n")
     r = run_python(ISOLATION, str(tmp_path / "a" / "cam.fmu"), str(tmp_path / "b" / "cam.fmu"),
                    str(fake.parent), cwd=tmp_path)
     assert r["a_end"] == pytest.approx(0.05, abs=1e-12)

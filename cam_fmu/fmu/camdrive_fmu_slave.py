@@ -101,7 +101,8 @@ class CamDriveSlave(Fmi2Slave):
         for name, _unit, desc in _variables.OUTPUTS:
             self.register_variable(Real(
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-                initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(name)))
+                initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(name),
+                setter=self._output_setter(name)))
         kinds = {"real": Real, "boolean": Boolean, "string": String}
         for spec in _parameters.PARAMETERS:
             self.register_variable(kinds[spec.kind](
@@ -127,6 +128,12 @@ class CamDriveSlave(Fmi2Slave):
                 self._build()  # outputs are 'calculated' from the parameters at start time
             return self._outputs[name]
         return getter
+
+    def _output_setter(self, name: str):
+        def setter(_value: Any) -> None:
+            self._fail(f"variable {name!r} is an output: it cannot be set (set the inputs "
+                       f"{', '.join(repr(n) for n in _variables.INPUT_NAMES)} or the parameters)")
+        return setter
 
     def _param_getter(self, name: str):
         return lambda: self._params[name]
@@ -183,6 +190,9 @@ class CamDriveSlave(Fmi2Slave):
 
     # ----------------------------------------------------------------- FMI calls
     def exit_initialization_mode(self) -> None:
+        if self._initialized:
+            self._fail("fmi2ExitInitializationMode was called again after initialisation: the instance is "
+                       "in step mode and keeps its state; use fmi2Reset to start over")
         self._build()
         self._initialized = True
 
@@ -202,6 +212,7 @@ class CamDriveSlave(Fmi2Slave):
 
     def _get_fmu_state(self) -> Dict[str, Any]:
         return {
+            "version": STATE_VERSION,
             "params": dict(self._params),
             "inputs": dict(self._inputs),
             "outputs": dict(self._outputs),
@@ -210,13 +221,37 @@ class CamDriveSlave(Fmi2Slave):
         }
 
     def _set_fmu_state(self, state: Dict[str, Any]) -> None:
-        self._params = dict(state["params"])
-        self._inputs = {k: float(v) for k, v in state["inputs"].items()}
-        self._outputs = {k: float(v) for k, v in state["outputs"].items()}
-        self._initialized = bool(state["initialized"])
-        if state["sim"] is None:
-            self._sim = None
-        else:
-            sim = _simulator.DriveSimulator(self._params)
-            sim.set_state(copy.deepcopy(state["sim"]))
-            self._sim = sim
+        """Restore a state, validated whole before anything changes (a bad blob is fmi2Error)."""
+        try:
+            params, inputs, outputs, initialized, sim = _checked_state(state)
+        except (KeyError, TypeError, ValueError, _parameters.ParameterError, _simulator.SimulationError) as exc:
+            self._fail(f"FMU state rejected: {exc}")
+        self._params, self._inputs, self._outputs = params, inputs, outputs
+        self._initialized, self._sim = initialized, sim
+
+
+STATE_VERSION = 2  # of the dictionary _get_fmu_state returns (serialised as JSON)
+
+
+def _checked_state(state: Any):
+    """(params, inputs, outputs, initialized, simulator) from a state, or an error naming what is wrong."""
+    if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
+        found = state.get("version") if isinstance(state, dict) else type(state).__name__
+        raise ValueError(f"state version {found!r}, expected {STATE_VERSION} (a state of another cam.fmu build?)")
+    params = {}
+    for name, value in dict(state["params"]).items():
+        if name not in _parameters.BY_NAME:
+            raise ValueError(f"unknown parameter {name!r}")
+        params[name] = _parameters.BY_NAME[name].check(value)
+    if set(params) != set(_parameters.BY_NAME):
+        raise ValueError(f"parameters missing: {sorted(set(_parameters.BY_NAME) - set(params))}")
+    inputs = {name: _variables.check_input(name, state["inputs"][name]) for name in _variables.INPUT_NAMES}
+    outputs = {name: float(state["outputs"][name]) for name in _variables.OUTPUT_NAMES}
+    bad = [name for name, value in outputs.items() if not math.isfinite(value)]
+    if bad:
+        raise ValueError(f"outputs {bad} are not finite")
+    sim = None
+    if state["sim"] is not None:
+        sim = _simulator.DriveSimulator(params)
+        sim.set_state(copy.deepcopy(state["sim"]))
+    return params, inputs, outputs, bool(state["initialized"]), sim

@@ -24,6 +24,7 @@ import math
 from typing import Any, Mapping
 
 from ..physics.drive import DriveModel
+from ..physics.energy import EnergyBudget
 from ..physics.formulations import formulation_for
 from ..physics.variables import INPUT_STARTS, INPUTS, OUTPUTS, check_input
 from ..solvers import SOLVERS, SimulationError
@@ -47,6 +48,7 @@ class DriveSimulator:
         self.steps_taken = 0  # internal steps, for benchmarks
         self._outputs: dict[str, float] | None = None
         self.formulation = formulation_for(model, self.u, self.omega_ref)
+        self.budget: EnergyBudget | None = None  # set at the first step (voltage drive)
 
     # ------------------------------------------------------------ public
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
@@ -65,14 +67,36 @@ class DriveSimulator:
         if not (math.isfinite(h) and h > 0.0):
             raise SimulationError(f"communication step size = {h!r} s: allowed (0, inf)")
         self.set_inputs(u, omega_ref, omega_dot_ref)
+        if self.budget is None and self.formulation.energy_bounded:
+            out = self.outputs()
+            self.budget = EnergyBudget(self.model, out["theta"], out["omega"], out["i"], out["s"], out["J"])
         self.steps_taken += self.formulation.advance(h, self.integrator, self.time)
         self.time = t + h
         self._outputs = None
-        for name, value in self.outputs().items():
+        out = self.outputs()
+        for name, value in out.items():
             if not math.isfinite(value):
                 raise SimulationError(
                     f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
                     f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
+        self._check_plausible(out, h)
+
+    def _check_plausible(self, out: dict[str, float], h: float) -> None:
+        """The bounds the model implies, on every published state; a violation is an error naming the cause."""
+        c = self.model.c
+        gap = abs(out["s"] - out["s_cam"])
+        if gap > c * (1.0 + 1e-9) + 1e-12:
+            raise SimulationError(
+                f"the follower is {gap:.6g} m from the cam at t = {self.time:g} s, beyond the clearance "
+                f"c = {c:g} m: a contact event was missed; {self.formulation.advice(self.stepper)}")
+        if self.budget is not None:
+            self.budget.step(self.u, h, out["theta"], out["i"])
+            excess, tolerance = self.budget.excess(out["omega"], out["s"], out["J"], out["i"])
+            if excess > tolerance:
+                raise SimulationError(
+                    f"the state at t = {self.time:g} s holds {excess:.6g} J more energy than the source "
+                    f"delivered (tolerance {tolerance:.3g} J): energy was created, the result cannot be "
+                    f"trusted; {self.formulation.advice(self.stepper)}")
 
     def outputs(self) -> dict[str, float]:
         """Current value of every output in OUTPUTS (computed once per state)."""
@@ -87,9 +111,14 @@ class DriveSimulator:
             "h_next": self.stepper.h_next, "steps_taken": self.steps_taken,
         }
         state.update(self.formulation.get_state())
+        state["energy"] = None if self.budget is None else self.budget.to_dict()
         return state
 
     def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from get_state; SimulationError names what is wrong (checked before use)."""
+        for key in ("time", "u", "omega_ref", "omega_dot_ref", "h_next"):
+            if not math.isfinite(float(state[key])):
+                raise SimulationError(f"state entry {key!r} = {state[key]!r} is not finite")
         self._outputs = None
         self.integrator.fsal = None
         self.time = float(state["time"])
@@ -99,6 +128,13 @@ class DriveSimulator:
         self.stepper.h_next = float(state["h_next"])
         self.steps_taken = int(state["steps_taken"])
         self.formulation.set_state(dict(state))
+        energy = state.get("energy")
+        if energy is None:
+            self.budget = None
+        else:
+            out = self.outputs()
+            self.budget = EnergyBudget(self.model, out["theta"], out["omega"], out["i"], out["s"], out["J"])
+            self.budget.restore(energy)
 
 
 def _finite(name: str, value: float) -> float:

@@ -13,6 +13,13 @@ from typing import Any
 class Formulation:
     """One way of computing the drive's motion. Subclasses implement every method."""
 
+    energy_bounded = False  # True: a voltage drive, whose states respect physics.energy's bound
+
+    def advice(self, stepper: Any) -> str:
+        """What to change when a state breaks a bound the model implies (names the setting)."""
+        return (f"solver {stepper.name!r} with h_max = {stepper.h_max:g} s: reduce h_max or the "
+                "communication step, or use solver 'rk45'")
+
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
         """Inputs held from now on [V, rad/s, rad/s2] (they may re-decide stick/slip)."""
         raise NotImplementedError

@@ -19,7 +19,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from ...errors import StepRejected
+from ...errors import SimulationError, StepRejected
 from ..drive import DriveModel
 from ..variables import output_record
 from .base import Formulation
@@ -304,6 +304,8 @@ class HybridDrive:
 class ConsistentVoltage(Formulation):
     """The energy-consistent drive under the voltage input u, stepped by the engine's integrator."""
 
+    energy_bounded = True
+
     def __init__(self, model: DriveModel, u: float) -> None:
         p = model.params
         self.hybrid = HybridDrive(model)
@@ -333,6 +335,13 @@ class ConsistentVoltage(Formulation):
 
     def set_state(self, state: dict[str, Any]) -> None:
         """The engine's state: this formulation's entries and the input held."""
-        self.u = float(state["u"])
-        self.y = [float(x) for x in state["y"]]
-        self.mode = Mode(**state["mode"])
+        y = [float(x) for x in state["y"]]
+        if len(y) != self.hybrid.size:
+            raise SimulationError(f"state 'y' has length {len(y)}, this drive's state has {self.hybrid.size} "
+                                  "(theta, omega" + (", i)" if self.hybrid.has_current else ")"))
+        mode = Mode(**state["mode"])
+        values = y + [mode.s_free, mode.direction, mode.side]
+        if not all(math.isfinite(v) for v in values) or mode.direction not in (1.0, -1.0) \
+                or mode.side not in (1.0, -1.0) or mode.contact not in (-1, 0, 1):
+            raise SimulationError(f"state 'y' = {y} or mode {mode} is not finite or not a valid mode")
+        self.u, self.y, self.mode = float(state["u"]), y, mode

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ...errors import StepRejected
+from ...errors import SimulationError, StepRejected
 from ..contact import play
 from ..drive import DriveModel, sign, solve_guide_friction
 from ..variables import output_record
@@ -51,8 +51,12 @@ class PaperScheme:
         return {name: getattr(self, name) for name in self.FIELDS + ("M_l",)}
 
     def set_state(self, state: dict[str, Any]) -> None:
-        for name, value in state.items():
-            setattr(self, name, float(value))
+        values = {name: float(state[name]) for name in self.FIELDS + ("M_l",)}
+        bad = [name for name, value in values.items() if not math.isfinite(value)]
+        if bad:
+            raise SimulationError(f"state entries {bad} of the paper scheme are not finite")
+        for name, value in values.items():
+            setattr(self, name, value)
 
     def _shaft_friction(self, drive_torque: float) -> float | None:
         """M_f with its sign, or None when the shaft stays stuck this step."""
@@ -182,6 +186,8 @@ def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J:
 class PaperVoltage(Formulation):
     """The paper's algorithm under the voltage input u, with T = the largest step <= h_max dividing h."""
 
+    energy_bounded = True
+
     def __init__(self, model: DriveModel, u: float) -> None:
         p = model.params
         self.scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
@@ -191,6 +197,11 @@ class PaperVoltage(Formulation):
 
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
         self.u = u
+
+    def advice(self, stepper: Any) -> str:
+        return (f"the paper formulation (the published steps 1-9, whose eq. (12) lags the follower's inertia "
+                f"by a calculation step of h_max = {self.h_max:g} s) is not trustworthy here: reduce h_max, "
+                "or use formulation 'consistent'")
 
     def advance(self, h: float, integrator: Any, time: float) -> int:
         n = max(1, math.ceil(h / self.h_max - 1e-9))

@@ -5,8 +5,10 @@ ramp of omega is exact in co-simulation (docs/model.md section 8).
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
+from ...errors import SimulationError
 from ..contact import follower_along, speed_engaged
 from ..drive import DriveModel
 from ..variables import output_record
@@ -67,6 +69,10 @@ class SpeedDrive(Formulation):
 
     def set_state(self, state: dict[str, Any]) -> None:
         """The engine's state: this formulation's entries and the inputs held."""
+        names = ("theta", "s", "speed", "omega_ref", "omega_dot_ref")
+        bad = [name for name in names if not math.isfinite(float(state[name]))]
+        if bad:
+            raise SimulationError(f"state entries {bad} of the speed drive are not finite")
         self.theta = float(state["theta"])
         self.s = float(state["s"])
         self.speed = float(state["speed"])
