@@ -187,7 +187,9 @@ class HybridDrive:
         c = self.model.c
         if mode.contact == 0:
             return (stop, mode.s_free - (s - c), (s + c) - mode.s_free)
-        return (stop, mode.contact * s1 * y[OMEGA]) + side
+        # s1 times the direction held between events, not times omega: at a stop omega = 0 would
+        # zero both functions at once (a tie the reference broke the other way); the stop decides there.
+        return (stop, mode.contact * s1 * mode.direction) + side
 
     def _side_value(self, y, u: float, mode: Mode, side: float | None = None) -> float:
         """mode.side times the side force N_r [N] on that branch: > 0 while the branch holds."""
