@@ -3,8 +3,8 @@
 The ``ecospy`` wheel ships the ``ecos`` command-line program in
 ``ecospy/binaries/ecos`` (not executable as installed: it is chmod-ed here, or
 copied to a cache directory when site-packages is read-only). It needs Debian's
-``libtbb12``. ecos loads the FMU's binary directly, so the embedded Python needs
-the environment of :mod:`cam_fmu.tools.host_env` (libpython preloaded).
+``libtbb12``. ecos loads the FMU's binary directly; it runs here in
+an empty environment (``PATH=/usr/bin:/bin`` only): cam.fmu's own binary needs no set-up.
 
 ``ecos simulate --path FMU --stopTime T --stepSize H`` writes ``<name>.csv`` in
 its working directory (columns ``iterations, time, instance::omega[REAL], ...``,
@@ -26,7 +26,6 @@ from typing import Dict, List, Optional, Sequence
 
 import numpy as np
 
-from .host_env import host_env
 
 
 class EcosError(RuntimeError):
@@ -119,8 +118,9 @@ def simulate(fmu: Path, stop_time: float, step_size: float, start_time: float = 
         raise EcosError("ecos needs at least 10 steps (it crashes in its progress report otherwise)")
     fmu = Path(fmu).resolve()
     binary = ecos_binary()
-    run_env = dict(os.environ)
-    run_env.update(host_env() if env is None else env)
+    # An empty environment, as a new user's tool would have: cam.fmu's own binary finds the Python
+    # recorded at build time by itself (docs/fmu.md). ``env`` adds to the caller's environment instead.
+    run_env = {"PATH": "/usr/bin:/bin"} if env is None else {**os.environ, **env}
     command = [str(binary), "simulate", "--path", str(fmu), "--startTime", repr(float(start_time)),
                "--stopTime", repr(float(stop_time)), "--stepSize", repr(float(step_size)), *extra_args]
     with tempfile.TemporaryDirectory(prefix="cam_fmu_ecos_") as tmp:
