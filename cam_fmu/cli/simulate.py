@@ -6,6 +6,11 @@ theta, omega, s, i, M, J, then the remaining outputs of physics.variables.OUTPUT
 SI units, named in the header: ``time [s],theta [rad],omega [rad/s],...``
 (experiments.columns; the units come from physics.variables.UNITS).
 ``--set NAME=VALUE`` (repeatable) overrides a parameter in every run of the scene.
+
+Progress: a bar on stderr (experiments.progress.ProgressBar), per run on the
+reference engine and per communication step on the FMU, drawn only when stderr
+is a terminal or CAM_FMU_PROGRESS=1 (CAM_FMU_PROGRESS=0: never). In pipes and
+tests stderr carries nothing but the one error line; stdout lists the files.
 """
 from __future__ import annotations
 
@@ -80,18 +85,24 @@ def csv_path(out: Path, scene_name: str, label: str | None) -> Path:
 
 
 def run(args) -> int:
+    from ..experiments.progress import ProgressBar
     from ..experiments.runner import EngineError, run_scene
     from ..experiments.scenes import SceneError, find_scene
 
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {args.out!r} exists and is not a directory")
+    bar = None
     try:
         scene = apply_sets(find_scene(args.scene), args.set)
         if args.stop_time is not None:
             scene = scene.with_stop_time(args.stop_time)
-        results = run_scene(scene, args.engine, args.fmu)
+        unit = "runs" if args.engine == "reference" else "steps"
+        bar = ProgressBar(f"simulate {scene.name} ({args.engine}, {unit})")
+        results = run_scene(scene, args.engine, args.fmu, progress=bar)
     except (SceneError, EngineError, ValueError) as exc:
+        if bar is not None:
+            bar.close()
         print(f"cam-fmu simulate: error: {exc}", file=sys.stderr)
         return 2
     out.mkdir(parents=True, exist_ok=True)

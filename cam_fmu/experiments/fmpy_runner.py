@@ -64,8 +64,10 @@ class FmuRunner:
         self.fresh = True
 
     def simulate(self, start_values: dict[str, Any], stop_time: float, output_interval: float, inputs: Any,
-                 outputs: Sequence[str] | None = None, check_end: bool = False) -> Any:
-        """fmpy's result array; ``check_end``: raise FmuRunError when the run stopped before stop_time."""
+                 outputs: Sequence[str] | None = None, check_end: bool = False,
+                 on_step: Callable[[float], None] | None = None) -> Any:
+        """fmpy's result array; ``check_end``: raise FmuRunError when the run stopped before stop_time;
+        ``on_step(time)``: called after every communication step (progress)."""
         from fmpy import simulate_fmu
 
         if not self.fresh:
@@ -75,13 +77,15 @@ class FmuRunner:
 
         def step_finished(time: float, _recorder: Any) -> bool:
             reached[0] = time
+            if on_step is not None:
+                on_step(time)
             return True
 
         result = simulate_fmu(self.unzipdir, model_description=self.md, fmu_instance=self.fmu,
                               start_values=start_values, start_time=0.0, stop_time=stop_time,
                               output_interval=output_interval, input=inputs,
                               output=list(outputs) if outputs is not None else None,
-                              step_finished=step_finished if check_end else None)
+                              step_finished=step_finished if check_end or on_step is not None else None)
         if check_end and not math.isclose(reached[0], stop_time, rel_tol=1e-9, abs_tol=1e-12):
             raise FmuRunError(f"the FMU stopped at t = {reached[0]:g} s before stop_time = {stop_time:g} s")
         return result

@@ -15,6 +15,7 @@ class ProgressBar:
             os.environ.get("CAM_FMU_PROGRESS") != "0" and hasattr(self.stream, "isatty") and self.stream.isatty())
         self.start = time.monotonic()
         self.last = 0.0
+        self.open = False  # a line drawn and not yet finished with its newline
 
     def __call__(self, done: int, total: int) -> None:
         if not self.enabled:
@@ -29,6 +30,14 @@ class ProgressBar:
         eta = elapsed / frac - elapsed if frac > 0 else float("nan")
         self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} "
                           f"{elapsed:5.1f} s, {eta:5.1f} s left ")
-        if done >= total:
+        self.open = done < total
+        if not self.open:
             self.stream.write("\n")
         self.stream.flush()
+
+    def close(self) -> None:
+        """End an unfinished line (a run that failed), so that what follows starts on its own line."""
+        if self.open:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.open = False

@@ -16,7 +16,7 @@ holds 'time' and every name of physics.variables.OUTPUTS, in SI units.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Mapping
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -32,17 +32,30 @@ class EngineError(RuntimeError):
     """A run that did not complete; the message names the scene, the run and the engine."""
 
 
-def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | None = None) -> dict[str, dict[str, np.ndarray]]:
-    """Every run of ``scene`` on ``engine`` ('reference' or 'fmu'), keyed by run label."""
+def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | None = None,
+              progress: Callable[[int, int], None] | None = None) -> dict[str, dict[str, np.ndarray]]:
+    """Every run of ``scene`` on ``engine`` ('reference' or 'fmu'), keyed by run label.
+
+    ``progress(done, total)`` (e.g. progress.ProgressBar) is called as the work goes on:
+    per run on the reference (one scipy call per run: done/total = runs), per
+    communication step on the FMU (done/total = steps over all runs)."""
     if engine not in ENGINES:
         raise ValueError(f"engine {engine!r}: allowed {', '.join(map(repr, ENGINES))}")
     if engine == "reference":
-        return {run.label: _reference(scene, run) for run in scene.runs}
+        results = {}
+        total = len(scene.runs)
+        if progress is not None:
+            progress(0, total)
+        for k, run in enumerate(scene.runs, start=1):
+            results[run.label] = _reference(scene, run)
+            if progress is not None:
+                progress(k, total)
+        return results
     try:
         fmu = ensure_fmu(fmu_path)
     except FmuFileError as exc:
         raise EngineError(str(exc)) from None
-    return _fmu_runs(scene, fmu)
+    return _fmu_runs(scene, fmu, progress)
 
 
 # ------------------------------------------------------------------ reference
@@ -98,7 +111,7 @@ def _left_value(sig: Signal, t: float) -> float:
     return sig.values[k]  # first of the repeated stamps: the value before the jump
 
 
-def _fmu_runs(scene: Scene, fmu: Path) -> dict[str, dict[str, np.ndarray]]:
+def _fmu_runs(scene: Scene, fmu: Path, progress: Callable[[int, int], None] | None = None) -> dict[str, dict[str, np.ndarray]]:
     """All runs on one instance of the FMU, reset between runs.
 
     No fmi2FreeInstance: with it, the process aborted at exit in about half of
@@ -109,10 +122,18 @@ def _fmu_runs(scene: Scene, fmu: Path) -> dict[str, dict[str, np.ndarray]]:
 
     runner = FmuRunner(fmu, name=scene.name)
     results = {}
-    for run in scene.runs:
+    steps = max(1, round(scene.stop_time / scene.output_interval))
+    total = steps * len(scene.runs)
+    for k, run in enumerate(scene.runs):
+        on_step = None
+        if progress is not None:
+            progress(k * steps, total)
+
+            def on_step(time: float, _base: int = k * steps) -> None:
+                progress(min(total, _base + round(time / scene.output_interval)), total)
         try:
             result = runner.simulate(run.start_values(), scene.stop_time, scene.output_interval,
-                                     input_table(scene), outputs=OUTPUT_NAMES, check_end=True)
+                                     input_table(scene), outputs=OUTPUT_NAMES, check_end=True, on_step=on_step)
         except Exception as exc:  # noqa: BLE001 - re-raised with the scene and run named
             raise EngineError(f"scene {scene.name!r}, run {run.label!r}, engine 'fmu' ({fmu}): {exc}") from exc
         results[run.label] = {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}

@@ -134,16 +134,30 @@ def plot(rows: list[dict], path: Path) -> None:
         ax.axhline(TARGET_ERR, color="k", linestyle="--", linewidth=0.8)
         ax.axhspan(1e-10, 1e-8, color="0.9", zorder=0)
         ax.set_ylim(1e-10, None)
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.text(0.02, 0.02, "below the reference's own accuracy (~1e-8 rad)", transform=ax.transAxes,
                 fontsize=7, color="0.4")
         ax.set_title(f"{case}")
-        ax.set_xlabel("cost ratio (us per comm step / trivial slave's)")
+        ax.set_xlabel("cost ratio [-]\n(us per comm step / trivial slave's us per comm step)")
         ax.set_ylabel("max |theta - theta_ref| [rad]")
-        ax.grid(True, which="both", alpha=0.3)
+        log_ticks(ax, matplotlib.ticker)
+        ax.grid(True, which="major", alpha=0.4)
+        ax.grid(True, which="minor", alpha=0.15)
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=7, frameon=False)
+    # below the axes, outside them; bbox_inches="tight" grows the canvas so nothing is clipped
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=min(4, max(1, len(labels))),
+               fontsize=8, frameon=False)
     fig.suptitle("cam.fmu through fmpy: theta error against cost (dashed: 1e-6 rad target)")
-    fig.tight_layout(rect=(0, 0.12, 1, 0.95))
-    fig.savefig(path, dpi=110)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
+
+
+def log_ticks(ax, ticker) -> None:
+    """Both log axes: a labelled major tick at every decade (10^k); minor ticks labelled too
+    when the axis spans less than about one decade (else it could carry no number at all)."""
+    for axis in (ax.xaxis, ax.yaxis):
+        axis.set_major_locator(ticker.LogLocator(base=10.0, numticks=30))
+        axis.set_major_formatter(ticker.LogFormatterSciNotation(base=10.0))
+        axis.set_minor_locator(ticker.LogLocator(base=10.0, subs=tuple(range(2, 10)), numticks=30))
+        axis.set_minor_formatter(ticker.LogFormatterSciNotation(base=10.0, labelOnlyBase=False,
+                                                                 minor_thresholds=(1.0, 0.5)))
