@@ -109,6 +109,7 @@ class _Consistent:
         k_out = 0
         breaks = [b for b in u.breaks if 0.0 < b < stop] + [stop]
         events_seen = 0
+        stalled, t_event_last = 0, -math.inf  # events at one instant in a row
         input_changed = True  # at the start and at each input break: decide stick/slip anew
         while True:
             u_now = u.value(t)
@@ -155,6 +156,11 @@ class _Consistent:
             t = t_stop
             input_changed = sol.status != 1
             if sol.status == 1:
+                stalled = stalled + 1 if t_stop <= t_event_last else 0
+                t_event_last = t_stop
+                if stalled > 1000:  # events at one instant without end (Zeno): never a hang
+                    raise RuntimeError(f"reference integration: more than 1000 events at t = {t_stop!r} s "
+                                       f"without progress (last mode {mode})")
                 fired = [k for k, te in enumerate(sol.t_events) if len(te)]
                 k = min(fired, key=lambda j: sol.t_events[j][0])
                 y = list(sol.y_events[k][0])

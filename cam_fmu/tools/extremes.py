@@ -170,6 +170,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cam_fmu.tools.extremes", description=__doc__.split("\n\n")[0])
     parser.add_argument("--minutes", type=float, default=5.0, help="how long to run (default 5)")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--trace", action="store_true", help="print each case before running it (find a hang)")
     args = parser.parse_args(argv)
     rng = random.Random(args.seed)
     end = time.monotonic() + 60.0 * args.minutes
@@ -177,10 +178,15 @@ def main(argv: list[str] | None = None) -> int:
     while time.monotonic() < end:
         case = draw(rng)
         runs += 1
+        if args.trace:
+            print(f"case {runs}: {case}", flush=True)
+        started = time.monotonic()
         try:
             problem = check(case)
         except Exception as exc:  # noqa: BLE001 - any other exception breaks the property
             problem = f"{type(exc).__name__}: {exc}"
+        if time.monotonic() - started > 30.0:
+            print(f"SLOW {time.monotonic() - started:.0f} s: {case}", flush=True)
         if problem:
             failures += 1
             print(f"FAIL {problem}\n     {case}", flush=True)

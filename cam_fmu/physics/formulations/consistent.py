@@ -261,7 +261,14 @@ class HybridDrive:
         if direction == 0.0 and at_threshold:
             forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, engaged)
             backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, engaged)
-            direction = 1.0 if forward >= backward else -1.0
+            if forward == backward and self.has_current:
+                # A tie (no shaft friction, zero torque as the current passes through 0): the
+                # shaft goes where the current is heading. Taking +1 here made the reference
+                # chatter forever between the break-away and a stop at one instant.
+                rate = self.motor.current_rate(u, y[CURRENT], 0.0)
+                direction = 1.0 if rate > 0.0 else (-1.0 if rate < 0.0 else 0.0)
+            else:
+                direction = 1.0 if forward >= backward else -1.0
         if direction == 0.0:
             return
         leaves = False
