@@ -121,7 +121,7 @@ def test_status_protocol_error_is_recoverable(fmu_dir, host, vr):
     errors = [x for x in r["logs"] if x["log"] == 3]
     assert all(x["category"] == "logStatusError" for x in errors)
     assert any("'u'" in x["msg"] and "allowed range" in x["msg"] for x in errors)   # logged with loggingOn = false
-    assert any("'R'" in x["msg"] and "(0, 10000]" in x["msg"] for x in errors)
+    assert any("'R'" in x["msg"] and "[0.001, 10000]" in x["msg"] for x in errors)  # physical range (issue 9)
     assert any("not allowed after fmi2Error" in x["msg"] for x in errors)
     assert not [x for x in r["logs"] if x["log"] == 4]                    # never fmi2Fatal
 

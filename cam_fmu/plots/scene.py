@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
+from . import save_figure
 
 if TYPE_CHECKING:
     from ..experiments.scenes import Scene
@@ -132,12 +133,7 @@ def plot_scene(scene: "Scene", results: Results, path: str | Path, engine: str =
     if not title.startswith(scene.name):
         title = f"{scene.name}: {title}"
     fig.suptitle(f"{title}\n(engine: {engine})", fontsize=10)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(plt, fig, path)
 
 
 def draw_scene(plt: Any, scene: "Scene", results: Results) -> Any:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
+from . import save_figure
 
 
 def plot_speed_loop(runs: Mapping[str, Mapping[str, np.ndarray]], omega_set: Mapping[str, float],
@@ -45,9 +46,4 @@ def plot_speed_loop(runs: Mapping[str, Mapping[str, np.ndarray]], omega_set: Map
         ax.set_ylim(ulo, uhi)
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(plt, fig, path)

@@ -29,6 +29,7 @@ class Euler(Stepper):
     name = "euler"
     stability = 1.0
     resolution = 0.01  # first order: 40 % off at 100 V with 0.1 (measured), 2e-4 rad at 3.5 V with 0.01
+    promised_relative = 0.25  # first order: 9 % measured at 100 V
 
     def step(self, f, y, dt, system, u, mode):
         return euler_step(f, y, dt)
@@ -40,6 +41,7 @@ class RK4(Stepper):
     name = "rk4"
     stability = 2.5
     resolution = 0.1  # 100 V: 4e-3 rad of 68 (was 29 rad off with the stability limit alone)
+    promised_relative = 1e-2  # 6e-5 measured at 100 V
 
     def step(self, f, y, dt, system, u, mode):
         return rk4_step(f, y, dt)

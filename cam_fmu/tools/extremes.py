@@ -65,9 +65,9 @@ def draw(rng: random.Random) -> Case:
     params["max_steps"] = 2000.0
     kind = rng.random()
     if kind < 0.15:
-        params["drive"] = "speed"
+        params["drive"] = BY_NAME["drive"].choices[-1]  # the speed drive
     elif kind < 0.3:
-        params["formulation"] = "paper"
+        params["formulation"] = BY_NAME["formulation"].choices[-1]  # the paper's algorithm
     comm = math.exp(rng.uniform(math.log(1e-4), math.log(1e-2)))
     stop = comm * rng.randint(5, 60)
     u_steps = [(0.0, rng.uniform(-30.0, 60.0))]
@@ -114,19 +114,23 @@ def names_a_cause(message: str) -> bool:
 def promised(case: Case, theta_span: float) -> float:
     """The largest |theta - theta_ref| [rad] the settings promise over the run.
 
-    rk45: error control at rtol (1e4 rtol per radian turned covers error growth over the run);
-    fixed-step solvers: their stability and resolution limits bound the relative error (rk4 and
-    etdrk4 1 %, euler 20 %: measured 6e-5, 2.5e-4 and 9 % at 100 and 400 V); the paper
-    formulation and the speed drive are their own references (rounding only).
+    rk45 (adaptive): error control at rtol (1e4 rtol per radian turned covers error growth over
+    the run); fixed-step solvers: the relative error their stability and resolution limits keep
+    (``Stepper.promised_relative``); a formulation that is its own reference (the paper
+    formulation, the speed drive): rounding only.
     """
-    p = case.params
+    from ..physics.drive import DriveModel
+    from ..physics.formulations import FORMULATIONS, formulation_name
+    from ..solvers import SOLVERS
+
     scale = 1.0 + theta_span
-    if p.get("drive") == "speed" or p.get("formulation") == "paper":
+    model = DriveModel(case.params)
+    if FORMULATIONS[formulation_name(model)].own_reference:
         return 1e-9 * scale
-    solver = p["solver"]
-    if solver == "rk45":
-        return 1e4 * p["rtol"] * scale + 1e-8
-    return (0.25 if solver == "euler" else 1e-2) * scale
+    stepper = SOLVERS[model.params["solver"]]
+    if stepper.adaptive:
+        return 1e4 * model.params["rtol"] * scale + 1e-8
+    return stepper.promised_relative * scale
 
 
 def reference_thetas(case: Case, rtol: float = 1e-12) -> list[float]:

@@ -14,6 +14,7 @@ class Formulation:
     """One way of computing the drive's motion. Subclasses implement every method."""
 
     energy_bounded = False  # True: a voltage drive, whose states respect physics.energy's bound
+    own_reference = False  # True: its reference is the same algorithm (agreement to rounding)
 
     def advice(self, stepper: Any) -> str:
         """What to change when a state breaks a bound the model implies (names the setting)."""

@@ -186,6 +186,8 @@ def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J:
 class PaperVoltage(Formulation):
     """The paper's algorithm under the voltage input u, with T = the largest step <= h_max dividing h."""
 
+    own_reference = True
+
     energy_bounded = True
 
     def __init__(self, model: DriveModel, u: float) -> None:

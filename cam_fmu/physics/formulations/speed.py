@@ -39,6 +39,8 @@ def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot
 class SpeedDrive(Formulation):
     """theta follows omega_ref + omega_dot_ref t; the play operator sees every extremum of s_cam."""
 
+    own_reference = True
+
     def __init__(self, model: DriveModel, omega_ref: float) -> None:
         self.model = model
         self.theta = model.params["theta0"]
