@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
+
 from . import save_figure
 
 
