@@ -218,3 +218,26 @@ def test_progress_bar_close_ends_an_open_line():
     assert stream.getvalue().endswith("\n") and stream.getvalue().count("\n") == 1
     bar.close()
     assert stream.getvalue().count("\n") == 1
+
+
+def test_the_paper_figures_of_the_speed_drive_show_the_voltage_needed():
+    """fig4 and fig5 (speed-drive scenes) carry a voltage panel over the cam angle."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cam_fmu.experiments.runner import run_scene
+    from cam_fmu.experiments.scenes import find_scene
+    from cam_fmu.plots.scene import PLOTS
+
+    for kind, name in (("fig4", "paper_fig4"), ("fig5", "paper_fig5a")):
+        scene = find_scene(name)
+        assert scene.drive == "speed"
+        results = run_scene(scene.with_stop_time(1.0), "reference")
+        fig, axes = PLOTS[kind](plt, results, scene.drive)
+        labels = [ax.get_ylabel() for ax in axes]
+        assert "voltage [V]" in labels, labels
+        line = axes[labels.index("voltage [V]")].get_lines()[0]
+        first = next(iter(results.values()))
+        assert np.allclose(line.get_ydata(), first["voltage"])
+        plt.close(fig)

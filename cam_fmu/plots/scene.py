@@ -29,7 +29,7 @@ Results = Mapping[str, Mapping[str, np.ndarray]]
 
 
 def _fig4(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, list]:
-    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    fig, axes = plt.subplots(3, 1, figsize=(8, 9.5), sharex=True)
     for label, r in results.items():
         deg = np.degrees(r["theta"])
         name = None if len(results) == 1 else label
@@ -39,19 +39,28 @@ def _fig4(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, list]:
     axes[0].set_title("(a) J(theta) = J_m + m (ds/dtheta)$^2$")
     axes[1].set_ylabel("load torque M [N m]")
     axes[1].set_title("(b) total load torque M = M_f sgn(omega) + M_l")
-    axes[1].set_xlabel("cam angle theta [deg]")
-    _theta_ticks(axes[1])
+    _voltage_panel(axes[2], results)
+    _theta_ticks(axes[2])
     return fig, list(axes)
 
 
 def _fig5(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, list]:
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, (ax, volts) = plt.subplots(2, 1, figsize=(8, 7.5), sharex=True, height_ratios=(2, 1))
     for label, r in results.items():
         ax.plot(np.degrees(r["theta"]), r["M"], label=label)
-    ax.set_xlabel("cam angle theta [deg]")
     ax.set_ylabel("load torque M [N m]")
-    _theta_ticks(ax)
-    return fig, [ax]
+    _voltage_panel(volts, results)
+    _theta_ticks(volts)
+    return fig, [ax, volts]
+
+
+def _voltage_panel(ax: Any, results: Results) -> None:
+    """The armature voltage the imposed motion needs, over the cam angle (speed drive)."""
+    for label, r in results.items():
+        ax.plot(np.degrees(r["theta"]), r["voltage"], label=None if len(results) == 1 else label)
+    ax.set_ylabel("voltage [V]")
+    ax.set_title("armature voltage the imposed speed needs (R i + c_e omega + L di/dt)", fontsize=9)
+    ax.set_xlabel("cam angle theta [deg]")
 
 
 def _fig6(plt: Any, results: Results, drive: str = "voltage") -> tuple[Any, list]:
