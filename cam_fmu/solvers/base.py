@@ -46,6 +46,9 @@ class Stepper:
     # Fixed-step methods: the cam turns at most this fraction of the profile's finest angular
     # detail per internal step (an accuracy limit: a step cannot resolve a shorter feature).
     resolution: ClassVar[float] = math.inf
+    # A fixed-step method without resolution sub-steps refuses (SimulationError naming h_max) a step
+    # that sweeps more than this fraction of the profile's finest feature.
+    max_sweep: ClassVar[float] = math.inf
     # The relative theta error its limits keep a run within (fixed-step methods; measured at 100 and
     # 400 V against the reference, docs/performance.md); an adaptive method promises ~ its rtol instead.
     promised_relative: ClassVar[float] = math.inf

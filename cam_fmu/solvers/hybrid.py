@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .base import HybridSystem, StepRejected, Stepper
+from .base import HybridSystem, SimulationError, StepRejected, Stepper
 from .events import locate
 
 
@@ -114,6 +114,13 @@ class HybridIntegrator:
             else:
                 rate_end = sweep_end = math.inf
             if (dt * rate_end <= 1.25 * stab and dt * sweep_end <= 1.25 * res) or retries >= 30:
+                swept = dt * max(sweep, sweep_end)
+                if swept > stepper.max_sweep:
+                    raise SimulationError(
+                        f"solver {stepper.name!r} with h_max = {stepper.h_max:g} s turns the cam through "
+                        f"{swept:.3g} of the profile's finest feature in one step (omega = {y_new[1]:.4g} rad/s), "
+                        f"more than {stepper.max_sweep:g}: its first-order error is large there; reduce h_max "
+                        f"below {stepper.max_sweep / max(sweep, sweep_end):.3g} s or use solver 'rk4' or 'rk45'")
                 return dt, y_new, retries
             rate = max(rate, rate_end if math.isfinite(rate_end) else 4.0 * stab / dt)
             sweep = max(sweep, sweep_end if math.isfinite(sweep_end) else 4.0 * res / dt)
