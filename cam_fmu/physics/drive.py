@@ -164,10 +164,10 @@ class DriveModel:
         """
         if self.mu == 0.0 or not self.follower:
             return 0.0
-        s, s1, _, _ = self._profile(theta)
+        s, s1, s2, _ = self._profile(theta)
         J = self.J_m + self.m * s1 * s1
         tan_a = s1 / (self.r_b + s)
-        inertial = self.m * self._profile(theta)[2] * omega * omega - self.F_gx
+        inertial = self.m * s2 * omega * omega - self.F_gx
         x0 = (torque - self.M_f * direction - inertial * s1) / J
         v_sign = s1 * direction
         sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)

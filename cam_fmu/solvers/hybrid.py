@@ -23,6 +23,9 @@ class HybridIntegrator:
         self.stepper = stepper
         self.max_steps = max_steps
         self.fsal: tuple[tuple, float] | None = None  # (f(y), u) of rk45's last stage
+        # (state, event values) at the end of the last step without an event: the next step starts
+        # there, so its start values need no second evaluation (two profile evaluations per step).
+        self._events_at: tuple[list, tuple] | None = None
 
     def derivative_at_end(self, u: float) -> float | None:
         """omega_dot at the state reached, when the last stage computed it under input u."""
@@ -36,6 +39,7 @@ class HybridIntegrator:
         t = 0.0
         steps = 0
         was_stuck = mode.stuck
+        self._events_at = None
         system.settle(y, u, mode)
         # rk45's first-same-as-last derivative f(y), kept across communication
         # steps while u, the mode and y are those it was computed for.
@@ -150,7 +154,9 @@ class HybridIntegrator:
 
     def _first_event(self, system: HybridSystem, f, y, y_new, dt: float, u: float, mode):
         """Earliest event in (0, dt]: (name, time from step start, state there), or None."""
-        before = system.event_values(y, u, mode)
+        cached = self._events_at
+        self._events_at = None
+        before = cached[1] if cached is not None and cached[0] is y else system.event_values(y, u, mode)
         if not before:
             return None
         after = system.event_values(y_new, u, mode)
@@ -163,6 +169,7 @@ class HybridIntegrator:
                 return names[k], 0.0, list(y)
         fired = [k for k, (g0, g1) in enumerate(zip(before, after)) if g0 > 0.0 and g1 <= 0.0]
         if not fired:
+            self._events_at = (y_new, after)
             return None
         stepper = self.stepper
         if mode.stuck:

@@ -323,6 +323,8 @@ class ConsistentVoltage(Formulation):
         self.hybrid.settle(self.y, u, self.mode)
 
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
+        if u == self.u:
+            return  # settled for this input already (each advance settles again at its start)
         self.u = u
         self.hybrid.settle(self.y, u, self.mode)  # at rest: stuck, or starting now
 
