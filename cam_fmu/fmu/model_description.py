@@ -64,7 +64,13 @@ def variable_rows() -> List[Dict[str, Any]]:
         rows.append(dict(name=name, type="Real", causality="output", variability="continuous",
                          initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
                          allowed="(output)"))
-    for spec in parameters.PARAMETERS:
+    return rows + parameter_rows(parameters.PARAMETERS)
+
+
+def parameter_rows(specs) -> List[Dict[str, Any]]:
+    """The rows of parameters (ParameterSpec): fixed, exact start, min/max from their ranges."""
+    rows: List[Dict[str, Any]] = []
+    for spec in specs:
         kind = {"real": "Real", "boolean": "Boolean", "string": "String"}[spec.kind]
         row = dict(name=spec.name, type=kind, causality="parameter", variability="fixed", initial="exact",
                    unit=spec.unit if spec.kind == "real" else "", start=spec.default,
@@ -90,16 +96,7 @@ def controller_rows() -> List[Dict[str, Any]]:
         rows.append(dict(name=name, type="Real", causality="output", variability="discrete",
                          initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
                          allowed="(output)"))
-    for spec in pi.PARAMETERS:
-        kind = {"real": "Real", "boolean": "Boolean", "string": "String"}[spec.kind]
-        row = dict(name=spec.name, type=kind, causality="parameter", variability="fixed", initial="exact",
-                   unit=spec.unit if spec.kind == "real" else "", start=spec.default, min=None, max=None,
-                   description=spec.description, allowed=spec.allowed())
-        if spec.kind == "real":
-            row["min"] = spec.low if math.isfinite(spec.low) else None
-            row["max"] = spec.high if math.isfinite(spec.high) else None
-        rows.append(row)
-    return rows
+    return rows + parameter_rows(pi.PARAMETERS)
 
 
 ROWS = {"cam": variable_rows, "pi_speed": controller_rows}  # model name -> its variable table

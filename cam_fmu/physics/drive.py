@@ -26,15 +26,20 @@ def sign(x: float) -> float:
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
 
 
-def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_support: float) -> float:
+def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_support: float,
+                         side: float = 0.0) -> float:
     """Guide friction force f >= 0 [N] solving f = mu (|n0 + sigma kappa f| + n_support).
 
     The side force N_r = n0 + sigma kappa f depends on f itself (through the
     contact force): solved exactly on its two linear branches instead of lagging
     f by a step (docs/model.md section 5). Unique because mu |kappa| < 1.
+    ``side`` +1/-1 takes the branch where N_r has that sign (held between the
+    integrators' side-force events); 0 chooses the branch that holds.
     """
     if mu == 0.0:
         return 0.0
+    if side != 0.0:
+        return mu * (side * n0 + n_support) / (1.0 - side * mu * sigma * kappa)
     sk = sigma * kappa
     f = mu * (n0 + n_support) / (1.0 - mu * sk)
     if f >= 0.0 and n0 + sk * f >= 0.0:
@@ -150,10 +155,7 @@ class DriveModel:
         tan_a = s1 / (self.r_b + s)
         n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
         kappa = self.J_m / J * tan_a
-        if side == 0.0:
-            f = solve_guide_friction(n0, kappa, sigma, mu, self.N_g)
-        else:
-            f = mu * (side * n0 + self.N_g) / (1.0 - side * mu * sigma * kappa)
+        f = solve_guide_friction(n0, kappa, sigma, mu, self.N_g, side)
         return x0 - sigma * f * s1 / J
 
     def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
@@ -173,10 +175,7 @@ class DriveModel:
         sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
         n0 = (inertial + self.m * s1 * x0) * tan_a + self.G_y
         kappa = self.J_m / J * tan_a
-        if side == 0.0:
-            f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g)
-        else:
-            f = self.mu * (side * n0 + self.N_g) / (1.0 - side * self.mu * sigma * kappa)
+        f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g, side)
         return n0 + sigma * kappa * f
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
