@@ -53,9 +53,9 @@ class DriveSimulator:
     # ------------------------------------------------------------ public
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
         """Inputs used by ``outputs`` before the first step [V, rad/s, rad/s2]."""
-        self.u = _finite("u", u)
-        self.omega_ref = _finite("omega_ref", omega_ref)
-        self.omega_dot_ref = _finite("omega_dot_ref", omega_dot_ref)
+        self.u = _checked_input("u", u)
+        self.omega_ref = _checked_input("omega_ref", omega_ref)
+        self.omega_dot_ref = _checked_input("omega_dot_ref", omega_dot_ref)
         self.formulation.set_inputs(self.u, self.omega_ref, self.omega_dot_ref)
         self._outputs = None
 
@@ -137,7 +137,7 @@ class DriveSimulator:
             self.budget.restore(energy)
 
 
-def _finite(name: str, value: float) -> float:
+def _checked_input(name: str, value: float) -> float:
     try:
         return check_input(name, value)
     except ValueError as exc:
