@@ -120,7 +120,6 @@ class DriveSimulator:
             if not math.isfinite(float(state[key])):
                 raise SimulationError(f"state entry {key!r} = {state[key]!r} is not finite")
         self._outputs = None
-        self.integrator.fsal = None
         self.time = float(state["time"])
         self.u = float(state["u"])
         self.omega_ref = float(state["omega_ref"])

@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
+from ..kernel.drive_kernel import DriveKernel, solve_guide_friction
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
@@ -24,27 +25,6 @@ from .parameters import ParameterError, law_spec, resolve
 def sign(x: float) -> float:
     """+1, -1 or 0 (Coulomb friction's sgn, with sgn(0) = 0)."""
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
-
-
-def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_support: float,
-                         side: float = 0.0) -> float:
-    """Guide friction force f >= 0 [N] solving f = mu (|n0 + sigma kappa f| + n_support).
-
-    The side force N_r = n0 + sigma kappa f depends on f itself (through the
-    contact force): solved exactly on its two linear branches instead of lagging
-    f by a step (docs/model.md section 5). Unique because mu |kappa| < 1.
-    ``side`` +1/-1 takes the branch where N_r has that sign (held between the
-    integrators' side-force events); 0 chooses the branch that holds.
-    """
-    if mu == 0.0:
-        return 0.0
-    if side != 0.0:
-        return mu * (side * n0 + n_support) / (1.0 - side * mu * sigma * kappa)
-    sk = sigma * kappa
-    f = mu * (n0 + n_support) / (1.0 - mu * sk)
-    if f >= 0.0 and n0 + sk * f >= 0.0:
-        return f
-    return mu * (n_support - n0) / (1.0 + mu * sk)
 
 
 def check_self_locking(program: ProgramBase, mu: float, r_b: float) -> None:
@@ -120,13 +100,15 @@ class DriveModel:
         self.mu = p["mu"] if p["guide_friction"] else 0.0
         self.r_b = p["r_b"]
         self.c = p["c"] if p["backlash"] else 0.0
-        self._profile = self.program.derivatives  # bound once: the hot path calls it at every stage
         self.formulation = p["formulation"]
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
+        # The hot path (profile, right-hand side, rk45 with events): one object per model.
+        self.kernel = DriveKernel(self.program, self.J_m, self.m, self.M_f, self.F_gx, self.G_y, self.N_g,
+                                  self.mu, self.r_b, self.c, self.R, self.L, self.c_e, self.c_m)
 
     # ----------------------------------------------------------- mechanics
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
@@ -138,25 +120,9 @@ class DriveModel:
         False means the follower is free in the backlash gap (J = J_m, no load).
         ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
         branch, held between events so the right-hand side is smooth); 0 chooses it.
+        The formula is the drive kernel's (kernel/drive_kernel.py), compiled where it can be.
         """
-        drive = torque - self.M_f * direction
-        if not (engaged and self.follower):
-            return drive / self.J_m
-        s, s1, s2, _ = self._profile(theta)
-        m = self.m
-        J = self.J_m + m * s1 * s1
-        inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
-        x0 = (drive - inertial * s1) / J
-        mu = self.mu
-        if mu == 0.0:
-            return x0
-        v_sign = s1 * direction
-        sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
-        tan_a = s1 / (self.r_b + s)
-        n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
-        kappa = self.J_m / J * tan_a
-        f = solve_guide_friction(n0, kappa, sigma, mu, self.N_g, side)
-        return x0 - sigma * f * s1 / J
+        return self.kernel.omega_dot(theta, omega, torque, direction, engaged, side)
 
     def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
         """The guide's side force N_r [N] while the follower is engaged and moving (0 without guide friction).
@@ -164,19 +130,7 @@ class DriveModel:
         |N_r| has a kink where N_r changes sign (the friction mu |N_r| does): the
         integrators locate that zero as an event instead of stepping over it.
         """
-        if self.mu == 0.0 or not self.follower:
-            return 0.0
-        s, s1, s2, _ = self._profile(theta)
-        J = self.J_m + self.m * s1 * s1
-        tan_a = s1 / (self.r_b + s)
-        inertial = self.m * s2 * omega * omega - self.F_gx
-        x0 = (torque - self.M_f * direction - inertial * s1) / J
-        v_sign = s1 * direction
-        sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
-        n0 = (inertial + self.m * s1 * x0) * tan_a + self.G_y
-        kappa = self.J_m / J * tan_a
-        f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g, side)
-        return n0 + sigma * kappa * f
+        return self.kernel.side_force(theta, omega, torque, direction, side)
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
         """Load torque, inertia and follower motion for a known omega_dot."""

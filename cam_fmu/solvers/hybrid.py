@@ -17,20 +17,14 @@ from .events import locate
 
 
 class HybridIntegrator:
-    """Advances a HybridSystem with one Stepper; keeps rk45's first-same-as-last derivative."""
+    """Advances a HybridSystem with one fixed-step Stepper (rk45 runs in the drive kernel, same rules)."""
 
     def __init__(self, stepper: Stepper, max_steps: int) -> None:
         self.stepper = stepper
         self.max_steps = max_steps
-        self.fsal: tuple[tuple, float] | None = None  # (f(y), u) of rk45's last stage
         # (state, event values) at the end of the last step without an event: the next step starts
         # there, so its start values need no second evaluation (two profile evaluations per step).
         self._events_at: tuple[list, tuple] | None = None
-
-    def derivative_at_end(self, u: float) -> float | None:
-        """omega_dot at the state reached, when the last stage computed it under input u."""
-        fsal = self.fsal
-        return fsal[0][1] if fsal is not None and fsal[1] == u else None
 
     def advance(self, system: HybridSystem, y: list[float], mode: Any, u: float, h: float,
                 time: float) -> tuple[list[float], int]:
@@ -38,31 +32,19 @@ class HybridIntegrator:
         stepper = self.stepper
         t = 0.0
         steps = 0
-        was_stuck = mode.stuck
         self._events_at = None
         system.settle(y, u, mode)
-        # rk45's first-same-as-last derivative f(y), kept across communication
-        # steps while u, the mode and y are those it was computed for.
-        k1 = self.fsal[0] if self.fsal is not None and self.fsal[1] == u and not was_stuck else None
-
         f = system.rhs(u, mode)
         while h - t > 1e-12 * h:
             if mode.stuck and not system.has_current:
                 break  # nothing evolves until the input changes
             steps += 1
             if steps > self.max_steps:
-                raise StepRejected(
-                    f"solver {stepper.name!r} needed more than max_steps = {self.max_steps} internal steps "
-                    f"in one communication step of {h:g} s at t = {time + t:g} s: {self._advice(system)}")
+                raise StepRejected(self.max_steps_message(system, time + t, h))
             remaining = h - t
             if mode.stuck:
                 dt = remaining
                 y_new = system.stuck_state(y, u, dt)
-            elif stepper.adaptive:
-                dt, y_new, k1 = stepper.attempt(f, y, remaining, k1, time + t, system.error_caps, h)
-                cut, y_cut = self._stop_at_breakpoint(system, f, y, y_new, dt, u, mode)
-                if cut != dt:  # ends on a breakpoint: its FSAL derivative belonged to the longer step
-                    dt, y_new, k1 = cut, y_cut, None
             else:
                 dt, y_new, retries = self._stable_step(system, f, y, remaining, u, mode)
                 steps += retries
@@ -75,9 +57,12 @@ class HybridIntegrator:
             y, t = y_event, t + tau
             system.apply_event(y, u, mode, name)
             f = system.rhs(u, mode)  # the mode changed
-            k1 = None
-        self.fsal = None if k1 is None or mode.stuck else (k1, u)
         return y, steps
+
+    def max_steps_message(self, system: HybridSystem, time: float, h: float) -> str:
+        """The error text when a communication step of h [s] needed more than max_steps internal steps."""
+        return (f"solver {self.stepper.name!r} needed more than max_steps = {self.max_steps} internal steps "
+                f"in one communication step of {h:g} s at t = {time:g} s: {self._advice(system)}")
 
     def _advice(self, system: HybridSystem) -> str:
         """What to change when the work bound is hit, for this solver."""
