@@ -44,6 +44,7 @@ from __future__ import annotations
 import copy
 import math
 import sys
+from array import array
 from typing import Any, Dict
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
@@ -90,7 +91,8 @@ class CamDriveSlave(Fmi2Slave):
         self.modelName = MODEL_NAME
         self._params: Dict[str, Any] = _parameters.defaults()
         self._inputs: Dict[str, float] = {name: float(start) for name, _u, start, _d in _variables.INPUTS}
-        self._outputs: Dict[str, float] = {name: 0.0 for name, _u, _d in _variables.OUTPUTS}
+        # the published outputs in OUTPUTS order: the simulator's own buffer once it exists (no copy per step)
+        self._values = array("d", [0.0] * len(_variables.OUTPUTS))
         self._sim = None  # DriveSimulator, built at exit_initialization_mode or on first use
         self._initialized = False  # True after exit_initialization_mode: parameters are fixed
 
@@ -98,10 +100,10 @@ class CamDriveSlave(Fmi2Slave):
             self.register_variable(Real(
                 name, causality=Fmi2Causality.input, variability=Fmi2Variability.continuous,
                 description=desc, getter=self._input_getter(name), setter=self._input_setter(name)))
-        for name, _unit, desc in _variables.OUTPUTS:
+        for index, (name, _unit, desc) in enumerate(_variables.OUTPUTS):
             self.register_variable(Real(
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
-                initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(name),
+                initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(index),
                 setter=self._output_setter(name)))
         kinds = {"real": Real, "boolean": Boolean, "string": String}
         for spec in _parameters.PARAMETERS:
@@ -122,11 +124,11 @@ class CamDriveSlave(Fmi2Slave):
                 self._fail(str(exc))
         return setter
 
-    def _output_getter(self, name: str):
+    def _output_getter(self, index: int):
         def getter() -> float:
             if self._sim is None:
                 self._build()  # outputs are 'calculated' from the parameters at start time
-            return self._outputs[name]
+            return self._values[index]
         return getter
 
     def _output_setter(self, name: str):
@@ -172,21 +174,12 @@ class CamDriveSlave(Fmi2Slave):
             sim.set_inputs(**self._inputs)  # initial outputs see the inputs set before initialisation
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
             self._fail(str(exc))
-        self._publish(sim, sim.outputs())
+        for name, value in sim.outputs().items():  # the initial outputs (do_step checks every later state)
+            if not math.isfinite(value):
+                self._fail(f"output {name!r} = {value!r} at t = {sim.time!r} s is not finite "
+                           "(check the solver settings 'solver', 'h_max', 'rtol', 'atol')")
         self._sim = sim
-
-    def _publish(self, sim: Any, values: Dict[str, float]) -> None:
-        """Make ``values`` the published outputs (no copy: this runs every step).
-
-        DriveSimulator.do_step has already refused non-finite outputs
-        (SimulationError); the check here covers the initial outputs.
-        """
-        if sim.steps_taken == 0:
-            for name, value in values.items():
-                if not math.isfinite(value):
-                    self._fail(f"output {name!r} = {value!r} at t = {sim.time!r} s is not finite "
-                               "(check the solver settings 'solver', 'h_max', 'rtol', 'atol')")
-        self._outputs = values
+        self._values = sim.values  # DriveSimulator.do_step refreshes it in place, after its checks
 
     # ----------------------------------------------------------------- FMI calls
     def exit_initialization_mode(self) -> None:
@@ -207,7 +200,6 @@ class CamDriveSlave(Fmi2Slave):
             # fmi2Discard, with the state as before the step; everything else is fmi2Error.
             discard = getattr(exc, "fmi_status", None) == "discard"
             self._fail(f"at t = {current_time!r} s: {exc}", StepDiscarded if discard else FmuError)
-        self._publish(self._sim, self._sim.outputs())
         return True  # a falsy return would become a silent fmi2Discard
 
     def _get_fmu_state(self) -> Dict[str, Any]:
@@ -215,7 +207,7 @@ class CamDriveSlave(Fmi2Slave):
             "version": STATE_VERSION,
             "params": dict(self._params),
             "inputs": dict(self._inputs),
-            "outputs": dict(self._outputs),
+            "outputs": dict(zip(_variables.OUTPUT_NAMES, self._values)),
             "initialized": self._initialized,
             "sim": None if self._sim is None else copy.deepcopy(self._sim.get_state()),
         }
@@ -226,8 +218,11 @@ class CamDriveSlave(Fmi2Slave):
             params, inputs, outputs, initialized, sim = _checked_state(state)
         except (KeyError, TypeError, ValueError, _parameters.ParameterError, _simulator.SimulationError) as exc:
             self._fail(f"FMU state rejected: {exc}")
-        self._params, self._inputs, self._outputs = params, inputs, outputs
+        self._params, self._inputs = params, inputs
         self._initialized, self._sim = initialized, sim
+        self._values = sim.values if sim is not None else array("d", outputs.values())
+        if sim is not None:
+            self._values[:] = array("d", outputs.values())  # the outputs as published when the state was taken
 
 
 STATE_VERSION = 2  # of the dictionary _get_fmu_state returns (serialised as JSON)

@@ -21,16 +21,20 @@ step <= h_max that divides the communication step; the speed drive is exact.
 from __future__ import annotations
 
 import math
+from array import array
 from typing import Any, Mapping
 
 from ..physics.drive import DriveModel
 from ..physics.energy import EnergyBudget
 from ..physics.formulations import formulation_for
-from ..physics.variables import INPUT_STARTS, INPUTS, OUTPUTS, check_input
+from ..physics.variables import INPUT_RANGES, INPUT_STARTS, INPUTS, OUTPUT_NAMES, OUTPUTS, check_input
 from ..solvers import SOLVERS, SimulationError
 from ..solvers.hybrid import HybridIntegrator
 
 __all__ = ["DriveSimulator", "SimulationError", "INPUTS", "OUTPUTS"]
+
+_OMEGA, _THETA, _S, _I, _J, _S_CAM = (OUTPUT_NAMES.index(name) for name in ("omega", "theta", "s", "i", "J", "s_cam"))
+(_U_LO, _U_HI), (_W_LO, _W_HI), (_A_LO, _A_HI) = (INPUT_RANGES[name] for name in ("u", "omega_ref", "omega_dot_ref"))
 
 
 class DriveSimulator:
@@ -46,52 +50,65 @@ class DriveSimulator:
         self.omega_ref = INPUT_STARTS["omega_ref"]
         self.omega_dot_ref = INPUT_STARTS["omega_dot_ref"]
         self.steps_taken = 0  # internal steps, for benchmarks
-        self._outputs: dict[str, float] | None = None
         self.formulation = formulation_for(model, self.u, self.omega_ref)
         self.budget: EnergyBudget | None = None  # set at the first step (voltage drive)
+        # The outputs in OUTPUTS order: ``values`` holds the published ones (the FMU reads it), ``_scratch``
+        # those of a step not yet checked; ``_stale`` until the current state's are computed.
+        self.values = array("d", [0.0] * len(OUTPUT_NAMES))
+        self._scratch = array("d", self.values)
+        self._stale = True
 
     # ------------------------------------------------------------ public
     def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
         """Inputs used by ``outputs`` before the first step [V, rad/s, rad/s2]."""
-        self.u = _checked_input("u", u)
-        self.omega_ref = _checked_input("omega_ref", omega_ref)
-        self.omega_dot_ref = _checked_input("omega_dot_ref", omega_dot_ref)
+        if not (_U_LO <= u <= _U_HI and _W_LO <= omega_ref <= _W_HI and _A_LO <= omega_dot_ref <= _A_HI):
+            u = _checked_input("u", u)  # the first one out of its range raises, naming it
+            omega_ref = _checked_input("omega_ref", omega_ref)
+            omega_dot_ref = _checked_input("omega_dot_ref", omega_dot_ref)
+        self.u, self.omega_ref, self.omega_dot_ref = float(u), float(omega_ref), float(omega_dot_ref)
         self.formulation.set_inputs(self.u, self.omega_ref, self.omega_dot_ref)
-        self._outputs = None
+        self._stale = True
 
     def do_step(self, t: float, h: float, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
         """Advance from t to t + h [s] with inputs held over the step (FMI co-simulation).
 
         Speed drive: omega(t) = omega_ref + omega_dot_ref (t - t_k) over the step.
+        The outputs reached are in ``values`` only once every check passed.
         """
-        if not (math.isfinite(h) and h > 0.0):
+        if not (h > 0.0 and math.isfinite(h)):
             raise SimulationError(f"communication step size = {h!r} s: allowed (0, inf)")
         self.set_inputs(u, omega_ref, omega_dot_ref)
         if self.budget is None and self.formulation.energy_bounded:
-            out = self.outputs()
-            self.budget = EnergyBudget(self.model, out["theta"], out["omega"], out["i"], out["s"], out["J"])
+            out = self.values if not self._stale else self._fill(self.values)
+            self.budget = EnergyBudget(self.model, out[_THETA], out[_OMEGA], out[_I], out[_S], out[_J])
         self.steps_taken += self.formulation.advance(h, self.integrator, self.time)
         self.time = t + h
-        self._outputs = None
-        out = self.outputs()
-        for name, value in out.items():
-            if not math.isfinite(value):
-                raise SimulationError(
-                    f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
-                    f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
+        out = self._fill(self._scratch)
+        if not math.isfinite(sum(out)):
+            for name, value in zip(OUTPUT_NAMES, out):
+                if not math.isfinite(value):
+                    raise SimulationError(
+                        f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
+                        f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
         self._check_plausible(out, h)
+        self.values[:] = out
+        self._stale = False
 
-    def _check_plausible(self, out: dict[str, float], h: float) -> None:
+    def _fill(self, buffer: array) -> array:
+        self.formulation.fill_outputs(self.integrator, buffer)
+        return buffer
+
+    def _check_plausible(self, out: array, h: float) -> None:
         """The bounds the model implies, on every published state; a violation is an error naming the cause."""
         c = self.model.c
-        gap = abs(out["s"] - out["s_cam"])
+        gap = abs(out[_S] - out[_S_CAM])
         if gap > c * (1.0 + 1e-9) + 1e-12:
             raise SimulationError(
                 f"the follower is {gap:.6g} m from the cam at t = {self.time:g} s, beyond the clearance "
                 f"c = {c:g} m: a contact event was missed; {self.formulation.advice(self.stepper)}")
         if self.budget is not None:
-            self.budget.step(self.u, h, out["theta"], out["i"])
-            excess, tolerance = self.budget.excess(out["omega"], out["s"], out["J"], out["i"])
+            self.budget.step(self.u, h, out[_THETA], out[_I])
+            excess, tolerance = self.budget.excess(out[_OMEGA], out[_S], out[_J], out[_I])
             if excess > tolerance:
                 raise SimulationError(
                     f"the state at t = {self.time:g} s holds {excess:.6g} J more energy than the source "
@@ -100,9 +117,10 @@ class DriveSimulator:
 
     def outputs(self) -> dict[str, float]:
         """Current value of every output in OUTPUTS (computed once per state)."""
-        if self._outputs is None:
-            self._outputs = self.formulation.outputs(self.integrator)
-        return self._outputs
+        if self._stale:
+            self._fill(self.values)
+            self._stale = False
+        return dict(zip(OUTPUT_NAMES, self.values))
 
     def get_state(self) -> dict[str, Any]:
         """Complete internal state, JSON-serialisable."""
@@ -119,7 +137,7 @@ class DriveSimulator:
         for key in ("time", "u", "omega_ref", "omega_dot_ref", "h_next"):
             if not math.isfinite(float(state[key])):
                 raise SimulationError(f"state entry {key!r} = {state[key]!r} is not finite")
-        self._outputs = None
+        self._stale = True
         self.time = float(state["time"])
         self.u = float(state["u"])
         self.omega_ref = float(state["omega_ref"])

@@ -30,6 +30,7 @@ cdef class Profile:
     cpdef double first_breakpoint(self, double start, double end)
 
 
+cdef int O_OMEGA, O_THETA, O_S, O_I, O_M, O_J, O_V, O_A, O_ALPHA, O_S_CAM, O_VOLTAGE
 cdef double A21, A31, A32, A41, A42, A43, A51, A52, A53, A54, A61, A62, A63, A64, A65
 cdef double B1, B3, B4, B5, B6, E1, E3, E4, E5, E6, E7
 cdef int STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE, EVENT_ITERATIONS
@@ -46,6 +47,7 @@ cdef class DriveKernel(Profile):
     cdef public int contact
     cdef public double s_free, side
     cdef double x0, J, sigma, f, n0, kappa
+    cdef public double load_M, load_J, load_f, load_v, load_a, load_alpha, load_s
     cdef double d0, d1, d2
     cdef public double h_next, h_max, rtol, atol
     cdef public int max_steps
@@ -75,6 +77,11 @@ cdef class DriveKernel(Profile):
     cpdef void settle(self, double u) except *
     @cython.locals(torque=double, forward=double, backward=double)
     cdef double breakaway_margin(self, double theta, double i, double u) except? -1e300
+    @cython.locals(s=double, s1=double, tan_a=double, shaft=double, v=double, a=double, v_sign=double,
+                   sigma=double, push=double, f=double)
+    cpdef void load(self, double theta, double omega, double omega_dot, double direction, bint engaged) except *
+    @cython.locals(theta=double, omega=double, i=double, engaged=bint)
+    cpdef void outputs(self, double u, double omega_dot, bint known, double[:] out) except *
     @cython.locals(n=int)
     cdef int event_codes(self) except -1
     cdef double event_value(self, int code, double theta, double omega, double i, double u) except? -1e300
@@ -101,3 +108,17 @@ cdef class DriveKernel(Profile):
     @cython.locals(t=double, steps=int, was_stuck=bint, remaining=double, next_valid=bint, dt=double,
                    target=double, cut=double, tau=double)
     cpdef int advance(self, double u, double h, double time) except -1
+
+
+cdef double _SLACK
+
+
+cdef class EnergyBudget:
+    cdef double c_e, L, R, F_gx
+    cdef public double ratio, work_in, work_abs, theta, i, e_mech0, e_mag0
+
+    cdef double _mech(self, double omega, double s, double J) noexcept
+    @cython.locals(w=double)
+    cpdef void step(self, double u, double h, double theta, double i) except *
+    @cython.locals(e_mech=double, e_mag=double, lhs=double, rhs=double, scale=double)
+    cpdef tuple excess(self, double omega, double s, double J, double i)

@@ -22,6 +22,8 @@ from __future__ import annotations
 import math
 from array import array
 
+from ..physics.variables import OUTPUT_NAMES
+
 TWO_PI = 2.0 * math.pi
 SHAPE_CONST, SHAPE_SIN, SHAPE_COS = 0, 1, 2  # as kinematics.motion_law (tests/test_kernel_paths.py checks)
 INF, NAN = math.inf, math.nan
@@ -188,6 +190,12 @@ class Profile:
         return NAN
 
 
+# Positions of the outputs in an output buffer (physics.variables.OUTPUTS order).
+O_OMEGA, O_THETA, O_S, O_I, O_M, O_J, O_V, O_A, O_ALPHA, O_S_CAM, O_VOLTAGE = (
+    OUTPUT_NAMES.index(name) for name in ("omega", "theta", "s", "i", "M", "J", "v", "a", "alpha", "s_cam",
+                                          "voltage"))
+N_OUTPUTS = len(OUTPUT_NAMES)
+
 # Dormand-Prince 5(4) tableau (Hairer, Norsett, Wanner, Solving ODE I, table 5.2).
 A21 = 1.0 / 5.0
 A31, A32 = 3.0 / 40.0, 9.0 / 40.0
@@ -237,6 +245,7 @@ class DriveKernel(Profile):
         self.side = 1.0
         # load terms (set by load_terms): frictionless acceleration x0 and the guide's friction terms
         self.x0 = self.J = self.sigma = self.f = self.n0 = self.kappa = 0.0
+        self.load_M = self.load_J = self.load_f = self.load_v = self.load_a = self.load_alpha = self.load_s = 0.0
         self.d0 = self.d1 = self.d2 = 0.0  # derivative written by rhs
         # integrator state
         self.h_next = self.h_max = self.rtol = self.atol = 0.0
@@ -341,6 +350,60 @@ class DriveKernel(Profile):
         forward = self.omega_dot(theta, 0.0, torque, 1.0, engaged, 0.0)
         backward = -self.omega_dot(theta, 0.0, torque, -1.0, engaged, 0.0)
         return backward if backward > forward else forward
+
+    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool) -> None:
+        """Load torque, inertia and follower motion for a known omega_dot [rad/s2], into the
+        attributes load_M [N m] (M_f sgn(omega) + M_l), load_J [kg m2], load_f [N, guide friction],
+        load_v [m/s], load_a [m/s2], load_alpha [rad, pressure angle], load_s [m, cam lift]."""
+        self.profile(theta)
+        s = self.s
+        s1 = self.s1
+        tan_a = s1 / (self.r_b + s)
+        shaft = self.M_f * direction
+        self.load_alpha = math.atan(tan_a)
+        self.load_s = s
+        if not engaged:
+            self.load_M, self.load_J, self.load_f, self.load_v, self.load_a = shaft, self.J_m, 0.0, 0.0, 0.0
+            return
+        v = s1 * omega
+        a = self.s2 * omega * omega + s1 * omega_dot
+        v_sign = s1 * direction
+        sigma = 1.0 if v_sign > 0.0 else (-1.0 if v_sign < 0.0 else 0.0)
+        push = self.m * a - self.F_gx  # N, axial force without friction
+        f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
+        self.load_M = shaft + (push + sigma * f) * s1
+        self.load_J = self.J_m + self.m * s1 * s1
+        self.load_f, self.load_v, self.load_a = f, v, a
+
+    def outputs(self, u: float, omega_dot: float, known: bool, out) -> None:
+        """Every output at the state, in physics.variables.OUTPUTS order, into the buffer ``out``.
+
+        ``known``: ``omega_dot`` [rad/s2] is the acceleration at the state already
+        (rk45's last stage), else it is computed.
+        """
+        theta, omega = self.y0, self.y1
+        i = self.y2 if self.has_current else (u - self.c_e * omega) / self.R
+        engaged = self.contact != 0
+        if self.stuck:
+            self.load(theta, 0.0, 0.0, 0.0, engaged)
+            self.load_M = self.c_m * i  # static friction takes whatever the motor applies
+            self.load_v = self.load_a = 0.0
+        else:
+            if not known:
+                self.rhs(theta, omega, self.y2, u)
+                omega_dot = self.d1
+            self.load(theta, omega, omega_dot, self.direction, engaged)
+        out[O_OMEGA] = omega
+        out[O_THETA] = theta
+        out[O_S] = self.load_s - self.c * self.contact if engaged else self.s_free
+        out[O_I] = i
+        out[O_M] = self.load_M
+        out[O_J] = self.load_J
+        out[O_V] = self.load_v
+        out[O_A] = self.load_a
+        out[O_ALPHA] = self.load_alpha
+        out[O_S_CAM] = self.load_s
+        out[O_VOLTAGE] = u
 
     # ------------------------------------------------------------ events
     def event_codes(self) -> int:
@@ -607,3 +670,50 @@ class DriveKernel(Profile):
             self.k1_valid = False
         self.fsal_u = u
         return steps
+
+
+# Relative slack of the bound (integration error, rounding), of the energy scale |E| + r sum |W_in|.
+# Every solver on every shipped voltage scene stays at least 0.74 of that scale below the
+# bound (measured: losses dominate); a diverged or energy-making step overshoots it.
+RELATIVE_SLACK = 1e-3
+_SLACK = RELATIVE_SLACK  # the compiled module's C copy
+
+
+class EnergyBudget:
+    """Tracks W_in and the bound for one drive (SI units): physics/energy.py explains the bound."""
+
+    def __init__(self, model, theta: float, omega: float, i: float, s: float, J: float) -> None:
+        self.c_e, self.L, self.R, self.F_gx = model.c_e, model.L, model.R, model.F_gx
+        self.ratio = model.c_m / model.c_e
+        self.work_in = 0.0  # J, electrical work delivered by the source
+        self.work_abs = 0.0  # J, sum of |u int i dt|: the scale of the bookkeeping
+        self.theta, self.i = theta, i
+        self.e_mech0 = self._mech(omega, s, J)
+        self.e_mag0 = 0.5 * self.L * i * i
+
+    def _mech(self, omega: float, s: float, J: float) -> float:
+        return 0.5 * J * omega * omega - self.F_gx * s
+
+    def step(self, u: float, h: float, theta: float, i: float) -> None:
+        """Account for one communication step of length h [s] under u [V] ending at theta, i."""
+        w = u * (u * h - self.c_e * (theta - self.theta) - self.L * (i - self.i)) / self.R
+        self.work_in += w
+        self.work_abs += abs(w)
+        self.theta, self.i = theta, i
+
+    def to_dict(self) -> dict:
+        return {"work_in": self.work_in, "work_abs": self.work_abs, "theta": self.theta, "i": self.i,
+                "e_mech0": self.e_mech0, "e_mag0": self.e_mag0}
+
+    def restore(self, state: dict) -> None:
+        for key in ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0"):
+            setattr(self, key, float(state[key]))
+
+    def excess(self, omega: float, s: float, J: float, i: float) -> tuple:
+        """(energy above the bound [J], the tolerance [J]) at the current state."""
+        e_mech = self._mech(omega, s, J)
+        e_mag = 0.5 * self.L * i * i
+        lhs = (e_mech - self.e_mech0) + self.ratio * (e_mag - self.e_mag0)
+        rhs = self.ratio * self.work_in
+        scale = abs(self.e_mech0) + abs(e_mech) + self.ratio * (self.work_abs + self.e_mag0 + e_mag) + 1e-12
+        return lhs - rhs, _SLACK * scale

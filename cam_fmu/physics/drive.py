@@ -133,19 +133,10 @@ class DriveModel:
         return self.kernel.side_force(theta, omega, torque, direction, side)
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
-        """Load torque, inertia and follower motion for a known omega_dot."""
-        s, s1, s2, _ = self.program.derivatives(theta)
-        tan_a = s1 / (self.r_b + s)
-        shaft = self.M_f * direction
-        if not engaged:
-            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, math.atan(tan_a), s)
-        v = s1 * omega
-        a = s2 * omega * omega + s1 * omega_dot
-        sigma = sign(s1 * direction)
-        push = self.m * a - self.F_gx  # N, axial force without friction
-        f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g)
-        M_l = (push + sigma * f) * s1
-        return LoadState(omega_dot, shaft + M_l, self.J_m + self.m * s1 * s1, f, v, a, math.atan(tan_a), s)
+        """Load torque, inertia and follower motion for a known omega_dot (the kernel's formula)."""
+        k = self.kernel
+        k.load(theta, omega, omega_dot, direction, engaged)
+        return LoadState(omega_dot, k.load_M, k.load_J, k.load_f, k.load_v, k.load_a, k.load_alpha, k.load_s)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True) -> float:
         """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).

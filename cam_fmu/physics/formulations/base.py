@@ -7,6 +7,7 @@ consistent one) uses the integrator it is given; the others step themselves.
 """
 from __future__ import annotations
 
+from array import array
 from typing import Any
 
 
@@ -32,6 +33,10 @@ class Formulation:
     def outputs(self, integrator: Any) -> dict[str, float]:
         """Every output of physics.variables.OUTPUTS at the current state."""
         raise NotImplementedError
+
+    def fill_outputs(self, integrator: Any, buffer: Any) -> None:
+        """The outputs, in OUTPUTS order, into ``buffer`` (a formulation on the hot path overrides this)."""
+        buffer[:] = array("d", self.outputs(integrator).values())
 
     def get_state(self) -> dict[str, Any]:
         """The formulation's own state, JSON-serialisable."""

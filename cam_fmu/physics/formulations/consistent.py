@@ -411,6 +411,11 @@ class ConsistentVoltage(Formulation):
     def outputs(self, integrator: Any) -> dict[str, float]:
         return self.hybrid.outputs(self.y, self.u, self.mode, self.omega_dot_at_end())
 
+    def fill_outputs(self, integrator: Any, buffer: Any) -> None:
+        k = self.kernel
+        known = k.k1_valid and not k.stuck and k.fsal_u == self.u
+        k.outputs(self.u, k.k1_1, known, buffer)
+
     def get_state(self) -> dict[str, Any]:
         return {"y": list(self.y), "mode": self.mode.to_dict()}
 
