@@ -1,5 +1,6 @@
 # C types for drive_kernel.py (Cython pure-Python mode): the .py stays the source and the fallback.
 cimport cython
+from libc cimport math  # math.sin & co. in the .py become C calls
 
 cdef double TWO_PI, INF, NAN
 cdef int SHAPE_CONST, SHAPE_SIN, SHAPE_COS, SEGMENT_FIELDS
@@ -10,8 +11,9 @@ cpdef double solve_guide_friction(double n0, double kappa, double sigma, double 
 
 cdef class Profile:
     cdef public double s, s1, s2, s3
+    cdef public long long evaluations
     cdef double law_S, law_V, law_A, law_J
-    cdef public object points
+    cdef double[:] points
     cdef public int n_points
     cdef public bint laws
     cdef object program_derivatives
@@ -62,6 +64,10 @@ cdef class DriveKernel(Profile):
     cdef int n_events, hit
     cdef bint have_before
     cdef public object apply_event, settle_python, fail
+    cdef double[:] saved
+
+    cpdef void snapshot(self)
+    cpdef void rollback(self)
 
     @cython.locals(s=double, s1=double, m=double, J=double, inertial=double, v_sign=double, tan_a=double)
     cdef void load_terms(self, double theta, double omega, double drive, double direction, double side) except *

@@ -24,9 +24,10 @@ from array import array
 
 from ..physics.variables import OUTPUT_NAMES
 
-TWO_PI = 2.0 * math.pi
+# Constants spelled out: compiled, ``math`` here is C's libc math (the .pxd), which has no pi, inf or nan.
+TWO_PI = 2.0 * 3.141592653589793  # 2 pi, math.pi being that double
 SHAPE_CONST, SHAPE_SIN, SHAPE_COS = 0, 1, 2  # as kinematics.motion_law (tests/test_kernel_paths.py checks)
-INF, NAN = math.inf, math.nan
+INF, NAN = float("inf"), float("nan")
 SEGMENT_FIELDS = 7  # end, start, F, c, kind, V0, S0 per non-empty law segment
 
 
@@ -65,6 +66,7 @@ class Profile:
 
     def __init__(self, program) -> None:
         self.s = self.s1 = self.s2 = self.s3 = 0.0
+        self.evaluations = 0  # of the profile, counted: a switched-off follower must cost none in the dynamics
         self.law_S = self.law_V = self.law_A = self.law_J = 0.0
         self.points = array("d", program.breakpoints())
         self.n_points = len(self.points)
@@ -133,6 +135,7 @@ class Profile:
 
     def profile(self, theta: float) -> None:
         """s [m], ds/dtheta [m/rad], d2s/dtheta2, d3s/dtheta3 at theta [rad] into s, s1, s2, s3."""
+        self.evaluations += 1
         if not self.laws:
             self.s, self.s1, self.s2, self.s3 = self.program_derivatives(theta)
             return
@@ -265,6 +268,7 @@ class DriveKernel(Profile):
         self.n_events = 0
         self.hit = 0  # code of the event first_event found
         self.have_before = False
+        self.saved = array("d", [0.0] * 8)  # snapshot(): y, mode
         self.apply_event = None  # callable(code, u): the formulation's transition, in Python
         self.settle_python = None  # callable(u): the formulation's settle at rest, in Python
         self.fail = None  # callable(kind, time, value): raises the formulation's error
@@ -445,6 +449,21 @@ class DriveKernel(Profile):
         if code == ENGAGE_DOWN:
             return (self.s + self.c) - self.s_free
         return self.contact * self.s1 * self.direction  # CONTACT: s1 times the direction held
+
+    def snapshot(self) -> None:
+        """Keep the state and mode, for ``rollback`` (a rejected step leaves the state as before it)."""
+        saved = self.saved
+        saved[0], saved[1], saved[2] = self.y0, self.y1, self.y2
+        saved[3] = 1.0 if self.stuck else 0.0
+        saved[4], saved[5], saved[6], saved[7] = self.direction, self.contact, self.s_free, self.side
+
+    def rollback(self) -> None:
+        """Back to the state and mode of the last ``snapshot``; rk45's stored derivative is dropped."""
+        saved = self.saved
+        self.y0, self.y1, self.y2 = saved[0], saved[1], saved[2]
+        self.stuck = saved[3] != 0.0
+        self.direction, self.contact, self.s_free, self.side = saved[4], int(saved[5]), saved[6], saved[7]
+        self.k1_valid = False
 
     # ------------------------------------------------------------ integration
     def dopri_step(self, h: float, u: float) -> None:

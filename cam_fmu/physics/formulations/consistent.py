@@ -380,7 +380,7 @@ class ConsistentVoltage(Formulation):
 
     def advance(self, h: float, integrator: Any, time: float) -> int:
         kernel = self.kernel
-        y_before, mode_before = self.y, self.mode
+        kernel.snapshot()
         self._integrator = integrator
         stepper = integrator.stepper
         try:
@@ -398,9 +398,7 @@ class ConsistentVoltage(Formulation):
             self.y, self.mode = y, mode
             return steps
         except StepRejected:
-            # a rejected step leaves the state as before it (fmi2Discard)
-            self.y, self.mode = y_before, mode_before
-            kernel.k1_valid = False
+            kernel.rollback()  # a rejected step leaves the state as before it (fmi2Discard)
             raise
 
     def omega_dot_at_end(self) -> float | None:
