@@ -105,6 +105,12 @@ class CamDriveSlave(Fmi2Slave):
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                 initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(index),
                 setter=self._output_setter(name)))
+        # value reference -> input name / output index: the packed per-step transfers (get_real_packed)
+        self._input_names = {vr: var.name for vr, var in self.vars.items() if var.name in self._inputs}
+        self._output_index = {vr: _variables.OUTPUT_NAMES.index(var.name) for vr, var in self.vars.items()
+                              if var.name in _variables.OUTPUT_NAMES}
+        self._get_request: tuple = (b"", ())  # the last fmi2GetReal request of outputs: (its bytes, indices)
+        self._set_request: tuple = (b"", ())  # the last fmi2SetReal request of inputs: (its bytes, names)
         kinds = {"real": Real, "boolean": Boolean, "string": String}
         for spec in _parameters.PARAMETERS:
             self.register_variable(kinds[spec.kind](
@@ -154,6 +160,42 @@ class CamDriveSlave(Fmi2Slave):
             self._sim = None  # rebuilt from the new values on first use
         return setter
 
+    # ----------------------------------------------------------------- packed transfers (the per-step path)
+    def get_real_packed(self, vrs: bytes) -> bytes | None:
+        """fmi2GetReal of outputs only, values packed as C doubles; None: not only outputs (use get_real).
+
+        cam.fmu's own binary calls this first: a master reads the same outputs at every
+        step, so the value references are resolved once per distinct request.
+        """
+        request, indices = self._get_request
+        if vrs != request:
+            found = [self._output_index.get(vr) for vr in array("I", vrs)]
+            if None in found:
+                return None
+            indices = tuple(found)
+            self._get_request = (vrs, indices)
+        if self._sim is None:
+            self._build()  # outputs are 'calculated' from the parameters at start time
+        values = self._values
+        return array("d", [values[k] for k in indices]).tobytes()
+
+    def set_real_packed(self, vrs: bytes, values: bytes) -> bool:
+        """fmi2SetReal of inputs only (packed C doubles), each checked against its range; False: not only inputs."""
+        request, names = self._set_request
+        if vrs != request:
+            found = [self._input_names.get(vr) for vr in array("I", vrs)]
+            if None in found:
+                return False
+            names = tuple(found)
+            self._set_request = (vrs, names)
+        inputs = self._inputs
+        for name, value in zip(names, array("d", values)):
+            try:
+                inputs[name] = _variables.check_input(name, value)
+            except ValueError as exc:
+                self._fail(str(exc))
+        return True
+
     # ----------------------------------------------------------------- helpers
     def _fail(self, message: str, error: type = FmuError) -> None:
         """Report an error: log it, print it to stderr, raise (pythonfmu returns fmi2Fatal).
@@ -194,7 +236,8 @@ class CamDriveSlave(Fmi2Slave):
             self._build()
             self._initialized = True
         try:  # inputs were checked in their setters, and are again in DriveSimulator.do_step
-            self._sim.do_step(current_time, step_size, **self._inputs)
+            inputs = self._inputs
+            self._sim.do_step(current_time, step_size, inputs["u"], inputs["omega_ref"], inputs["omega_dot_ref"])
         except (_parameters.ParameterError, _simulator.SimulationError) as exc:
             # The engine's StepRejected (max_steps, step floor) means "not at this step size":
             # fmi2Discard, with the state as before the step; everything else is fmi2Error.

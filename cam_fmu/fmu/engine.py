@@ -84,13 +84,9 @@ class DriveSimulator:
         self.steps_taken += self.formulation.advance(h, self.integrator, self.time)
         self.time = t + h
         out = self._fill(self._scratch)
-        if not math.isfinite(sum(out)):
-            for name, value in zip(OUTPUT_NAMES, out):
-                if not math.isfinite(value):
-                    raise SimulationError(
-                        f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
-                        f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
-        self._check_plausible(out, h)
+        verdict = self.model.kernel.publishable(out, self.budget, self.u, h)  # books the energy too
+        if verdict:
+            self._refuse(verdict, out)
         self.values[:] = out
         self._stale = False
 
@@ -98,22 +94,23 @@ class DriveSimulator:
         self.formulation.fill_outputs(self.integrator, buffer)
         return buffer
 
-    def _check_plausible(self, out: array, h: float) -> None:
-        """The bounds the model implies, on every published state; a violation is an error naming the cause."""
-        c = self.model.c
-        gap = abs(out[_S] - out[_S_CAM])
-        if gap > c * (1.0 + 1e-9) + 1e-12:
+    def _refuse(self, verdict: int, out: array) -> None:
+        """Raise the error the kernel's verdict on a step's outputs stands for, naming the cause."""
+        if verdict == 1:
+            name, value = next((n, v) for n, v in zip(OUTPUT_NAMES, out) if not math.isfinite(v))
             raise SimulationError(
-                f"the follower is {gap:.6g} m from the cam at t = {self.time:g} s, beyond the clearance "
-                f"c = {c:g} m: a contact event was missed; {self.formulation.advice(self.stepper)}")
-        if self.budget is not None:
-            self.budget.step(self.u, h, out[_THETA], out[_I])
-            excess, tolerance = self.budget.excess(out[_OMEGA], out[_S], out[_J], out[_I])
-            if excess > tolerance:
-                raise SimulationError(
-                    f"the state at t = {self.time:g} s holds {excess:.6g} J more energy than the source "
-                    f"delivered (tolerance {tolerance:.3g} J): energy was created, the result cannot be "
-                    f"trusted; {self.formulation.advice(self.stepper)}")
+                f"output {name!r} became {value!r} at t = {self.time:g} s with solver "
+                f"{self.stepper.name!r}, h_max = {self.stepper.h_max:g} s: reduce h_max or use 'rk45'/'etdrk4'")
+        if verdict == 2:
+            raise SimulationError(
+                f"the follower is {abs(out[_S] - out[_S_CAM]):.6g} m from the cam at t = {self.time:g} s, beyond "
+                f"the clearance c = {self.model.c:g} m: a contact event was missed; "
+                f"{self.formulation.advice(self.stepper)}")
+        excess, tolerance = self.budget.excess(out[_OMEGA], out[_S], out[_J], out[_I])
+        raise SimulationError(
+            f"the state at t = {self.time:g} s holds {excess:.6g} J more energy than the source "
+            f"delivered (tolerance {tolerance:.3g} J): energy was created, the result cannot be "
+            f"trusted; {self.formulation.advice(self.stepper)}")
 
     def outputs(self) -> dict[str, float]:
         """Current value of every output in OUTPUTS (computed once per state)."""

@@ -39,6 +39,9 @@ cdef int STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE, EVENT_ITERATIO
 cdef double _HYSTERESIS
 
 
+cdef class EnergyBudget
+
+
 cdef class DriveKernel(Profile):
     cdef public double J_m, m, M_f, F_gx, G_y, N_g, mu, r_b, c, R, L, c_e, c_m
     cdef public bint follower, has_current, backlash, guide_side
@@ -88,6 +91,8 @@ cdef class DriveKernel(Profile):
     cpdef void load(self, double theta, double omega, double omega_dot, double direction, bint engaged) except *
     @cython.locals(theta=double, omega=double, i=double, engaged=bint)
     cpdef void outputs(self, double u, double omega_dot, bint known, double[:] out) except *
+    @cython.locals(total=double, k=int)
+    cpdef int publishable(self, double[:] out, EnergyBudget budget, double u, double h) except -1
     @cython.locals(n=int)
     cdef int event_codes(self) except -1
     cdef double event_value(self, int code, double theta, double omega, double i, double u) except? -1e300
@@ -126,5 +131,7 @@ cdef class EnergyBudget:
     cdef double _mech(self, double omega, double s, double J) noexcept
     @cython.locals(w=double)
     cpdef void step(self, double u, double h, double theta, double i) except *
+    @cython.locals(excess=double, tolerance=double)
+    cpdef double surplus(self, double omega, double s, double J, double i) except? -1e300
     @cython.locals(e_mech=double, e_mag=double, lhs=double, rhs=double, scale=double)
     cpdef tuple excess(self, double omega, double s, double J, double i)

@@ -409,6 +409,24 @@ class DriveKernel(Profile):
         out[O_S_CAM] = self.load_s
         out[O_VOLTAGE] = u
 
+    def publishable(self, out, budget, u: float, h: float) -> int:
+        """Check the outputs of a step of h [s] under u [V] before they are published (the energy budget,
+        if any, books the step): 0 fine, 1 an output is not finite, 2 the follower is beyond the
+        clearance c from the cam (a contact event was missed), 3 the state holds more energy than the
+        source delivered."""
+        total = 0.0
+        for k in range(N_OUTPUTS):
+            total += out[k]
+        if not math.isfinite(total):
+            return 1
+        if abs(out[O_S] - out[O_S_CAM]) > self.c * (1.0 + 1e-9) + 1e-12:
+            return 2
+        if budget is not None:
+            budget.step(u, h, out[O_THETA], out[O_I])
+            if budget.surplus(out[O_OMEGA], out[O_S], out[O_J], out[O_I]) > 0.0:
+                return 3
+        return 0
+
     # ------------------------------------------------------------ events
     def event_codes(self) -> int:
         """The active events into ``codes``; returns how many."""
@@ -727,6 +745,11 @@ class EnergyBudget:
     def restore(self, state: dict) -> None:
         for key in ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0"):
             setattr(self, key, float(state[key]))
+
+    def surplus(self, omega: float, s: float, J: float, i: float) -> float:
+        """Energy above the bound, less the tolerance [J]: > 0 means energy was created."""
+        excess, tolerance = self.excess(omega, s, J, i)
+        return excess - tolerance
 
     def excess(self, omega: float, s: float, J: float, i: float) -> tuple:
         """(energy above the bound [J], the tolerance [J]) at the current state."""

@@ -34,6 +34,9 @@ _CATEGORY = {WARNING: "logStatusWarning", DISCARD: "logStatusDiscard", ERROR: "l
              FATAL: "logStatusFatal"}
 
 _added_modules: set = set()
+# "no messages": an empty list, never mutated (the C side reads it with PyList_Size; None would make
+# that call raise and clear a TypeError on every FMI call, ~1 us each)
+_NO_MESSAGES: list = []
 
 
 def _own_names(package: str, slave_module: str):
@@ -111,7 +114,7 @@ class Instance:
 
     # ------------------------------------------------------------ plumbing
     def _drain(self, extra=None):
-        messages = None
+        messages = _NO_MESSAGES
         slave = self.slave
         queue = getattr(slave, "log_queue", None) if slave is not None else None
         if queue:
@@ -163,9 +166,19 @@ class Instance:
 
     # ------------------------------------------------------------ values
     def get_real(self, vrs: bytes):
+        packed = getattr(self.slave, "get_real_packed", None)  # a slave's fast path for its outputs
+        if packed is not None:
+            status, payload, messages = self._run(packed, vrs)
+            if status != OK or payload is not None:
+                return status, payload, messages
         return self._run(lambda: array("d", self.slave.get_real(array("I", vrs).tolist())).tobytes())
 
     def set_real(self, vrs: bytes, values: bytes):
+        packed = getattr(self.slave, "set_real_packed", None)  # a slave's fast path for its inputs
+        if packed is not None:
+            status, payload, messages = self._run(packed, vrs, values)
+            if status != OK or payload:
+                return status, None, messages
         return self._run(lambda: self.slave.set_real(array("I", vrs).tolist(), array("d", values).tolist()))
 
     def get_integer(self, vrs: bytes):
