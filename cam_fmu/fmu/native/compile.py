@@ -33,7 +33,7 @@ import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Sequence
 
 HERE = Path(__file__).resolve().parent
 C_SOURCE = HERE / "fmi2_python.c"
@@ -73,20 +73,24 @@ def _rewrite_imports(source: str, old: str, new: str) -> str:
     return re.sub(rf"^(\s*import\s+){re.escape(old)}(?=[\s.,]|$)", rf"\g<1>{new}", source, flags=re.M)
 
 
-def content_digest(staging: Path, package: str, script: Path) -> str:
-    """8 hex digits of a hash over everything that runs inside the FMU."""
+def content_digest(staging: Path, package: str, script: Path, extra: Sequence[Path] = ()) -> str:
+    """8 hex digits of a hash over everything that runs inside the FMU (``extra``: files added later)."""
     h = hashlib.sha256()
-    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE]
+    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE, *extra]
     files += [_pythonfmu_dir() / name for name in PYTHONFMU_RUNTIME]
     for path in files:
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()[:8]
 
 
-def privatize(staging: Path, package: str, script_stem: str) -> PrivateNames:
-    """Rename the staged package and slave script to private names (see the module doc)."""
+def privatize(staging: Path, package: str, script_stem: str, extra: Sequence[Path] = ()) -> PrivateNames:
+    """Rename the staged package and slave script to private names (see the module doc).
+
+    ``extra``: files put into the package after this (the compiled kernel), hashed
+    into the name too: a compiled and a pure-Python build never share a name.
+    """
     script = staging / f"{script_stem}.py"
-    digest = content_digest(staging, package, script)
+    digest = content_digest(staging, package, script, extra)
     names = PrivateNames(f"{package}_{digest}", f"{script_stem}_{digest}", digest)
     (staging / package).rename(staging / names.package)
     text = _rewrite_imports(script.read_text(encoding="utf-8"), package, names.package)
