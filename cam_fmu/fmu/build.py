@@ -32,9 +32,10 @@ with the system C compiler (no compiler: the build stops) and puts it,
 The compiled drive kernel (``cam_fmu/kernel``, docs/architecture.md): cam.fmu
 always bundles ``kernel/drive_kernel.py`` (the fallback); ``build(compiled=True)``
 (the default; ``--pure-python`` turns it off) first builds its extension in
-place with ``kernel.compile`` (so the checkout uses it too) and puts the .so
-beside the bundled .py, under the private package name. Where the .so's ABI tag
-does not match the host's Python, the import system loads the .py.
+place with ``kernel.compile`` (so the checkout uses it too), then compiles the
+staged copy under the private package name and ships that .so beside the
+bundled .py. Where the .so's ABI tag does not match the host's Python, the
+import system loads the .py.
 """
 from __future__ import annotations
 
@@ -262,20 +263,42 @@ def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> 
     return fmu.stat().st_mtime < newest
 
 
-def kernel_extensions(package_dir: Path, staging: Path, fallback_dir: Path) -> List[Path]:
-    """Build the extensions of the staged compiled modules (in place when the package is writable).
+def compiled_in_bundle(staged_package: Path) -> Tuple[str, ...]:
+    """The compiled modules whose .py is in the staged package (cam.fmu: all; pi_speed.fmu: none)."""
+    return tuple(m for m in COMPILED_MODULES if (staged_package / KERNEL / f"{m}.py").is_file())
 
-    In place in ``package_dir/kernel``, so a source checkout imports them too; a
-    read-only package (an installed one) gets them built into ``fallback_dir``.
+
+def build_kernel_in_place(package_dir: Path) -> List[Path]:
+    """The kernel's extensions beside their .py in ``package_dir`` (a checkout then imports them too).
+
+    A read-only package (an installed one) is left as it is: the FMU compiles its own copy anyway.
     """
     from ..kernel import compile as kernel_compile
 
-    names = tuple(m for m in COMPILED_MODULES if (staging / PACKAGE / KERNEL / f"{m}.py").is_file())
-    if not names:
-        return []
     source = package_dir / KERNEL
-    dest = source if os.access(source, os.W_OK) else fallback_dir
-    return kernel_compile.build_extension(source, dest, names)
+    return kernel_compile.build_extension(source) if os.access(source, os.W_OK) else []
+
+
+def kernel_extensions(package_dir: Path, staged_package: Path) -> List[Path]:
+    """Compile the staged (privatized) kernel modules into the staged package and return the extensions.
+
+    Compiled again under the private name (``cam_fmu_<hash>.kernel.drive_kernel``),
+    not copied from the checkout: a Cython module also enters itself into
+    sys.modules under the dotted name it was compiled with, and the checkout's
+    (``cam_fmu.kernel.drive_kernel``) would put a public name into every host
+    process, shadowing a host's own cam_fmu (tests/test_kernel_build.py).
+    """
+    from ..kernel import compile as kernel_compile
+
+    modules = compiled_in_bundle(staged_package)
+    kernel_dir = staged_package / KERNEL
+    for name in modules:  # the C types, beside the staged .py for Cython (not shipped)
+        shutil.copy2(package_dir / KERNEL / f"{name}.pxd", kernel_dir / f"{name}.pxd")
+    try:
+        return kernel_compile.build_extension(kernel_dir, modules=modules, force=True)
+    finally:
+        for name in modules:
+            (kernel_dir / f"{name}.pxd").unlink()
 
 
 def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, model: str = "cam",
@@ -304,14 +327,17 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
         staging = Path(tmp) / "stage"
         staging.mkdir()
         bundled = stage(package_dir, script, staging, ROOTS.get(model, ()))
-        extensions = kernel_extensions(package_dir, staging, Path(tmp) / "kernel") if compiled else []
-        # private names: cam_fmu_<hash>, ...; the hash covers the extensions (a pure-Python build differs)
-        names = native.privatize(staging, PACKAGE, script.stem, extra=extensions)
-        for ext in extensions:  # the extension's PyInit_<name> does not depend on the package name
-            shutil.copy2(ext, staging / names.package / KERNEL / ext.name)
+        extensions: List[Path] = []
+        kernel_inputs: List[Path] = []  # hashed into the private name: a pure-Python build gets another one
+        if compiled and compiled_in_bundle(staging / PACKAGE):
+            build_kernel_in_place(package_dir)
+            kernel_inputs = [package_dir / KERNEL / "compile.py",
+                             *(package_dir / KERNEL / f"{m}.pxd" for m in compiled_in_bundle(staging / PACKAGE))]
+        names = native.privatize(staging, PACKAGE, script.stem, extra=kernel_inputs)  # cam_fmu_<hash>, ...
+        if kernel_inputs:
+            extensions = kernel_extensions(package_dir, staging / names.package)
         binary = native.build_binary(Path(tmp) / "native" / f"{model}.so")  # fails early without a C compiler
-        kernel = [f"{KERNEL}.{m}" for m in COMPILED_MODULES
-                  if (staging / names.package / KERNEL / f"{m}.py").is_file()]
+        kernel = [f"{KERNEL}.{m}" for m in compiled_in_bundle(staging / names.package)]
         info = check_bundle(staging, names.slave_module, cls, names.package, kernel)
         loaded = {m: not f.endswith(".py") for m, f in info["kernel"].items()}
         if any(is_ext != compiled for is_ext in loaded.values()):
