@@ -115,7 +115,7 @@ def test_an_extension_compiled_as_cam_fmu_loads_under_a_private_name_but_leaks_i
     assert r["where"] == ["cam_fmu_deadbeef.errors", "cam_fmu_deadbeef.kernel.probe", "cam_fmu_deadbeef.kernel",
                           list(COMPILED_MODULES)]
     assert r["cam_fmu"] is False
-    assert r["leaked"] is True  # the reason for kernel_extensions in fmu/build.py
+    assert r["leaked"] is True  # the reason for compile_kernel in fmu/native/compile.py
 
 
 # --------------------------------------------------------------------------- cam.fmu

@@ -269,36 +269,11 @@ def compiled_in_bundle(staged_package: Path) -> Tuple[str, ...]:
 
 
 def build_kernel_in_place(package_dir: Path) -> List[Path]:
-    """The kernel's extensions beside their .py in ``package_dir`` (a checkout then imports them too).
-
-    A read-only package (an installed one) is left as it is: the FMU compiles its own copy anyway.
-    """
+    """The kernel's extensions beside their .py (a checkout imports them too); a read-only package is left as is."""
     from ..kernel import compile as kernel_compile
 
     source = package_dir / KERNEL
     return kernel_compile.build_extension(source) if os.access(source, os.W_OK) else []
-
-
-def kernel_extensions(package_dir: Path, staged_package: Path) -> List[Path]:
-    """Compile the staged (privatized) kernel modules into the staged package and return the extensions.
-
-    Compiled again under the private name (``cam_fmu_<hash>.kernel.drive_kernel``),
-    not copied from the checkout: a Cython module also enters itself into
-    sys.modules under the dotted name it was compiled with, and the checkout's
-    (``cam_fmu.kernel.drive_kernel``) would put a public name into every host
-    process, shadowing a host's own cam_fmu (tests/test_kernel_build.py).
-    """
-    from ..kernel import compile as kernel_compile
-
-    modules = compiled_in_bundle(staged_package)
-    kernel_dir = staged_package / KERNEL
-    for name in modules:  # the C types, beside the staged .py for Cython (not shipped)
-        shutil.copy2(package_dir / KERNEL / f"{name}.pxd", kernel_dir / f"{name}.pxd")
-    try:
-        return kernel_compile.build_extension(kernel_dir, modules=modules, force=True)
-    finally:
-        for name in modules:
-            (kernel_dir / f"{name}.pxd").unlink()
 
 
 def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, model: str = "cam",
@@ -334,8 +309,9 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
             kernel_inputs = [package_dir / KERNEL / "compile.py",
                              *(package_dir / KERNEL / f"{m}.pxd" for m in compiled_in_bundle(staging / PACKAGE))]
         names = native.privatize(staging, PACKAGE, script.stem, extra=kernel_inputs)  # cam_fmu_<hash>, ...
-        if kernel_inputs:
-            extensions = kernel_extensions(package_dir, staging / names.package)
+        if kernel_inputs:  # compiled again under the private name (native.compile_kernel says why)
+            extensions = native.compile_kernel(package_dir / KERNEL, staging / names.package / KERNEL,
+                                               compiled_in_bundle(staging / names.package))
         binary = native.build_binary(Path(tmp) / "native" / f"{model}.so")  # fails early without a C compiler
         kernel = [f"{KERNEL}.{m}" for m in compiled_in_bundle(staging / names.package)]
         info = check_bundle(staging, names.slave_module, cls, names.package, kernel)

@@ -17,6 +17,10 @@ Build time only (never bundled). Three steps, used by ``build_fmu.py``:
    ``resources/native.txt`` (private names), move pythonfmu's run-time modules
    into the private package (``<package>._pythonfmu``) and add the bridge
    (``<package>._fmi_bridge``). pythonfmu's win64 binary stays as it is.
+
+``compile_kernel`` compiles the staged drive kernel under the private name
+(build_fmu.py without --pure-python; the extension loads on linux64 with the
+build's Python version, the bundled .py everywhere else).
 """
 from __future__ import annotations
 
@@ -102,6 +106,26 @@ def privatize(staging: Path, package: str, script_stem: str, extra: Sequence[Pat
         if fixed != src:
             path.write_text(fixed, encoding="utf-8")
     return names
+
+
+def compile_kernel(kernel_dir: Path, staged_kernel: Path, modules: Sequence[str]) -> List[Path]:
+    """Compile the staged (privatized) kernel modules beside their staged .py; return the extensions.
+
+    Not a copy of the checkout's extension: a Cython module also enters itself
+    into sys.modules under the dotted name it was compiled with, so the
+    checkout's (``cam_fmu.kernel.drive_kernel``) would put a public name into
+    every host process and shadow a host's own cam_fmu. Compiled from the staged
+    copy, the name is the private ``cam_fmu_<hash>.kernel.drive_kernel``.
+    """
+    from ...kernel import compile as kernel_compile
+
+    for name in modules:  # the C types beside the staged .py, for Cython only (not shipped)
+        shutil.copy2(kernel_dir / f"{name}.pxd", staged_kernel / f"{name}.pxd")
+    try:
+        return kernel_compile.build_extension(staged_kernel, modules=tuple(modules), force=True)
+    finally:
+        for name in modules:
+            (staged_kernel / f"{name}.pxd").unlink()
 
 
 def find_compiler() -> str:
