@@ -20,3 +20,5 @@ if [ "${#missing[@]}" -gt 0 ]; then
 fi
 
 python -m pip install -e ".[test]"
+# the drive kernel's extension beside its .py (Cython + gcc; skipped while current), so the tests use it
+python -m cam_fmu.kernel.compile

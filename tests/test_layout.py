@@ -50,6 +50,15 @@ def test_no_module_over_400_lines():
     assert long == {}
 
 
+def test_each_pxd_is_the_twin_of_a_compiled_module():
+    """The C types (.pxd, read by cam_fmu/kernel/compile.py) exist exactly for COMPILED_MODULES, beside their .py."""
+    from cam_fmu.kernel import COMPILED_MODULES
+
+    pxds = {p.relative_to(PACKAGE) for p in PACKAGE.rglob("*.pxd")}
+    assert pxds == {Path("kernel") / f"{m}.pxd" for m in COMPILED_MODULES}
+    assert all((PACKAGE / "kernel" / f"{m}.py").is_file() for m in COMPILED_MODULES)
+
+
 def test_imports_inside_the_package_are_relative():
     """So the FMU's bundle can live under any package name (the slave scripts, top-level modules, excepted)."""
     absolute = []

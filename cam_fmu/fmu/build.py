@@ -28,18 +28,29 @@ linux64: ``native.compile`` stages the bundle under private names
 (``cam_fmu_<hash>``, ``<slave>_<hash>``), compiles the project's own FMI wrapper
 with the system C compiler (no compiler: the build stops) and puts it,
 ``resources/python.txt`` and ``resources/native.txt`` into the FMU (docs/fmu.md).
+
+The compiled drive kernel (``cam_fmu/kernel``, docs/architecture.md): cam.fmu
+always bundles ``kernel/drive_kernel.py`` (the fallback); ``build(compiled=True)``
+(the default; ``--pure-python`` turns it off) first builds its extension in
+place with ``kernel.compile`` (so the checkout uses it too), then compiles the
+staged copy under the private package name and ships that .so beside the
+bundled .py. Where the .so's ABI tag does not match the host's Python, the
+import system loads the .py.
 """
 from __future__ import annotations
 
 import argparse
 import ast
 import json
+import os
 import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 from typing import Dict, Iterable, List, Set, Tuple
+
+from ..kernel import COMPILED_MODULES
 
 PACKAGE = "cam_fmu"
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
@@ -49,11 +60,14 @@ MODELS: Dict[str, Tuple[Path, str]] = {
     "cam": (SLAVE_SCRIPT, "CamDriveSlave"),
     "pi_speed": (Path("fmu") / "pi_speed_fmu_slave.py", "PiSpeedSlave"),
 }
+KERNEL = "kernel"  # the subpackage of the compiled modules
+# Modules bundled even before the slave imports them: cam.fmu carries the drive kernel (.py and .so).
+ROOTS: Dict[str, Tuple[str, ...]] = {"cam": tuple(f"{KERNEL}.{m}" for m in COMPILED_MODULES)}
 SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
 # Files that shape the FMU beside the bundled closure (their change makes a built FMU stale).
 BUILD_SOURCES = (Path("fmu") / "build.py", Path("fmu") / "model_description.py",
                  Path("fmu") / "native" / "fmi2_python.c", Path("fmu") / "native" / "bridge.py",
-                 Path("fmu") / "native" / "compile.py")
+                 Path("fmu") / "native" / "compile.py", Path(KERNEL) / "compile.py")
 ALLOWED_THIRD_PARTY = {"numpy", "pythonfmu"}
 FORBIDDEN = {"scipy", "matplotlib", "pandas", "fmpy"}
 
@@ -122,8 +136,11 @@ def _imports(path: Path, package_dir: Path) -> Tuple[Set[str], Set[str], bool]:
     return internal, external, needs_init
 
 
-def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
-    """Files of ``package_dir`` the slave needs (transitively) and whether the real __init__ is needed."""
+def bundle_modules(package_dir: Path, script: Path, roots: Iterable[str] = ()) -> Tuple[List[Path], bool]:
+    """Files of ``package_dir`` the slave needs (transitively) and whether the real __init__ is needed.
+
+    ``roots``: package-internal modules (``kernel.drive_kernel``) bundled as if the slave imported them.
+    """
     todo = [script]
     seen: Set[Path] = set()
     files: Set[Path] = set()
@@ -135,6 +152,8 @@ def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
             continue
         seen.add(path)
         internal, external, init = _imports(path, package_dir)
+        if path == script:
+            internal |= set(roots)
         needs_init |= init
         for ext in external:
             externals.setdefault(ext, set()).add(path.name)
@@ -162,7 +181,7 @@ def bundle_modules(package_dir: Path, script: Path) -> Tuple[List[Path], bool]:
     return sorted(f for f in files if f != script), needs_init
 
 
-def stage(package_dir: Path, script: Path, staging: Path) -> List[str]:
+def stage(package_dir: Path, script: Path, staging: Path, roots: Iterable[str] = ()) -> List[str]:
     """Copy the slave script and the needed part of the package into ``staging``; return the bundled names.
 
     Each FMU bundles only its own slave's closure: ``native.privatize`` then
@@ -170,7 +189,7 @@ def stage(package_dir: Path, script: Path, staging: Path) -> List[str]:
     (``cam_fmu_<hash>``), so cam.fmu and pi_speed.fmu loaded into one host
     process never share or shadow each other's modules.
     """
-    modules, needs_init = bundle_modules(package_dir, script)
+    modules, needs_init = bundle_modules(package_dir, script, roots)
     target_pkg = staging / PACKAGE
     target_pkg.mkdir(parents=True)
     for path in modules:
@@ -195,13 +214,22 @@ slave = slave_module.{cls}(instance_name="check", resources=sys.argv[1])
 slave.exit_initialization_mode()
 assert slave.do_step(0.0, 1e-3) is True
 forbidden = sorted(m for m in sys.modules if m.split(".")[0] in {forbidden!r})
-print(json.dumps({{"forbidden": forbidden, "modules": sorted(m for m in sys.modules if m.startswith("cam_fmu"))}}))
+modules = sorted(m for m in sys.modules if m.startswith("cam_fmu"))
+import importlib
+kernel = {{m: importlib.import_module("{package}." + m).__file__ for m in {kernel!r}}}
+print(json.dumps({{"forbidden": forbidden, "modules": modules, "kernel": kernel}}))
 """
 
 
-def check_bundle(staging: Path, module: str, cls: str = "CamDriveSlave", package: str = PACKAGE) -> dict:
-    """Import and step the staged slave in an isolated interpreter: proves the bundle is complete."""
-    code = CHECK_BUNDLE.format(module=module, cls=cls, package=package, forbidden=sorted(FORBIDDEN))
+def check_bundle(staging: Path, module: str, cls: str = "CamDriveSlave", package: str = PACKAGE,
+                 kernel: Iterable[str] = ()) -> dict:
+    """Import and step the staged slave in an isolated interpreter: proves the bundle is complete.
+
+    Each module of ``kernel`` (``kernel.drive_kernel``) is imported too; ``info["kernel"]``
+    maps it to the file Python loaded (the extension, or the .py where there is none).
+    """
+    code = CHECK_BUNDLE.format(module=module, cls=cls, package=package, forbidden=sorted(FORBIDDEN),
+                               kernel=list(kernel))
     proc = subprocess.run([sys.executable, "-I", "-c", code, str(staging)], capture_output=True, text=True,
                           cwd=staging, timeout=120)
     if proc.returncode != 0:
@@ -221,7 +249,9 @@ def _model(model: str) -> Tuple[Path, str]:
 def sources(package_dir: Path = PACKAGE_DIR, model: str = "cam") -> list[Path]:
     """Every file whose content ends up in (or shapes) the FMU of ``model``."""
     script = package_dir / _model(model)[0]
-    return [script, *bundle_modules(package_dir, script)[0], *(package_dir / p for p in BUILD_SOURCES)]
+    modules = bundle_modules(package_dir, script, ROOTS.get(model, ()))[0]
+    pxds = [p.with_suffix(".pxd") for p in modules if p.with_suffix(".pxd").is_file()]  # C types of a compiled one
+    return [script, *modules, *pxds, *(package_dir / p for p in BUILD_SOURCES)]
 
 
 def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> bool:
@@ -233,8 +263,26 @@ def is_stale(fmu: Path, package_dir: Path = PACKAGE_DIR, model: str = "cam") -> 
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, model: str = "cam") -> Path:
-    """Build the FMU of ``model`` (a key of MODELS) at ``dest`` (a path ending in .fmu) and return it."""
+def compiled_in_bundle(staged_package: Path) -> Tuple[str, ...]:
+    """The compiled modules whose .py is in the staged package (cam.fmu: all; pi_speed.fmu: none)."""
+    return tuple(m for m in COMPILED_MODULES if (staged_package / KERNEL / f"{m}.py").is_file())
+
+
+def build_kernel_in_place(package_dir: Path) -> List[Path]:
+    """The kernel's extensions beside their .py (a checkout imports them too); a read-only package is left as is."""
+    from ..kernel import compile as kernel_compile
+
+    source = package_dir / KERNEL
+    return kernel_compile.build_extension(source) if os.access(source, os.W_OK) else []
+
+
+def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, model: str = "cam",
+          compiled: bool = True) -> Path:
+    """Build the FMU of ``model`` (a key of MODELS) at ``dest`` (a path ending in .fmu) and return it.
+
+    ``compiled``: bundle the compiled drive kernel beside its .py (built first, in
+    place); False builds a pure-Python FMU (the bench compares the two).
+    """
     package_dir = Path(package_dir or PACKAGE_DIR).resolve()
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
@@ -253,13 +301,28 @@ def build(dest: Path, package_dir: Path | None = None, verbose: bool = False, mo
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         staging = Path(tmp) / "stage"
         staging.mkdir()
-        bundled = stage(package_dir, script, staging)
-        names = native.privatize(staging, PACKAGE, script.stem)  # private names: cam_fmu_<hash>, ...
+        bundled = stage(package_dir, script, staging, ROOTS.get(model, ()))
+        extensions: List[Path] = []
+        kernel_inputs: List[Path] = []  # hashed into the private name: a pure-Python build gets another one
+        if compiled and compiled_in_bundle(staging / PACKAGE):
+            build_kernel_in_place(package_dir)
+            kernel_inputs = [package_dir / KERNEL / "compile.py",
+                             *(package_dir / KERNEL / f"{m}.pxd" for m in compiled_in_bundle(staging / PACKAGE))]
+        names = native.privatize(staging, PACKAGE, script.stem, extra=kernel_inputs)  # cam_fmu_<hash>, ...
+        if kernel_inputs:  # compiled again under the private name (native.compile_kernel says why)
+            extensions = native.compile_kernel(package_dir / KERNEL, staging / names.package / KERNEL,
+                                               compiled_in_bundle(staging / names.package))
         binary = native.build_binary(Path(tmp) / "native" / f"{model}.so")  # fails early without a C compiler
-        info = check_bundle(staging, names.slave_module, cls, names.package)
+        kernel = [f"{KERNEL}.{m}" for m in compiled_in_bundle(staging / names.package)]
+        info = check_bundle(staging, names.slave_module, cls, names.package, kernel)
+        loaded = {m: not f.endswith(".py") for m, f in info["kernel"].items()}
+        if any(is_ext != compiled for is_ext in loaded.values()):
+            raise BuildError(f"the staged kernel modules loaded {info['kernel']}, expected "
+                             f"{'the extensions' if compiled else 'the .py files'}")
         if verbose:
-            print("bundled:", ", ".join(bundled))
+            print("bundled:", ", ".join(bundled + [str(e.name) for e in extensions]))
             print("modules imported at run time:", ", ".join(info["modules"]))
+            print("kernel:", ", ".join(f"{m} ({Path(f).name})" for m, f in info["kernel"].items()))
         out = Path(tmp) / "out" / f"{model}.fmu"
         out.parent.mkdir()
         FmuBuilder.build_FMU(
@@ -301,12 +364,16 @@ def main(argv: List[str] | None = None) -> int:
     parser.add_argument("--model", choices=sorted(MODELS), default="cam", help="the FMU --dest builds")
     parser.add_argument("--package-dir", type=Path, default=None, help=argparse.SUPPRESS)
     parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules")
+    parser.add_argument("--pure-python", action="store_true",
+                        help="bundle the drive kernel as Python only (no compiled extension; for the bench)")
     args = parser.parse_args(argv)
+    compiled = not args.pure_python
     try:
         if args.dest is not None:
-            print(build(args.dest, args.package_dir, args.verbose, args.model))
+            print(build(args.dest, args.package_dir, args.verbose, args.model, compiled))
             return 0
-        built = {name: build(default_model_path(name), args.package_dir, args.verbose, name) for name in MODELS}
+        built = {name: build(default_model_path(name), args.package_dir, args.verbose, name, compiled)
+                 for name in MODELS}
         for path in built.values():
             print(path)
         print(build_ssp(default_model_path(SSP_NAME, ".ssp"), built["cam"], built["pi_speed"]))

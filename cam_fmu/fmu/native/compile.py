@@ -17,6 +17,10 @@ Build time only (never bundled). Three steps, used by ``build_fmu.py``:
    ``resources/native.txt`` (private names), move pythonfmu's run-time modules
    into the private package (``<package>._pythonfmu``) and add the bridge
    (``<package>._fmi_bridge``). pythonfmu's win64 binary stays as it is.
+
+``compile_kernel`` compiles the staged drive kernel under the private name
+(build_fmu.py without --pure-python; the extension loads on linux64 with the
+build's Python version, the bundled .py everywhere else).
 """
 from __future__ import annotations
 
@@ -33,7 +37,7 @@ import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Sequence
 
 HERE = Path(__file__).resolve().parent
 C_SOURCE = HERE / "fmi2_python.c"
@@ -73,20 +77,24 @@ def _rewrite_imports(source: str, old: str, new: str) -> str:
     return re.sub(rf"^(\s*import\s+){re.escape(old)}(?=[\s.,]|$)", rf"\g<1>{new}", source, flags=re.M)
 
 
-def content_digest(staging: Path, package: str, script: Path) -> str:
-    """8 hex digits of a hash over everything that runs inside the FMU."""
+def content_digest(staging: Path, package: str, script: Path, extra: Sequence[Path] = ()) -> str:
+    """8 hex digits of a hash over everything that runs inside the FMU (``extra``: files added later)."""
     h = hashlib.sha256()
-    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE]
+    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE, *extra]
     files += [_pythonfmu_dir() / name for name in PYTHONFMU_RUNTIME]
     for path in files:
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()[:8]
 
 
-def privatize(staging: Path, package: str, script_stem: str) -> PrivateNames:
-    """Rename the staged package and slave script to private names (see the module doc)."""
+def privatize(staging: Path, package: str, script_stem: str, extra: Sequence[Path] = ()) -> PrivateNames:
+    """Rename the staged package and slave script to private names (see the module doc).
+
+    ``extra``: files put into the package after this (the compiled kernel), hashed
+    into the name too: a compiled and a pure-Python build never share a name.
+    """
     script = staging / f"{script_stem}.py"
-    digest = content_digest(staging, package, script)
+    digest = content_digest(staging, package, script, extra)
     names = PrivateNames(f"{package}_{digest}", f"{script_stem}_{digest}", digest)
     (staging / package).rename(staging / names.package)
     text = _rewrite_imports(script.read_text(encoding="utf-8"), package, names.package)
@@ -98,6 +106,26 @@ def privatize(staging: Path, package: str, script_stem: str) -> PrivateNames:
         if fixed != src:
             path.write_text(fixed, encoding="utf-8")
     return names
+
+
+def compile_kernel(kernel_dir: Path, staged_kernel: Path, modules: Sequence[str]) -> List[Path]:
+    """Compile the staged (privatized) kernel modules beside their staged .py; return the extensions.
+
+    Not a copy of the checkout's extension: a Cython module also enters itself
+    into sys.modules under the dotted name it was compiled with, so the
+    checkout's (``cam_fmu.kernel.drive_kernel``) would put a public name into
+    every host process and shadow a host's own cam_fmu. Compiled from the staged
+    copy, the name is the private ``cam_fmu_<hash>.kernel.drive_kernel``.
+    """
+    from ...kernel import compile as kernel_compile
+
+    for name in modules:  # the C types beside the staged .py, for Cython only (not shipped)
+        shutil.copy2(kernel_dir / f"{name}.pxd", staged_kernel / f"{name}.pxd")
+    try:
+        return kernel_compile.build_extension(staged_kernel, modules=tuple(modules), force=True)
+    finally:
+        for name in modules:
+            (staged_kernel / f"{name}.pxd").unlink()
 
 
 def find_compiler() -> str:
