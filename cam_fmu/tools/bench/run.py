@@ -36,6 +36,18 @@ Outputs: one printed row per run (as it goes), OUT/bench.csv, OUT/bench.png
 and communication step) and OUT/choices.csv (per scene and communication step,
 the cheapest setting reaching each accuracy level). Default OUT: out/bench.
 
+Then, per shipped scene at the defaults (1 ms communication steps; ``--quick``:
+fig. 6 only), the per-step table (``perstep.py``, OUT/scenes.csv): cam.fmu as
+measured (the compiled path), cam.fmu built with ``build(dest, compiled=False)``
+(the pure-Python path), the pythonfmu floor and a C floor (``c_floor.py``: the
+same variables, a trivial C model), run alternately, each once recording theta
+and omega and once every output: us/step and both paths' ratios to both floors.
+On fig. 6 the cost per effect (OUT/effects.csv: each effect switched, all off),
+the Pareto front of the grid (column ``pareto`` of bench.csv, drawn on
+bench.png) and the goal verdict (at most 1.5x the pythonfmu floor and 2.5x the
+C floor with theta and omega recorded). Memory: ``python -m
+cam_fmu.tools.bench.memory``.
+
 Timing on a shared machine is noisy: compare ratios measured in the same run,
 not absolute times across runs. The FMU runs in this process, which already
 imported the checkout's ``cam_fmu``: the FMU's slave script then uses these
