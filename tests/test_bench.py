@@ -21,7 +21,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
            "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
-           "floor_us_per_step", "cost_ratio", "repeats", "error")
+           "floor_us_per_step", "cost_ratio", "repeats", "pareto", "error")
 QUICK_FMU_ROWS = {("euler", "h=0.001"), ("rk4", "h=0.001"), ("etdrk4", "h=0.001"),
                   ("rk45", "rtol=1e-06"), ("rk45", "rtol=1e-10")}
 
@@ -70,6 +70,34 @@ def test_csv_columns_and_rows(quick):
     # one printed row per run
     printed = [line for line in quick["stdout"].splitlines() if re.match(r"fig6\s+(floor|ref|fmu)\s", line)]
     assert len(printed) == len(rows)
+
+
+def test_scene_table_effects_pareto_and_goal(quick):
+    """The per-step table (fig6 only with --quick), the cost per effect and the goal verdict."""
+    from cam_fmu.tools.bench import perstep
+
+    with open(quick["out"] / "scenes.csv", newline="", encoding="utf-8") as fh:
+        scenes = list(csv.DictReader(fh))
+    assert [(r["scene"], r["record"]) for r in scenes] == [("paper_fig6", "theta,omega"), ("paper_fig6", "all")]
+    for r in scenes:
+        assert r["error"] == "", r
+        for kind in perstep.KINDS:
+            assert math.isfinite(_num(r, f"{kind}_us")) and _num(r, f"{kind}_us") > 0.0
+        assert math.isclose(_num(r, "cam_c_ratio"), _num(r, "cam_us") / _num(r, "c_floor_us"), rel_tol=1e-9)
+        assert _num(r, "cam_py_ratio") > 1.0 and _num(r, "pure_c_ratio") > 1.0  # a model costs more than none
+    with open(quick["out"] / "effects.csv", newline="", encoding="utf-8") as fh:
+        effects = list(csv.DictReader(fh))
+    assert [r["config"] for r in effects] == [c[0] for c in perstep.effect_configs()]
+    assert all(r["error"] == "" and _num(r, "us_per_step") > 0.0 for r in effects)
+    assert _num(effects[0], "delta_us") == 0.0
+    front = [r for r in quick["rows"] if r["pareto"] == "True"]
+    assert front and all(r["kind"] == "fmu" for r in front)
+    # nothing beats the least error: a run with it is on the front
+    runs = [r for r in quick["rows"] if r["kind"] == "fmu"]
+    least = min(_num(r, "theta_err") for r in runs)
+    assert any(r["pareto"] == "True" for r in runs if _num(r, "theta_err") == least)
+    assert re.search(r"^# goal \(fig6, defaults, 1 ms, theta\+omega recorded\): compiled path .* the C floor",
+                     quick["stdout"], flags=re.M)
 
 
 def test_every_run_reached_stop_time(quick):

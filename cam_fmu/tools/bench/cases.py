@@ -22,9 +22,7 @@ TARGET_RATIO = 3.0  # the cheapest setting meeting TARGET_ERR costs at most this
 
 CASE_SCENES = {"fig6": "paper_fig6", "backlash": "backlash", "inductance": "inductance"}  # shipped scenes
 
-COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
-           "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
-           "floor_us_per_step", "cost_ratio", "repeats", "error")
+# the CSV columns: report.COLUMNS
 
 
 @dataclass

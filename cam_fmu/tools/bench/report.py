@@ -11,7 +11,7 @@ from .cases import CASES, LEVELS, TARGET_ERR, TARGET_RATIO
 
 COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
            "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
-           "floor_us_per_step", "cost_ratio", "repeats", "error")
+           "floor_us_per_step", "cost_ratio", "repeats", "pareto", "error")
 
 def _fmt(value, spec: str, width: int) -> str:
     if value is None or value == "" or (isinstance(value, float) and math.isnan(value)):
@@ -108,6 +108,83 @@ def target_verdict(rows: list[dict]) -> str:
     return "# target (fig6, 1 ms): " + "; ".join(parts)
 
 
+# =========================================================================== Pareto front
+def pareto(rows: list[dict]) -> list[dict]:
+    """Mark every FMU row: ``pareto`` True when no other successful run of the same scene and comm step
+    is at least as good in both theta error and cost ratio and better in one (the non-dominated
+    settings), False otherwise; rows without an error (floor, reference, failed runs) get "".
+    Returns the front's rows, by scene, comm step and cost."""
+    groups: dict = {}
+    for r in rows:
+        r["pareto"] = ""
+        if r["kind"] == "fmu" and r["status"] == "ok" and r["theta_err"] != "" and r["cost_ratio"] != "":
+            groups.setdefault((r["case"], r["comm_step"]), []).append(r)
+    front = []
+    for key in sorted(groups, key=lambda k: (CASES.index(k[0]) if k[0] in CASES else 99, k[1])):
+        runs = groups[key]
+        for r in runs:
+            dominated = any(o is not r and o["theta_err"] <= r["theta_err"] and o["cost_ratio"] <= r["cost_ratio"]
+                            and (o["theta_err"] < r["theta_err"] or o["cost_ratio"] < r["cost_ratio"])
+                            for o in runs)
+            r["pareto"] = not dominated
+        front += sorted((r for r in runs if r["pareto"]), key=lambda r: r["cost_ratio"])
+    return front
+
+
+def format_pareto(front: list[dict]) -> str:
+    lines = ["# Pareto front: the settings no other one beats in both theta error and cost (per scene, comm step)",
+             f"{'case':<11}{'comm[s]':>8}  {'solver':<7}{'setting':<12}{'theta_err':>11}{'us/step':>10}{'ratio':>8}"]
+    for r in front:
+        lines.append(f"{r['case']:<11}{r['comm_step']:>8g}  {r['solver']:<7}{r['setting'] + ('*' if r['default'] else ''):<12}"
+                     f"{_fmt(r['theta_err'], '.2e', 11)}{_fmt(r['us_per_step'], '.1f', 10)}"
+                     f"{_fmt(r['cost_ratio'], '.2f', 8)}")
+    return "\n".join(lines)
+
+
+# =========================================================================== per-step tables
+SCENE_HEADER = (f"{'scene':<13}{'record':<13}{'cam':>8}{'pure':>8}{'py_flr':>8}{'c_flr':>8}"
+                f"{'cam/py':>8}{'cam/c':>8}{'pure/py':>8}{'pure/c':>8}   [us/step; ratios]")
+
+
+def format_scene_row(row: dict) -> str:
+    return (f"{row['scene']:<13}{row['record']:<13}" + "".join(_fmt(row[f"{k}_us"], ".1f", 8) for k in
+                                                               ("cam", "pure", "py_floor", "c_floor"))
+            + "".join(_fmt(row[k], ".2f", 8) for k in ("cam_py_ratio", "cam_c_ratio", "pure_py_ratio", "pure_c_ratio"))
+            + (f"   error: {row['error']}" if row["error"] else ""))
+
+
+def format_effects(rows: list[dict]) -> str:
+    lines = ["# cost per effect: fig. 6 at the defaults, 1 ms, theta and omega recorded, cam.fmu (compiled path); "
+             "delta: against the defaults",
+             f"{'config':<24}{'change':<24}{'us/step':>9}{'delta':>9}{'/py_flr':>9}{'/c_flr':>9}"]
+    for r in rows:
+        lines.append(f"{r['config']:<24}{r['change']:<24}{_fmt(r['us_per_step'], '.1f', 9)}"
+                     f"{r['delta_us']:>+9.1f}{_fmt(r['py_ratio'], '.2f', 9)}{_fmt(r['c_ratio'], '.2f', 9)}"
+                     + (f"  error: {r['error']}" if r["error"] else ""))
+    return "\n".join(lines)
+
+
+def goal_verdict(scene_rows: list[dict], goal_py: float = 1.5, goal_c: float = 2.5) -> str:
+    """The issue's goal on fig. 6 at the defaults, theta and omega recorded: cam.fmu per communication
+    step at most ``goal_py`` x the pythonfmu floor and at most ``goal_c`` x the C floor; both paths."""
+    rows = [r for r in scene_rows if r["scene"] == "paper_fig6" and r["record"] == "theta,omega"]
+    if not rows:
+        return "# goal (fig6, defaults, 1 ms, theta+omega recorded): no fig6 row"
+    r = rows[0]
+    parts = []
+    for path, key in (("compiled", "cam"), ("pure", "pure")):
+        py, c = r[f"{key}_py_ratio"], r[f"{key}_c_ratio"]
+        if not (math.isfinite(py) and math.isfinite(c)):
+            parts.append(f"{path} path: no measurement")
+            continue
+        ok_py, ok_c = py <= goal_py, c <= goal_c
+        parts.append(f"{path} path {r[key + '_us']:.1f} us/step = {py:.2f}x the pythonfmu floor "
+                     f"({r['py_floor_us']:.1f} us) {'<=' if ok_py else '>'} {goal_py:g}x: {'met' if ok_py else 'NOT met'}, "
+                     f"{c:.2f}x the C floor ({r['c_floor_us']:.1f} us) {'<=' if ok_c else '>'} {goal_c:g}x: "
+                     f"{'met' if ok_c else 'NOT met'}")
+    return "# goal (fig6, defaults, 1 ms, theta+omega recorded): " + "; ".join(parts)
+
+
 def plot(rows: list[dict], path: Path) -> None:
     import matplotlib
 
@@ -131,6 +208,12 @@ def plot(rows: list[dict], path: Path) -> None:
                 if pts:
                     ax.loglog(*zip(*pts), color=color, marker=markers.get(comm, "x"), linewidth=1.2,
                               label=f"{solver}, comm {comm:g} s")
+        front = sorted((r for r in runs if r.get("pareto") is True), key=lambda r: (r["comm_step"], r["cost_ratio"]))
+        for k, comm in enumerate(sorted({r["comm_step"] for r in front})):
+            pts = [(r["cost_ratio"], max(r["theta_err"], 1e-10)) for r in front if r["comm_step"] == comm]
+            ax.loglog(*zip(*pts), color="k", linestyle=":", linewidth=1.0, marker=markers.get(comm, "x"),
+                      markerfacecolor="none", markersize=11, zorder=5,
+                      label="Pareto front (per comm step)" if k == 0 else None)
         ax.axhline(TARGET_ERR, color="k", linestyle="--", linewidth=0.8)
         ax.axhspan(1e-10, 1e-8, color="0.9", zorder=0)
         ax.set_ylim(1e-10, None)
@@ -146,7 +229,8 @@ def plot(rows: list[dict], path: Path) -> None:
     # below the axes, outside them; bbox_inches="tight" grows the canvas so nothing is clipped
     fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=min(4, max(1, len(labels))),
                fontsize=8, frameon=False)
-    fig.suptitle("cam.fmu through fmpy: theta error against cost (dashed: 1e-6 rad target)")
+    fig.suptitle("cam.fmu through fmpy: theta error against cost (dashed: 1e-6 rad target; "
+                 "open black markers, dotted: the Pareto front)")
     fig.tight_layout()
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)

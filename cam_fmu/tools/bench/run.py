@@ -36,6 +36,18 @@ Outputs: one printed row per run (as it goes), OUT/bench.csv, OUT/bench.png
 and communication step) and OUT/choices.csv (per scene and communication step,
 the cheapest setting reaching each accuracy level). Default OUT: out/bench.
 
+Then, per shipped scene at the defaults (1 ms communication steps; ``--quick``:
+fig. 6 only), the per-step table (``perstep.py``, OUT/scenes.csv): cam.fmu as
+measured (the compiled path), cam.fmu built with ``build(dest, compiled=False)``
+(the pure-Python path), the pythonfmu floor and a C floor (``c_floor.py``: the
+same variables, a trivial C model), run alternately, each once recording theta
+and omega and once every output: us/step and both paths' ratios to both floors.
+On fig. 6 the cost per effect (OUT/effects.csv: each effect switched, all off),
+the Pareto front of the grid (column ``pareto`` of bench.csv, drawn on
+bench.png) and the goal verdict (at most 1.5x the pythonfmu floor and 2.5x the
+C floor with theta and omega recorded). Memory: ``python -m
+cam_fmu.tools.bench.memory``.
+
 Timing on a shared machine is noisy: compare ratios measured in the same run,
 not absolute times across runs. The FMU runs in this process, which already
 imported the checkout's ``cam_fmu``: the FMU's slave script then uses these
@@ -53,7 +65,9 @@ from typing import Callable
 from ...experiments.fmu_file import ensure_fmu
 from .cases import CASES, COMM_STEPS, References, load_cases, settings_grid
 from .floor import build_floor_fmu
-from .report import CHOICE_COLUMNS, HEADER, _row, choose, format_choices, format_row, plot, target_verdict, write_csv
+from .perstep import EFFECT_COLUMNS, GOAL_C, GOAL_PY, SCENE_COLUMNS, run_perstep
+from .report import (CHOICE_COLUMNS, HEADER, _row, choose, format_choices, format_pareto, format_row, goal_verdict,
+                     pareto, plot, target_verdict, write_csv)
 from .timing import RunError, TimedRunner, _reached, input_array, paired
 
 
@@ -139,19 +153,26 @@ def run_bench(out: Path, quick: bool = False, fmu_path: Path | None = None,
             if pending_ref is not None:  # the reference's grid is not one of the comm steps
                 emit(pending_ref)
 
+        scene_rows, effect_rows, _note = run_perstep(tmp, cam, floor, quick, say, repeats=5)
         del floor, cam
 
+    front = pareto(rows)
     write_csv(rows, out / "bench.csv")
+    write_csv(scene_rows, out / "scenes.csv", columns=SCENE_COLUMNS)
+    write_csv(effect_rows, out / "effects.csv", columns=EFFECT_COLUMNS)
     choices = choose(rows)
     write_csv(choices, out / "choices.csv", columns=CHOICE_COLUMNS)
     say("")
     say(format_choices(choices))
     say("")
+    say(format_pareto(front))
+    say("")
     say(target_verdict(rows))
+    say(goal_verdict(scene_rows, GOAL_PY, GOAL_C))
+    written = ", ".join(str(out / name) for name in ("bench.csv", "choices.csv", "scenes.csv", "effects.csv"))
     try:
         plot(rows, out / "bench.png")
-        say(f"# wrote {out / 'bench.csv'}, {out / 'choices.csv'}, {out / 'bench.png'} "
-            f"in {time.perf_counter() - started:.0f} s")
+        say(f"# wrote {written}, {out / 'bench.png'} in {time.perf_counter() - started:.0f} s")
     except ImportError as exc:  # matplotlib is optional
-        say(f"# wrote {out / 'bench.csv'}, {out / 'choices.csv'}; no plot ({exc})")
+        say(f"# wrote {written}; no plot ({exc})")
     return rows

@@ -16,8 +16,10 @@ class RunError(RuntimeError):
 class TimedRunner(FmuRunner):
     """An FmuRunner whose ``run`` times repeated simulations (garbage collection off while timing)."""
 
-    def run(self, start_values, stop_time, comm_step, input_array, repeats: int, min_time: float):
-        """(result, best wall time [s], repeats done) or raise RunError with the FMU's message."""
+    def run(self, start_values, stop_time, comm_step, input_array, repeats: int, min_time: float, outputs=None):
+        """(result, best wall time [s], repeats done) or raise RunError with the FMU's message.
+
+        ``outputs``: the variables fmpy records (None: every output, fmpy's default)."""
         best, result, done = math.inf, None, 0
         total = 0.0
         while done < repeats and (done == 0 or total < min_time):
@@ -25,11 +27,12 @@ class TimedRunner(FmuRunner):
             gc.disable()
             try:
                 t0 = time.perf_counter()
-                result = self.simulate(start_values, stop_time, comm_step, input_array)
+                result = self.simulate(start_values, stop_time, comm_step, input_array, outputs=outputs)
                 wall = time.perf_counter() - t0
             except Exception as exc:  # noqa: BLE001  (an FMI error is a result, not a crash)
                 gc.enable()
-                raise RunError(self.error_text(exc, start_values, stop_time, comm_step, input_array)) from None
+                raise RunError(self.error_text(exc, start_values, stop_time, comm_step, input_array,
+                                               outputs=outputs)) from None
             finally:
                 gc.enable()
             best = min(best, wall)
@@ -52,6 +55,31 @@ def paired(floor: TimedRunner, cam: TimedRunner, values, stop_time, comm, inputs
         total += wall
         done += 1
     return result, best, best_floor, done
+
+
+def alternated(entries, stop_time, comm, inputs, outputs, rounds: int):
+    """Run every entry once per round, ``rounds`` rounds: {name: (result or None, best wall [s] or nan,
+    error or "")}.
+
+    ``entries``: {name: (TimedRunner, start values)}; several names may share a runner. Alternating
+    puts every measurement of a comparison in the same seconds (see ``paired``). An entry that fails
+    is reported once with the FMU's message and left out of the later rounds.
+    """
+    best = {name: math.inf for name in entries}
+    results: dict = {name: None for name in entries}
+    errors = {name: "" for name in entries}
+    for _round in range(rounds):
+        for name, (runner, values) in entries.items():
+            if errors[name]:
+                continue
+            try:
+                res, wall, _ = runner.run(values, stop_time, comm, inputs, 1, 0.0, outputs=outputs)
+            except RunError as exc:
+                errors[name] = str(exc)
+                continue
+            results[name] = res
+            best[name] = min(best[name], wall)
+    return {name: (results[name], best[name] if not errors[name] else math.nan, errors[name]) for name in entries}
 
 
 def _reached(result, stop_time: float, n: int) -> bool:
