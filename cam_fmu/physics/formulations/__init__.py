@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from ..drive import DriveModel
 from .base import Formulation
-from .consistent import ConsistentVoltage
+from .consistent_voltage import ConsistentVoltage
 from .paper import PaperVoltage
 from .speed import SpeedDrive
 
