@@ -13,7 +13,6 @@ what the error grid does).
 """
 from __future__ import annotations
 
-import inspect
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,28 +65,17 @@ def load_scene_case(name: str) -> SceneCase:
     return SceneCase(name, scene.drive, values, signals_table(signal, scene.stop_time), scene.stop_time)
 
 
-def has_compiled_parameter() -> bool:
-    from ...fmu import build as fmu_build
-
-    return "compiled" in inspect.signature(fmu_build.build).parameters
-
-
 BUILD_SCRIPT = """
 import sys
 from pathlib import Path
 from cam_fmu.fmu.build import build
-if sys.argv[2] == "compiled=False":
-    build(Path(sys.argv[1]), compiled=False)
-else:
-    build(Path(sys.argv[1]))
+build(Path(sys.argv[1]), compiled=False)
 """
 
 
 def build_pure_fmu(folder: Path) -> tuple[Path, str]:
     """cam.fmu without the compiled extension (the pure-Python path): (the .fmu, a note for the report).
 
-    Uses ``build(dest, compiled=False)``. Where ``build`` has no ``compiled`` parameter yet the FMU
-    has no compiled extension to leave out: ``build(dest)`` is then the pure path, and the note says so.
     The build runs in a child process of this checkout's ``cam_fmu``: pythonfmu's builder imports the
     slave script by its private module name, which the cam.fmu already loaded here has taken.
     """
@@ -96,15 +84,13 @@ def build_pure_fmu(folder: Path) -> tuple[Path, str]:
     import sys
 
     dest = Path(folder) / "cam_pure.fmu"
-    compiled = has_compiled_parameter()
     root = str(Path(__file__).resolve().parents[3])
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH")))))
-    proc = subprocess.run([sys.executable, "-c", BUILD_SCRIPT, str(dest), "compiled=False" if compiled else "-"],
+    proc = subprocess.run([sys.executable, "-c", BUILD_SCRIPT, str(dest)],
                           capture_output=True, text=True, env=env, timeout=600)
     if proc.returncode != 0 or not dest.is_file():
         raise RuntimeError(f"building the pure-Python cam.fmu failed:\n{proc.stdout[-2000:]}\n{proc.stderr[-4000:]}")
-    note = "" if compiled else "build() has no 'compiled' parameter yet: pure = build(dest), no compiled extension"
-    return dest, note
+    return dest, ""
 
 
 def measure_scene(case: SceneCase, runners: dict, record: str, repeats: int) -> dict:
