@@ -9,6 +9,10 @@ cpdef double solve_guide_friction(double n0, double kappa, double sigma, double 
                                   double side=*)
 
 
+@cython.locals(k=int, p=double, angle=double, best=double)
+cpdef double first_angle_crossed(double[:] points, int n, double start, double end)
+
+
 cdef class Profile:
     cdef public double s, s1, s2, s3
     cdef public long long evaluations
@@ -28,7 +32,6 @@ cdef class Profile:
     @cython.locals(th=double)
     cpdef void profile(self, double theta) except *
     cpdef tuple derivatives(self, double theta)
-    @cython.locals(k=int, p=double, angle=double, best=double)
     cpdef double first_breakpoint(self, double start, double end)
 
 

@@ -169,28 +169,34 @@ class Profile:
 
     def first_breakpoint(self, start: float, end: float) -> float:
         """The first breakpoint angle [rad] strictly between start and end, or NaN (none)."""
-        best = 0.0
-        if end > start:
-            best = INF
-            for k in range(self.n_points):
-                p = self.points[k]
-                angle = p + math.ceil((start - p) / TWO_PI) * TWO_PI
-                if angle <= start:
-                    angle += TWO_PI
-                if angle < best:
-                    best = angle
-            return best if best < end else NAN
-        if end < start:
-            best = -INF
-            for k in range(self.n_points):
-                p = self.points[k]
-                angle = p + math.floor((start - p) / TWO_PI) * TWO_PI
-                if angle >= start:
-                    angle -= TWO_PI
-                if angle > best:
-                    best = angle
-            return best if best > end else NAN
-        return NAN
+        return first_angle_crossed(self.points, self.n_points, start, end)
+
+
+def first_angle_crossed(points, n: int, start: float, end: float) -> float:
+    """The first of the periodic angles points[:n] (each in [0, 2 pi)) strictly between start and end [rad],
+    in the direction of travel, or NaN (none); its cost does not grow with |end - start|."""
+    best = 0.0
+    if end > start:
+        best = INF
+        for k in range(n):
+            p = points[k]
+            angle = p + math.ceil((start - p) / TWO_PI) * TWO_PI
+            if angle <= start:
+                angle += TWO_PI
+            if angle < best:
+                best = angle
+        return best if best < end else NAN
+    if end < start:
+        best = -INF
+        for k in range(n):
+            p = points[k]
+            angle = p + math.floor((start - p) / TWO_PI) * TWO_PI
+            if angle >= start:
+                angle -= TWO_PI
+            if angle > best:
+                best = angle
+        return best if best > end else NAN
+    return NAN
 
 
 # Positions of the outputs in an output buffer (physics.variables.OUTPUTS order).
