@@ -81,10 +81,12 @@ class DriveSimulator:
         if self.budget is None and self.formulation.energy_bounded:
             out = self.values if not self._stale else self._fill(self.values)
             self.budget = EnergyBudget(self.model, out[_THETA], out[_OMEGA], out[_I], out[_S], out[_J])
-        self.steps_taken += self.formulation.advance(h, self.integrator, self.time)
+        out, formulation = self._scratch, self.formulation
+        # the step, its outputs into out and the kernel's verdict on them (the energy budget books the step)
+        verdict = formulation.advance_checked(h, self.integrator, self.time, out, self.budget, self.u,
+                                              self.model.kernel)
+        self.steps_taken += formulation.steps
         self.time = t + h
-        out = self._fill(self._scratch)
-        verdict = self.model.kernel.publishable(out, self.budget, self.u, h)  # books the energy too
         if verdict:
             self._refuse(verdict, out)
         self.values[:] = out

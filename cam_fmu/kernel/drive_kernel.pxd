@@ -122,6 +122,8 @@ cdef class DriveKernel(Profile):
     @cython.locals(t=double, steps=int, was_stuck=bint, remaining=double, next_valid=bint, dt=double,
                    target=double, cut=double, tau=double)
     cpdef int advance(self, double u, double h, double time) except -1
+    cdef public int steps
+    cpdef int advance_checked(self, double u, double h, double time, double[:] out, EnergyBudget budget) except -1
 
 
 cdef double _SLACK

@@ -258,7 +258,7 @@ class DriveKernel(Profile):
         self.d0 = self.d1 = self.d2 = 0.0  # derivative written by rhs
         # integrator state
         self.h_next = self.h_max = self.rtol = self.atol = 0.0
-        self.max_steps = 0
+        self.max_steps = self.steps = 0
         self.k1_valid = False
         self.k1_0 = self.k1_1 = self.k1_2 = 0.0  # f(y)
         self.z0 = self.z1 = self.z2 = 0.0  # dopri_step: y5
@@ -713,6 +713,14 @@ class DriveKernel(Profile):
             self.k1_valid = False
         self.fsal_u = u
         return steps
+
+    def advance_checked(self, u: float, h: float, time: float, out, budget) -> int:
+        """A whole communication step in one call: ``snapshot``, ``advance`` (its step count into
+        ``steps``), the outputs into ``out`` and ``publishable``'s verdict on them (0: publish)."""
+        self.snapshot()
+        self.steps = self.advance(u, h, time)
+        self.outputs(u, self.k1_1, self.k1_valid and not self.stuck, out)  # advance's k1 is f at its end
+        return self.publishable(out, budget, u, h)
 
 
 # Relative slack of the bound (integration error, rounding), of the energy scale |E| + r sum |W_in|.

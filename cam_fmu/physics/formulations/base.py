@@ -14,6 +14,7 @@ from typing import Any
 class Formulation:
     """One way of computing the drive's motion. Subclasses implement every method."""
 
+    steps = 0  # internal steps of the last advance_checked
     energy_bounded = False  # True: a voltage drive, whose states respect physics.energy's bound
     own_reference = False  # True: its reference is the same algorithm (agreement to rounding)
 
@@ -29,6 +30,14 @@ class Formulation:
     def advance(self, h: float, integrator: Any, time: float) -> int:
         """Advance by h [s] from ``time`` [s]; return the internal steps taken."""
         raise NotImplementedError
+
+    def advance_checked(self, h: float, integrator: Any, time: float, out: Any, budget: Any, u: float,
+                        kernel: Any) -> int:
+        """``advance`` (its step count into ``steps``), then the outputs into ``out`` and the kernel's
+        verdict on them under the input u [V] (``DriveKernel.publishable``: 0 publish, else what is wrong)."""
+        self.steps = self.advance(h, integrator, time)
+        self.fill_outputs(integrator, out)
+        return kernel.publishable(out, budget, u, h)
 
     def outputs(self, integrator: Any) -> dict[str, float]:
         """Every output of physics.variables.OUTPUTS at the current state."""

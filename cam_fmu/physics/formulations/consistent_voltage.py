@@ -39,6 +39,7 @@ class ConsistentVoltage(Formulation):
         kernel.settle_python = self._settle
         kernel.fail = self._fail
         self._integrator: Any = None  # the one advancing the kernel (its messages name its settings)
+        self._configured: Any = None  # the integrator whose rk45 settings the kernel holds
 
     # ------------------------------------------------------------ the state, kept in the kernel
     @property
@@ -92,16 +93,9 @@ class ConsistentVoltage(Formulation):
         kernel = self.kernel
         kernel.snapshot()
         self._integrator = integrator
-        stepper = integrator.stepper
         try:
-            if stepper.adaptive:
-                kernel.h_next, kernel.h_max, kernel.rtol, kernel.atol = \
-                    stepper.h_next, stepper.h_max, stepper.rtol, stepper.atol
-                kernel.max_steps = integrator.max_steps
-                try:
-                    return kernel.advance(self.u, h, time)
-                finally:
-                    stepper.h_next = kernel.h_next
+            if integrator.stepper.adaptive:
+                return self._advance_rk45(integrator, kernel.advance, self.u, h, time)
             kernel.k1_valid = False
             y, mode = self.y, self.mode
             y, steps = integrator.advance(self.hybrid, y, mode, self.u, h, time)
@@ -110,6 +104,32 @@ class ConsistentVoltage(Formulation):
         except StepRejected:
             kernel.rollback()  # a rejected step leaves the state as before it (fmi2Discard)
             raise
+
+    def advance_checked(self, h: float, integrator: Any, time: float, out: Any, budget: Any, u: float,
+                        kernel: Any) -> int:
+        if not integrator.stepper.adaptive:
+            return super().advance_checked(h, integrator, time, out, budget, u, kernel)
+        self._integrator = integrator
+        try:  # rk45: the step, the outputs and their checks in one compiled call
+            verdict = self._advance_rk45(integrator, kernel.advance_checked, self.u, h, time, out, budget)
+        except StepRejected:
+            kernel.rollback()
+            raise
+        self.steps = kernel.steps
+        return verdict
+
+    def _advance_rk45(self, integrator: Any, advance: Any, *args: Any) -> int:
+        """``advance(*args)`` of the kernel with the stepper's settings; its step size carried over."""
+        kernel, stepper = self.kernel, integrator.stepper
+        if self._configured is not integrator:  # the settings are fixed for an integrator's life
+            kernel.h_max, kernel.rtol, kernel.atol = stepper.h_max, stepper.rtol, stepper.atol
+            kernel.max_steps = integrator.max_steps
+            self._configured = integrator
+        kernel.h_next = stepper.h_next  # the engine's state (set_state may change it)
+        try:
+            return advance(*args)
+        finally:
+            stepper.h_next = kernel.h_next
 
     def omega_dot_at_end(self) -> float | None:
         """omega_dot at the state reached, when rk45's last stage computed it under the input held."""
