@@ -196,6 +196,27 @@ class CamDriveSlave(Fmi2Slave):
                 self._fail(str(exc))
         return True
 
+    # ----------------------------------------------------------------- the exchange (cam.fmu's own binary)
+    def exchange_layout(self) -> tuple:
+        """(output value references in OUTPUTS order, input value references, input ranges): the
+        variables whose fmi2GetReal (and fmi2SetReal within range, for inputs) the binary answers in C."""
+        by_name = {var.name: vr for vr, var in self.vars.items()}
+        return (tuple(by_name[name] for name in _variables.OUTPUT_NAMES),
+                tuple(by_name[name] for name in _variables.INPUT_NAMES),
+                tuple(_variables.INPUT_RANGES[name] for name in _variables.INPUT_NAMES))
+
+    def published_outputs(self) -> array | None:
+        """The outputs as an FMI get would return them, or None before they are calculated."""
+        return None if self._sim is None else self._values
+
+    def input_values(self) -> array:
+        """The inputs in INPUT_NAMES order (C doubles)."""
+        return array("d", [self._inputs[name] for name in _variables.INPUT_NAMES])
+
+    def take_inputs(self, values: list) -> None:
+        """Inputs in INPUT_NAMES order, already checked against INPUT_RANGES by the binary."""
+        self._inputs.update(zip(_variables.INPUT_NAMES, values))
+
     # ----------------------------------------------------------------- helpers
     def _fail(self, message: str, error: type = FmuError) -> None:
         """Report an error: log it, print it to stderr, raise (pythonfmu returns fmi2Fatal).

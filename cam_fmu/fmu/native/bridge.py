@@ -16,6 +16,15 @@ runs with the GIL held by the caller. Protocol:
 Values cross the boundary packed (``array`` bytes): fmi2GetReal/fmi2SetReal of n
 variables is one Python call, not n.
 
+The exchange (``Exchange``): a slave that names its per-step variables
+(``exchange_layout``) gets a ``bytearray`` the C side also reads. After every
+call this module publishes the slave's outputs and inputs into it; fmi2GetReal
+of those variables and fmi2SetReal of inputs within their ranges are then
+answered in C without the GIL, and inputs C wrote are handed to the slave before
+the next call. Everything else, and every value out of range, comes here.
+Python owns the buffer (C keeps a reference), so Python holds no pointer into
+the library.
+
 Isolation: the private package and the slave module are imported from their
 files by name (``importlib``), without ever touching ``sys.path``; ``unload``
 takes exactly the ``sys.modules`` names they added away again after the last
@@ -95,6 +104,58 @@ def attach() -> int:
     return count
 
 
+_EXCHANGE_MAGIC = 0x58434D43  # "CMCX": the C side checks it before it trusts the layout
+# the exchange's header, int32 each, in this order (the C side reads these names' positions: fmi2_python.c)
+_HEAD = ("magic", "n_out", "n_in", "off_vr", "off_lo", "off_hi", "off_value", "ready", "dirty")
+_READY, _DIRTY = _HEAD.index("ready"), _HEAD.index("dirty")
+
+
+class Exchange:
+    """The per-step variables in one buffer shared with the C side (layout described by its header).
+
+    Slots: the outputs, then the inputs. ``vr`` their value references (uint32), ``lo``/``hi``
+    the allowed range of each input (C checks a value against it, an out-of-range value goes to
+    Python for its message), ``value`` the current values (double). ``ready``: the outputs are
+    published; ``dirty``: C wrote inputs the slave has not seen yet.
+    """
+
+    def __init__(self, output_vrs, input_vrs, input_ranges) -> None:
+        self.n_out, n = len(output_vrs), len(output_vrs) + len(input_vrs)
+        off_vr = 4 * len(_HEAD)
+        off_lo = (off_vr + 4 * n + 7) // 8 * 8
+        off_hi, off_value = off_lo + 8 * n, off_lo + 16 * n
+        self.buffer = bytearray(off_value + 8 * n)
+        view = memoryview(self.buffer)
+        self.head = view[:off_vr].cast("i")
+        self.head[:] = array("i", [_EXCHANGE_MAGIC, self.n_out, n - self.n_out, off_vr, off_lo, off_hi, off_value,
+                                   0, 0])
+        view[off_vr:off_vr + 4 * n].cast("I")[:] = array("I", list(output_vrs) + list(input_vrs))
+        unbounded = [(-float("inf"), float("inf"))] * self.n_out  # outputs are never set
+        bounds = unbounded + [(float(lo), float(hi)) for lo, hi in input_ranges]
+        view[off_lo:off_hi].cast("d")[:] = array("d", [lo for lo, _ in bounds])
+        view[off_hi:off_value].cast("d")[:] = array("d", [hi for _, hi in bounds])
+        values = view[off_value:].cast("d")
+        self.outputs, self.inputs = values[:self.n_out], values[self.n_out:]
+
+    def hand_inputs(self, slave) -> None:
+        """Give the slave the inputs C wrote (already checked against their ranges)."""
+        self.head[_DIRTY] = 0
+        slave.take_inputs(self.inputs.tolist())
+
+    def publish(self, slave, inputs: bool = True) -> None:
+        """Copy the slave's published outputs and its inputs in (``ready`` only when it has outputs).
+
+        ``inputs=False`` after a successful step: a slave's do_step does not change its inputs."""
+        outputs = slave.published_outputs()
+        if outputs is None:
+            self.head[_READY] = 0
+        else:
+            self.outputs[:] = outputs
+            self.head[_READY] = 1
+        if inputs:
+            self.inputs[:] = slave.input_values()
+
+
 def _text(exc: BaseException) -> str:
     text = str(exc)
     if type(exc).__module__.split(".")[0] in {"builtins"} or not text:
@@ -111,6 +172,7 @@ class Instance:
         self.slave = None
         self.last_error = ""
         self.strings = ()  # keeps the bytes returned by the last get_string alive
+        self.exchange: Exchange | None = None  # made at the first create of a slave that has a layout
 
     # ------------------------------------------------------------ plumbing
     def _drain(self, extra=None):
@@ -128,13 +190,36 @@ class Instance:
         return messages
 
     def _run(self, fn, *args):
+        exchange = self.exchange
+        if exchange is not None and exchange.head[_DIRTY]:
+            exchange.hand_inputs(self.slave)
         try:
             payload = fn(*args)
         except Exception as exc:  # noqa: BLE001 - every slave exception is a status for the importer
-            status = DISCARD if getattr(exc, "fmi_status", None) == "discard" else ERROR
-            self.last_error = _text(exc)
-            return status, None, self._drain((status, self.last_error))
+            return self._failed(exc)
+        if exchange is not None:
+            exchange.publish(self.slave)
         return OK, payload, self._drain()
+
+    def _failed(self, exc: Exception):
+        """The status and messages of a slave exception (fmi2Discard when it says so, else fmi2Error)."""
+        status = DISCARD if getattr(exc, "fmi_status", None) == "discard" else ERROR
+        self.last_error = _text(exc)
+        if self.exchange is not None and self.slave is not None:
+            self.exchange.publish(self.slave)  # a failed call may have changed some values
+        return status, None, self._drain((status, self.last_error))
+
+    def share(self):
+        """The exchange's buffer for the C side (after ``create``), or None: this slave has no layout."""
+        layout = getattr(self.slave, "exchange_layout", None)
+        if layout is None:
+            return OK, None, self._drain()
+        status, payload, messages = self._run(layout)
+        if status == OK:
+            self.exchange = Exchange(*payload)
+            self.exchange.publish(self.slave)
+            payload = self.exchange.buffer
+        return status, payload, messages
 
     # ------------------------------------------------------------ life cycle
     def create(self):
@@ -158,11 +243,21 @@ class Instance:
         return self._run(lambda: self.slave.terminate())
 
     def do_step(self, time, step):
-        status, payload, messages = self._run(self.slave.do_step, time, step)
-        if status == OK and not payload:
-            self.last_error = f"do_step({time!r}, {step!r}) returned {payload!r}: step discarded"
+        """The per-step call, written out (``_run``'s steps without its generality): a slave's do_step
+        changes no input, so only the outputs are published."""
+        slave, exchange = self.slave, self.exchange
+        if exchange is not None and exchange.head[_DIRTY]:
+            exchange.hand_inputs(slave)
+        try:
+            done = slave.do_step(time, step)
+        except Exception as exc:  # noqa: BLE001
+            return self._failed(exc)
+        if not done:
+            self.last_error = f"do_step({time!r}, {step!r}) returned {done!r}: step discarded"
             return DISCARD, None, self._drain((DISCARD, self.last_error))
-        return status, None, messages
+        if exchange is not None:
+            exchange.publish(slave, inputs=False)
+        return OK, None, self._drain()
 
     # ------------------------------------------------------------ values
     def get_real(self, vrs: bytes):

@@ -86,7 +86,8 @@ typedef struct {
     X(PyUnicode_AsUTF8) X(PyUnicode_FromString) X(PyErr_Occurred) X(PyErr_Fetch)        \
     X(PyErr_NormalizeException) X(PyErr_Clear) X(Py_IncRef) X(Py_DecRef)                 \
     X(PyBytes_FromStringAndSize) X(PyBytes_AsStringAndSize) X(PyTuple_Size)              \
-    X(PyTuple_GetItem) X(PyList_Size) X(PyList_GetItem) X(PyLong_AsLong) X(PyFloat_FromDouble)
+    X(PyTuple_GetItem) X(PyList_Size) X(PyList_GetItem) X(PyLong_AsLong) X(PyFloat_FromDouble)  \
+    X(PyByteArray_AsString) X(PyByteArray_Size)
 
 #define DECLARE_PTR(name) static __typeof__(&name) p_##name;
 PY_FUNCTIONS(DECLARE_PTR)
@@ -106,6 +107,21 @@ static char g_slave[128];
 #define INSTANCE_MAGIC 0xCA3F3001u
 #define STATE_MAGIC 0xCA3F5701u
 
+/* The exchange: a bytearray of the bridge (bridge.Exchange) holding the per-step variables, so that
+ * fmi2GetReal of them and fmi2SetReal of inputs within range are answered here, without the GIL.
+ * Header of int32 (positions as bridge._HEAD lists them), then uint32 value references, double
+ * lower and upper input bounds and double values at the offsets the header gives. */
+enum { X_MAGIC, X_N_OUT, X_N_IN, X_OFF_VR, X_OFF_LO, X_OFF_HI, X_OFF_VALUE, X_READY, X_DIRTY, X_HEAD };
+#define EXCHANGE_MAGIC 0x58434D43
+typedef struct {
+    PyObject *buffer;     /* the bytearray (a reference held); NULL: every call goes to Python */
+    int *head;
+    const fmi2ValueReference *vr;
+    const double *lo, *hi;
+    double *value;
+    int n_out, n;         /* slots [0, n_out) are outputs, [n_out, n) inputs */
+} Exchange;
+
 typedef struct {
     unsigned magic;
     char *name;
@@ -117,6 +133,7 @@ typedef struct {
     int fatal;          /* after fmi2Fatal: only free */
     int terminated;     /* a step was discarded: fmi2Terminated status */
     double time;        /* end of the last successful step */
+    Exchange x;
     char last_error[1024];
 } Instance;
 
@@ -738,6 +755,82 @@ static PyObject *packed(const void *data, size_t bytes)
     return p_PyBytes_FromStringAndSize(data ? (const char *)data : "", (Py_ssize_t)bytes);
 }
 
+/* ------------------------------------------------------------------ the exchange */
+/* Ask the bridge for the exchange and check its layout (GIL held).  Without one (another slave, or a
+ * layout that does not fit) every value call goes to Python, as before. */
+static void share_exchange(Instance *c)
+{
+    PyObject *buffer = NULL;
+    char *data;
+    Py_ssize_t size;
+    int *h;
+    fmi2Status s = invoke(c, "share", &buffer, NULL);
+    if (s == fmi2Error || s == fmi2Discard) {   /* logged; the instance works without the exchange */
+        c->in_error = c->terminated = 0;
+        logf_(c, fmi2Warning, "logStatusWarning", "the exchange could not be set up: every value call goes to Python");
+    }
+    if (s != fmi2OK || !buffer) {
+        if (buffer) p_Py_DecRef(buffer);
+        return;
+    }
+    data = p_PyByteArray_AsString(buffer);
+    size = data ? p_PyByteArray_Size(buffer) : -1;
+    h = (int *)data;
+    if (!data || size < (Py_ssize_t)(X_HEAD * sizeof(int)) || h[X_MAGIC] != EXCHANGE_MAGIC || h[X_N_OUT] < 0 ||
+        h[X_N_IN] < 0 || h[X_N_OUT] + h[X_N_IN] > 1024 || h[X_OFF_VR] < (int)(X_HEAD * sizeof(int)) ||
+        h[X_OFF_LO] % 8 || h[X_OFF_HI] % 8 || h[X_OFF_VALUE] % 8 ||
+        h[X_OFF_VR] + 4L * (h[X_N_OUT] + h[X_N_IN]) > size || h[X_OFF_LO] + 8L * (h[X_N_OUT] + h[X_N_IN]) > size ||
+        h[X_OFF_HI] + 8L * (h[X_N_OUT] + h[X_N_IN]) > size || h[X_OFF_VALUE] + 8L * (h[X_N_OUT] + h[X_N_IN]) > size) {
+        if (!data) p_PyErr_Clear();
+        logf_(c, fmi2Warning, "logStatusWarning", "the bridge's exchange has an unexpected layout: not used");
+        p_Py_DecRef(buffer);
+        return;
+    }
+    c->x.buffer = buffer;
+    c->x.head = h;
+    c->x.vr = (const fmi2ValueReference *)(data + h[X_OFF_VR]);
+    c->x.lo = (const double *)(data + h[X_OFF_LO]);
+    c->x.hi = (const double *)(data + h[X_OFF_HI]);
+    c->x.value = (double *)(data + h[X_OFF_VALUE]);
+    c->x.n_out = h[X_N_OUT];
+    c->x.n = h[X_N_OUT] + h[X_N_IN];
+}
+
+static int slot_of(const Exchange *x, fmi2ValueReference vr)
+{
+    for (int k = 0; k < x->n; k++)
+        if (x->vr[k] == vr) return k;
+    return -1;
+}
+
+/* fmi2GetReal answered from the exchange: 1, or 0 when Python must answer (a variable not in it, or
+ * outputs not yet calculated).  No GIL: only this instance's calls touch its exchange, one at a time. */
+static int exchange_get(const Exchange *x, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
+{
+    if (!x->buffer || !x->head[X_READY]) return 0;
+    for (size_t i = 0; i < nvr; i++) {
+        int k = slot_of(x, vr[i]);
+        if (k < 0) return 0;
+        value[i] = x->value[k];
+    }
+    return 1;
+}
+
+/* fmi2SetReal of inputs, each within its range, into the exchange: 1, or 0 when Python must answer
+ * (another variable, or a value out of range or NaN: Python's message names it).  Nothing is written
+ * unless every value passes. */
+static int exchange_set(Exchange *x, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
+{
+    if (!x->buffer) return 0;
+    for (size_t i = 0; i < nvr; i++) {
+        int k = slot_of(x, vr[i]);
+        if (k < x->n_out || !(x->lo[k] <= value[i] && value[i] <= x->hi[k])) return 0;
+    }
+    for (size_t i = 0; i < nvr; i++) x->value[slot_of(x, vr[i])] = value[i];
+    x->head[X_DIRTY] = 1;
+    return 1;
+}
+
 /* ------------------------------------------------------------------ FMI 2.0 API */
 EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
@@ -816,6 +909,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
         g_live--;
         goto fail;
     }
+    share_exchange(c);
     logf_(c, fmi2OK, "logAll", "cam.fmu: Python %.*s (%s), module %s", (int)strcspn(p_Py_GetVersion(), " "),
           p_Py_GetVersion(), mode, g_slave);
     p_PyGILState_Release(gil);
@@ -836,6 +930,7 @@ EXPORT void fmi2FreeInstance(fmi2Component comp)
     c->magic = 0;
     if (python_usable()) {   /* during a Python host's shutdown, leave its objects to it */
         PyGILState_STATE gil = p_PyGILState_Ensure();
+        if (c->x.buffer) p_Py_DecRef(c->x.buffer);
         if (c->inst) {
             p_Py_DecRef(c->inst);
             g_live--;
@@ -940,8 +1035,17 @@ static fmi2Status set_values(fmi2Component comp, const char *fname, const char *
     LEAVE(s);
 }
 
+/* The instance, when a value call may be answered from its exchange (otherwise the full path reports). */
+static Instance *exchange_instance(fmi2Component comp, int allowed_after_error)
+{
+    Instance *c = comp;
+    return c && c->magic == INSTANCE_MAGIC && !c->fatal && (allowed_after_error || !c->in_error) ? c : NULL;
+}
+
 EXPORT fmi2Status fmi2GetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
 {
+    Instance *c = exchange_instance(comp, 1);
+    if (c && vr && value && exchange_get(&c->x, vr, nvr, value)) return fmi2OK;
     return get_values(comp, "fmi2GetReal", "get_real", vr, nvr, value, sizeof(fmi2Real));
 }
 
@@ -960,6 +1064,8 @@ EXPORT fmi2Status fmi2GetBoolean(fmi2Component comp, const fmi2ValueReference vr
 EXPORT fmi2Status fmi2SetReal(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                               const fmi2Real value[])
 {
+    Instance *c = exchange_instance(comp, 0);
+    if (c && vr && value && exchange_set(&c->x, vr, nvr, value)) return fmi2OK;
     return set_values(comp, "fmi2SetReal", "set_real", vr, nvr, value, sizeof(fmi2Real));
 }
 
