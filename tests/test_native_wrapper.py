@@ -192,10 +192,13 @@ def test_c_host_under_valgrind(fmu_dir, host, vr, tmp_path):
     """memcheck: no invalid read/write/free and nothing definitely lost, from load to dlclose and exit."""
     log = tmp_path / "valgrind.log"
     env = {**EMPTY_ENV, "PYTHONMALLOC": "malloc"}
-    r = run_host(host, fmu_dir, "inst", "init", "setr", str(vr["u"]), "3.0", "step", "100", "0.001", "save",
-                 "serial", "restore", "setr", str(vr["u"]), "nan", "step", "1", "0.001", "reset", "init",
-                 "step", "10", "0.001", "free", "cycles", "3", env=env, prefix=valgrind_prefix(log))
+    watch = f"{vr['theta']},{vr['omega']},{vr['u']}"  # answered from the exchange, in C
+    r = run_host(host, fmu_dir, "inst", "getr", watch, "init", "setr", str(vr["u"]), "3.0", "step", "100", "0.001",
+                 "getr", watch, "save", "serial", "restore", "getr", watch, "setr", str(vr["u"]), "nan",
+                 "step", "1", "0.001", "reset", "init", "step", "10", "0.001", "getr", watch, "free", "cycles", "3",
+                 env=env, prefix=valgrind_prefix(log))
     assert r["rc"] == 0 and r["lines"][-1] == {"exit": 0}, r
+    assert [x["status"] for x in r["cmds"] if x["cmd"] == "getr"] == [0, 0, 0, 0], r
     summary = valgrind_summary(log)
     assert summary["summaries"] == 1 and summary["errors"] == 0 and summary["definitely_lost"] == 0, \
         summary["excerpt"]

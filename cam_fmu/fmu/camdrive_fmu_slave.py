@@ -38,6 +38,10 @@ fmi2SetString / fmi2SetBoolean fails), the angle sum when the simulator is
 built (fmi2ExitInitializationMode fails), an input in its setter and again in
 do_step, the simulator's own errors in do_step (fmi2DoStep fails). Outputs are
 checked to be finite before they are published: never NaN outputs.
+
+cam.fmu's own binary answers the per-step gets and sets in C from its exchange
+(``exchange_layout``, docs/fmu.md): it checks each input against the same
+INPUT_RANGES and sends every value outside them here, for the message.
 """
 from __future__ import annotations
 

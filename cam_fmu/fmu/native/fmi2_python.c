@@ -30,6 +30,10 @@
  *   or a failing C-API call is fmi2Fatal.
  * - After the last instance is freed, the bridge removes the FMU's private
  *   module names from sys.modules (sys.path is never touched).
+ * - The exchange (bridge.Exchange, a bytearray the bridge keeps current):
+ *   fmi2GetReal of the slave's outputs and inputs, and fmi2SetReal of inputs
+ *   within their ranges, are answered here without the GIL; per step only
+ *   fmi2DoStep enters Python.
  */
 #include <Python.h>
 
