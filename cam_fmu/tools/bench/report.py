@@ -178,7 +178,7 @@ def goal_verdict(scene_rows: list[dict], goal_py: float = 1.5, goal_c: float = 2
             parts.append(f"{path} path: no measurement")
             continue
         ok_py, ok_c = py <= goal_py, c <= goal_c
-        parts.append(f"{path} path {r[key + '_us']:.1f} us/step = {py:.2f}x the pythonfmu floor "
+        parts.append(f"{path} path {r[key + '_us']:.1f} us/step (best of {r['repeats']} rounds) = {py:.2f}x the pythonfmu floor "
                      f"({r['py_floor_us']:.1f} us) {'<=' if ok_py else '>'} {goal_py:g}x: {'met' if ok_py else 'NOT met'}, "
                      f"{c:.2f}x the C floor ({r['c_floor_us']:.1f} us) {'<=' if ok_c else '>'} {goal_c:g}x: "
                      f"{'met' if ok_c else 'NOT met'}")
