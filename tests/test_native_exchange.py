@@ -11,7 +11,7 @@ import shutil
 
 import pytest
 
-from native_support import EMPTY_ENV, compile_host, extract, run_host, run_python, value_references
+from native_support import EMPTY_ENV, ROOT, compile_host, extract, run_host, run_python, value_references
 
 PER_STEP_CALLS = r"""
 import json, sys
@@ -156,3 +156,17 @@ def test_native_host_bad_input_still_named_and_state_restores_inputs(fmu_dir, tm
     assert gets[3] == gets[2]                             # the refused value changed nothing
     assert gets[4][2:] == [3.5, 1.0] and gets[4][0] == 0.0  # reset: start values, outputs from theta0 = 0
     assert any(x["log"] == 3 and "'u'" in x["msg"] and "allowed range" in x["msg"] for x in r["logs"]), r["logs"]
+
+
+def test_the_header_layout_is_the_same_on_both_sides():
+    """The bridge's header names (bridge._HEAD) and the C side's enum list the same fields in the same order."""
+    import re
+
+    from cam_fmu.fmu.native import bridge
+
+    source = (ROOT / "cam_fmu" / "fmu" / "native" / "fmi2_python.c").read_text()
+    enum = re.search(r"enum \{ (X_MAGIC[^}]*) \};", source).group(1)
+    names = [name.strip()[2:].lower() for name in enum.split(",")]
+    assert names[-1] == "head" and names[:-1] == list(bridge._HEAD)
+    magic = int(re.search(r"#define EXCHANGE_MAGIC (0x[0-9A-Fa-f]+)", source).group(1), 16)
+    assert magic == bridge._EXCHANGE_MAGIC
