@@ -109,12 +109,10 @@ class CamDriveSlave(Fmi2Slave):
                 name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous,
                 initial=Fmi2Initial.calculated, description=desc, getter=self._output_getter(index),
                 setter=self._output_setter(name)))
-        # value reference -> input name / output index: the packed per-step transfers (get_real_packed)
+        # value reference -> input name / output index: the packed transfers (get_real_packed)
         self._input_names = {vr: var.name for vr, var in self.vars.items() if var.name in self._inputs}
         self._output_index = {vr: _variables.OUTPUT_NAMES.index(var.name) for vr, var in self.vars.items()
                               if var.name in _variables.OUTPUT_NAMES}
-        self._get_request: tuple = (b"", ())  # the last fmi2GetReal request of outputs: (its bytes, indices)
-        self._set_request: tuple = (b"", ())  # the last fmi2SetReal request of inputs: (its bytes, names)
         kinds = {"real": Real, "boolean": Boolean, "string": String}
         for spec in _parameters.PARAMETERS:
             self.register_variable(kinds[spec.kind](
@@ -164,20 +162,14 @@ class CamDriveSlave(Fmi2Slave):
             self._sim = None  # rebuilt from the new values on first use
         return setter
 
-    # ----------------------------------------------------------------- packed transfers (the per-step path)
+    # ----------------------------------------------------------------- packed transfers
+    # The binary's fallback when its exchange cannot answer: outputs not yet calculated, an input value out
+    # of range (its message), requests that mix in other variables (then pythonfmu's per-variable path).
     def get_real_packed(self, vrs: bytes) -> bytes | None:
-        """fmi2GetReal of outputs only, values packed as C doubles; None: not only outputs (use get_real).
-
-        cam.fmu's own binary calls this first: a master reads the same outputs at every
-        step, so the value references are resolved once per distinct request.
-        """
-        request, indices = self._get_request
-        if vrs != request:
-            found = [self._output_index.get(vr) for vr in array("I", vrs)]
-            if None in found:
-                return None
-            indices = tuple(found)
-            self._get_request = (vrs, indices)
+        """fmi2GetReal of outputs only, values packed as C doubles; None: not only outputs (use get_real)."""
+        indices = _resolved(vrs, self._output_index)
+        if indices is None:
+            return None
         if self._sim is None:
             self._build()  # outputs are 'calculated' from the parameters at start time
         values = self._values
@@ -185,13 +177,9 @@ class CamDriveSlave(Fmi2Slave):
 
     def set_real_packed(self, vrs: bytes, values: bytes) -> bool:
         """fmi2SetReal of inputs only (packed C doubles), each checked against its range; False: not only inputs."""
-        request, names = self._set_request
-        if vrs != request:
-            found = [self._input_names.get(vr) for vr in array("I", vrs)]
-            if None in found:
-                return False
-            names = tuple(found)
-            self._set_request = (vrs, names)
+        names = _resolved(vrs, self._input_names)
+        if names is None:
+            return False
         inputs = self._inputs
         for name, value in zip(names, array("d", values)):
             try:
@@ -294,6 +282,12 @@ class CamDriveSlave(Fmi2Slave):
 
 
 STATE_VERSION = 2  # of the dictionary _get_fmu_state returns (serialised as JSON)
+
+
+def _resolved(vrs: bytes, table: Dict[int, Any]) -> list | None:
+    """The table's entries for packed value references (C unsigned ints), or None if one is not in it."""
+    found = [table.get(vr) for vr in array("I", vrs)]
+    return None if None in found else found
 
 
 def _checked_state(state: Any):
