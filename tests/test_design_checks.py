@@ -83,7 +83,11 @@ def test_extremes_match_a_dense_independent_search(e):
     alpha = np.abs(np.arctan2(s1 - e, math.sqrt(0.1 ** 2 - e ** 2) + s))
     k = int(np.argmax(alpha))
     assert rep.max_pressure_angle == pytest.approx(alpha[k], abs=1e-8)
-    assert rep.max_pressure_angle_at == pytest.approx(th[k], abs=1e-3)
+    # where: any angle at which the dense search reaches the maximum (with offset 0 the cam is
+    # symmetric and two angles tie to the last bit, so which one argmax returns is rounding's choice)
+    maximisers = th[alpha >= alpha[k] - 1e-9]
+    gap = np.abs((maximisers - rep.max_pressure_angle_at + math.pi) % (2 * math.pi) - math.pi)
+    assert gap.min() < 1e-3
     # radius of curvature from the pitch points by periodic central differences
     x, y = cam.pitch(th)
     d = th[1] - th[0]
