@@ -199,6 +199,46 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
     return parseString(text).toprettyxml(indent="  ", encoding="UTF-8")
 
 
+LOG_CATEGORIES = (
+    ("logEvents", "hybrid events and mode changes of the drive (stop, break-away, contact, ...)"),
+    ("logStatusWarning", "messages with status fmi2Warning"),
+    ("logStatusDiscard", "messages with status fmi2Discard: a step the solver cannot complete at this size"),
+    ("logStatusError", "messages with status fmi2Error: a refused value or call, naming it"),
+    ("logStatusFatal", "messages with status fmi2Fatal"),
+)
+
+
+def guid(rows: List[Dict[str, Any]], engine_digest: str) -> str:
+    """The FMU's GUID [text]: a hash of the variable table and the engine's sources, so a binary and a
+    model description of different builds never pass fmi2Instantiate's check."""
+    import hashlib
+
+    text = repr([(r["name"], r["type"], r["causality"], r["start"]) for r in rows]) + engine_digest
+    h = hashlib.sha256(text.encode()).hexdigest()
+    return "{%s-%s-%s-%s-%s}" % (h[:8], h[8:12], h[12:16], h[16:20], h[20:32])
+
+
+def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]]) -> bytes:
+    """A co-simulation modelDescription.xml with every variable of ``rows`` (value reference = row
+    index) and the capabilities of the C binary; ``postprocess`` completes it."""
+    root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=model_identifier, guid=model_guid,
+                      generationTool="cam_fmu", variableNamingConvention="flat", numberOfEventIndicators="0")
+    ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier, needsExecutionTool="false",
+                  canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
+                  canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",
+                  canGetAndSetFMUstate="true", canSerializeFMUstate="true",
+                  providesDirectionalDerivative="false")
+    categories = ET.SubElement(root, "LogCategories")
+    for name, description in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=description)
+    variables = ET.SubElement(root, "ModelVariables")
+    for vr, row in enumerate(rows):
+        sv = ET.SubElement(variables, "ScalarVariable", name=row["name"], valueReference=str(vr))
+        ET.SubElement(sv, row["type"])
+    ET.SubElement(root, "ModelStructure")
+    return ET.tostring(root, encoding="UTF-8")
+
+
 def rewrite_fmu(fmu_path: Path, **kwargs: Any) -> None:
     """Replace modelDescription.xml inside ``fmu_path`` by its post-processed version."""
     fmu_path = Path(fmu_path)
