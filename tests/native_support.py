@@ -58,7 +58,10 @@ def value_references(fmu_dir: Path) -> Dict[str, int]:
 
 def compile_host(dest: Path) -> Path:
     gcc = require("gcc")
-    proc = subprocess.run([gcc, "-O1", "-g", "-Wall", "-o", str(dest), str(HOST_C), "-ldl", "-lm"],
+    from cam_fmu.engine.build import fmi_headers
+
+    proc = subprocess.run([gcc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra", "-Werror",
+                           f"-I{fmi_headers()}", "-o", str(dest), str(HOST_C), "-ldl", "-lm"],
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     return dest

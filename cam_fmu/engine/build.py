@@ -42,6 +42,16 @@ def source_files() -> list[Path]:
     return sorted(SOURCES.glob("*.c")) + sorted(INCLUDE.glob("*.h"))
 
 
+def fmi_headers() -> Path:
+    """The folder of the official FMI 2.0/3.0 headers: the copy fmpy (a core dependency) ships."""
+    import fmpy
+
+    folder = Path(fmpy.__file__).resolve().parent / "c-code"
+    if not (folder / "fmi2Functions.h").is_file():
+        raise EngineBuildError(f"the FMI headers are not in {folder} (fmpy's c-code folder): reinstall fmpy")
+    return folder
+
+
 def find_compiler() -> str:
     """The C compiler to use: ``$CC`` or the first of cc, gcc, clang on PATH."""
     tried = []

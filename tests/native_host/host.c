@@ -1,44 +1,51 @@
 /*
  * A minimal native FMI 2.0 co-simulation host, as real tools load FMUs:
- * dlopen(RTLD_NOW | RTLD_LOCAL), fmi2Instantiate, run, fmi2FreeInstance,
- * dlclose, exit.  No libpython is linked or preloaded.
+ * dlopen(RTLD_NOW | RTLD_LOCAL) (LoadLibrary on Windows), fmi2Instantiate, run,
+ * fmi2FreeInstance, dlclose, exit.  No libpython is linked or preloaded. The FMI
+ * types are the official headers' (fmi2FunctionTypes.h, the copy fmpy ships).
  *
- *   host <binary.so> <resources-dir> COMMAND...
+ *   host <binary> <resources-dir> COMMAND...
  *
  * Commands (run in order; each prints one JSON line; the logger prints
  * {"log": status, "category": ..., "msg": ...} lines):
+ *   guid TEXT            the GUID the following inst/cycles pass (default "")
  *   inst                 fmi2Instantiate (loggingOn = false: errors must still reach the logger)
  *   init                 fmi2SetupExperiment(0) + Enter/ExitInitializationMode
+ *   enter / exit         fmi2EnterInitializationMode / fmi2ExitInitializationMode alone
  *   setr VR VALUE        fmi2SetReal of one variable (VALUE may be nan)
  *   sets VR TEXT         fmi2SetString of one variable
  *   getr VR,VR,...       one fmi2GetReal of all listed variables
+ *   gets VR,VR,...       one fmi2GetString of all listed variables
  *   step N H             N x fmi2DoStep of size H (stops at the first non-OK status)
+ *   stepat T H           one fmi2DoStep(T, H), whatever the host's time
  *   save / restore       fmi2GetFMUstate / fmi2SetFMUstate (one slot)
  *   serial               serialise the saved state, deserialise it, and make that the saved state
  *   reset / term / free  fmi2Reset / fmi2Terminate / fmi2FreeInstance
  *   laststatus           fmi2GetBooleanStatus(fmi2Terminated) and fmi2GetRealStatus(fmi2LastSuccessfulTime)
- *   cycles N             N x (fmi2Instantiate + fmi2FreeInstance); prints RSS after 20 and after N
+ *   cycles N             N x (fmi2Instantiate + fmi2FreeInstance); prints RSS after 20 and after N (Linux)
+ *   nullcalls            every get/set/step call with a NULL instance: must return fmi2Error and zero outputs
  * At the end: fmi2FreeInstance if still instantiated, dlclose, {"exit": 0}, return 0.
  */
-#include <dlfcn.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _WIN32
+#include <windows.h>
+#define LIBRARY HMODULE
+#define OPEN(path) LoadLibraryA(path)
+#define SYMBOL(lib, name) ((void *)GetProcAddress(lib, name))
+#define CLOSE(lib) FreeLibrary(lib)
+#else
+#include <dlfcn.h>
+#define LIBRARY void *
+#define OPEN(path) dlopen(path, RTLD_NOW | RTLD_LOCAL)
+#define SYMBOL(lib, name) dlsym(lib, name)
+#define CLOSE(lib) dlclose(lib)
+#endif
 
-typedef void *fmi2Component;
-typedef void *fmi2FMUstate;
-typedef unsigned int fmi2ValueReference;
-typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
-typedef void (*Logger)(void *, const char *, fmi2Status, const char *, const char *, ...);
-typedef struct {
-    Logger logger;
-    void *(*allocateMemory)(size_t, size_t);
-    void (*freeMemory)(void *);
-    void (*stepFinished)(void *, fmi2Status);
-    void *componentEnvironment;
-} Callbacks;
+#include "fmi2FunctionTypes.h"
 
 static void json_string(const char *s)
 {
@@ -52,7 +59,8 @@ static void json_string(const char *s)
     putchar('"');
 }
 
-static void logger(void *env, const char *name, fmi2Status status, const char *category, const char *message, ...)
+static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status, fmi2String category,
+                   fmi2String message, ...)
 {
     char text[8192];
     va_list ap;
@@ -72,7 +80,7 @@ static void logger(void *env, const char *name, fmi2Status status, const char *c
 static long rss_kb(void)
 {
     long pages = 0, resident = 0;
-    FILE *f = fopen("/proc/self/statm", "r");
+    FILE *f = fopen("/proc/self/statm", "r"); /* Linux only: 0 elsewhere */
     if (f) {
         if (fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
         fclose(f);
@@ -80,32 +88,14 @@ static long rss_kb(void)
     return resident * 4;
 }
 
-#define SYM(name) name##_t name = (name##_t)dlsym(lib, #name)
-typedef fmi2Component (*fmi2Instantiate_t)(const char *, int, const char *, const char *, const Callbacks *, int, int);
-typedef void (*fmi2FreeInstance_t)(fmi2Component);
-typedef fmi2Status (*fmi2SetupExperiment_t)(fmi2Component, int, double, double, int, double);
-typedef fmi2Status (*fmi2EnterInitializationMode_t)(fmi2Component);
-typedef fmi2Status (*fmi2ExitInitializationMode_t)(fmi2Component);
-typedef fmi2Status (*fmi2Terminate_t)(fmi2Component);
-typedef fmi2Status (*fmi2Reset_t)(fmi2Component);
-typedef fmi2Status (*fmi2SetReal_t)(fmi2Component, const fmi2ValueReference *, size_t, const double *);
-typedef fmi2Status (*fmi2GetReal_t)(fmi2Component, const fmi2ValueReference *, size_t, double *);
-typedef fmi2Status (*fmi2SetString_t)(fmi2Component, const fmi2ValueReference *, size_t, const char *const *);
-typedef fmi2Status (*fmi2DoStep_t)(fmi2Component, double, double, int);
-typedef fmi2Status (*fmi2GetFMUstate_t)(fmi2Component, fmi2FMUstate *);
-typedef fmi2Status (*fmi2SetFMUstate_t)(fmi2Component, fmi2FMUstate);
-typedef fmi2Status (*fmi2FreeFMUstate_t)(fmi2Component, fmi2FMUstate *);
-typedef fmi2Status (*fmi2SerializedFMUstateSize_t)(fmi2Component, fmi2FMUstate, size_t *);
-typedef fmi2Status (*fmi2SerializeFMUstate_t)(fmi2Component, fmi2FMUstate, char *, size_t);
-typedef fmi2Status (*fmi2DeSerializeFMUstate_t)(fmi2Component, const char *, size_t, fmi2FMUstate *);
-typedef fmi2Status (*fmi2GetBooleanStatus_t)(fmi2Component, int, int *);
-typedef fmi2Status (*fmi2GetRealStatus_t)(fmi2Component, int, double *);
+#define SYM(name) fmi2##name##TYPE *fmi2##name = (fmi2##name##TYPE *)SYMBOL(lib, "fmi2" #name)
 
 int main(int argc, char **argv)
 {
-    void *lib;
+    LIBRARY lib;
     char uri[4200];
-    Callbacks cb = {logger, calloc, free, NULL, NULL};
+    const char *guid = "";
+    fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c = NULL;
     fmi2FMUstate saved = NULL;
     double time = 0.0;
@@ -113,19 +103,23 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: host <binary.so> <resources-dir> COMMAND...\n");
         return 2;
     }
-    lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    lib = OPEN(argv[1]);
     if (!lib) {
         printf("{\"dlopen\": ");
+#ifdef _WIN32
+        json_string("LoadLibrary failed");
+#else
         json_string(dlerror());
+#endif
         printf("}\n");
         return 3;
     }
-    SYM(fmi2Instantiate); SYM(fmi2FreeInstance); SYM(fmi2SetupExperiment); SYM(fmi2EnterInitializationMode);
-    SYM(fmi2ExitInitializationMode); SYM(fmi2Terminate); SYM(fmi2Reset); SYM(fmi2SetReal); SYM(fmi2GetReal);
-    SYM(fmi2SetString); SYM(fmi2DoStep); SYM(fmi2GetFMUstate); SYM(fmi2SetFMUstate); SYM(fmi2FreeFMUstate);
-    SYM(fmi2SerializedFMUstateSize); SYM(fmi2SerializeFMUstate); SYM(fmi2DeSerializeFMUstate);
-    SYM(fmi2GetBooleanStatus); SYM(fmi2GetRealStatus);
-    if (!fmi2Instantiate || !fmi2DoStep || !fmi2GetBooleanStatus || !fmi2DeSerializeFMUstate) {
+    SYM(Instantiate); SYM(FreeInstance); SYM(SetupExperiment); SYM(EnterInitializationMode);
+    SYM(ExitInitializationMode); SYM(Terminate); SYM(Reset); SYM(SetReal); SYM(GetReal); SYM(GetString);
+    SYM(SetString); SYM(DoStep); SYM(GetFMUstate); SYM(SetFMUstate); SYM(FreeFMUstate);
+    SYM(SerializedFMUstateSize); SYM(SerializeFMUstate); SYM(DeSerializeFMUstate);
+    SYM(GetBooleanStatus); SYM(GetRealStatus);
+    if (!fmi2Instantiate || !fmi2DoStep || !fmi2GetBooleanStatus || !fmi2DeSerializeFMUstate || !fmi2GetString) {
         printf("{\"dlsym\": \"missing FMI functions\"}\n");
         return 3;
     }
@@ -134,8 +128,26 @@ int main(int argc, char **argv)
     for (int k = 3; k < argc; k++) {
         const char *cmd = argv[k];
         fmi2Status s = fmi2OK;
-        if (!strcmp(cmd, "inst")) {
-            c = fmi2Instantiate("host", 1, "", uri, &cb, 0, 0);
+        if (!strcmp(cmd, "guid")) {
+            guid = argv[++k];
+            continue;
+        } else if (!strcmp(cmd, "nullcalls")) {
+            fmi2ValueReference vr[2] = {0, 1};
+            double reals[2] = {7.0, 7.0};
+            fmi2String strings[2] = {"x", "x"};
+            int zeroed;
+            fmi2Status st[4];
+            st[0] = fmi2GetReal(NULL, vr, 2, reals);
+            st[1] = fmi2GetString(NULL, vr, 2, strings);
+            st[2] = fmi2DoStep(NULL, 0.0, 1e-3, fmi2True);
+            st[3] = fmi2SetReal(NULL, vr, 2, reals);
+            zeroed = reals[0] == 0.0 && reals[1] == 0.0 && strings[0] && !strings[0][0] && strings[1] && !strings[1][0];
+            printf("{\"cmd\": \"nullcalls\", \"statuses\": [%d, %d, %d, %d], \"zeroed\": %s}\n", (int)st[0],
+                   (int)st[1], (int)st[2], (int)st[3], zeroed ? "true" : "false");
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(cmd, "inst")) {
+            c = fmi2Instantiate("host", fmi2CoSimulation, guid, uri, &cb, fmi2False, fmi2False);
             printf("{\"cmd\": \"inst\", \"ok\": %s}\n", c ? "true" : "false");
             if (!c) break;
             continue;
@@ -143,7 +155,7 @@ int main(int argc, char **argv)
             int n = atoi(argv[++k]);
             long after20 = 0;
             for (int i = 0; i < n; i++) {
-                fmi2Component x = fmi2Instantiate("cycle", 1, "", uri, &cb, 0, 0);
+                fmi2Component x = fmi2Instantiate("cycle", fmi2CoSimulation, guid, uri, &cb, fmi2False, fmi2False);
                 if (!x) { printf("{\"cmd\": \"cycles\", \"failed_at\": %d}\n", i); break; }
                 fmi2FreeInstance(x);
                 if (i == 19) after20 = rss_kb();
@@ -164,6 +176,31 @@ int main(int argc, char **argv)
             if (s == fmi2OK) s = fmi2EnterInitializationMode(c);
             if (s == fmi2OK) s = fmi2ExitInitializationMode(c);
             time = 0.0;
+        } else if (!strcmp(cmd, "enter")) {
+            s = fmi2EnterInitializationMode(c);
+        } else if (!strcmp(cmd, "exit")) {
+            s = fmi2ExitInitializationMode(c);
+        } else if (!strcmp(cmd, "stepat")) {
+            double t0 = strtod(argv[++k], NULL);
+            double h = strtod(argv[++k], NULL);
+            s = fmi2DoStep(c, t0, h, fmi2True);
+            if (s == fmi2OK) time = t0 + h;
+        } else if (!strcmp(cmd, "gets")) {
+            fmi2ValueReference vrs[64];
+            fmi2String values[64];
+            size_t n = 0;
+            char *list = strdup(argv[++k]);
+            for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
+            free(list);
+            s = fmi2GetString(c, vrs, n, values);
+            printf("{\"cmd\": \"gets\", \"status\": %d, \"values\": [", (int)s);
+            for (size_t i = 0; i < n; i++) {
+                if (i) printf(", ");
+                json_string(values[i] ? values[i] : "(null)");
+            }
+            printf("]}\n");
+            fflush(stdout);
+            continue;
         } else if (!strcmp(cmd, "setr")) {
             fmi2ValueReference vr = (fmi2ValueReference)atoi(argv[++k]);
             double v = strtod(argv[++k], NULL);
@@ -190,7 +227,7 @@ int main(int argc, char **argv)
             double h = strtod(argv[++k], NULL);
             int done = 0;
             for (; done < n; done++) {
-                s = fmi2DoStep(c, time, h, 1);
+                s = fmi2DoStep(c, time, h, fmi2True);
                 if (s != fmi2OK) break;
                 time += h;
             }
@@ -203,7 +240,7 @@ int main(int argc, char **argv)
             s = fmi2SetFMUstate(c, saved);
         } else if (!strcmp(cmd, "serial")) {
             size_t size = 0;
-            char *buf;
+            fmi2Byte *buf;
             fmi2FMUstate copy = NULL;
             s = fmi2SerializedFMUstateSize(c, saved, &size);
             buf = malloc(size ? size : 1);
@@ -222,8 +259,8 @@ int main(int argc, char **argv)
         } else if (!strcmp(cmd, "laststatus")) {
             int terminated = -1;
             double last = -1.0;
-            fmi2Status s1 = fmi2GetBooleanStatus(c, 3 /* fmi2Terminated */, &terminated);
-            fmi2Status s2 = fmi2GetRealStatus(c, 2 /* fmi2LastSuccessfulTime */, &last);
+            fmi2Status s1 = fmi2GetBooleanStatus(c, fmi2Terminated, &terminated);
+            fmi2Status s2 = fmi2GetRealStatus(c, fmi2LastSuccessfulTime, &last);
             printf("{\"cmd\": \"laststatus\", \"status\": %d, \"terminated\": %d, \"last_time\": %.17g}\n",
                    (int)(s1 > s2 ? s1 : s2), terminated, last);
             fflush(stdout);
@@ -239,7 +276,7 @@ int main(int argc, char **argv)
         if (saved) fmi2FreeFMUstate(c, &saved);
         fmi2FreeInstance(c);
     }
-    dlclose(lib);
+    CLOSE(lib);
     printf("{\"exit\": 0}\n");
     return 0;
 }
