@@ -1,7 +1,7 @@
-/* FMI 2.0 co-simulation glue of cam.fmu over the drive's instance API (cam_drive.h).
+/* FMI 2.0 co-simulation glue of cam.fmu over the drive's instance API (cam_instance.h).
  *
  * Thin by design: the FMI state machine, argument checks, logging and the FMU state objects.
- * Everything the drive does is behind cam_drive_*; an FMI 3.0 glue would replace only this file.
+ * Everything the drive does is behind cam_instance_*; an FMI 3.0 glue would replace only this file.
  * Compiled into the FMU's binary with the engine (csrc/src/*.c) and the official FMI 2.0 headers
  * (those fmpy ships); CAM_GUID is defined at build time from the model description.
  *
@@ -22,8 +22,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
-#include "cam_drive.h"
-#include "cam_variables.h"
+#include "cam_instance.h"
 
 #ifndef CAM_GUID
 #error "CAM_GUID must be defined by the build (the model description's guid)"
@@ -49,7 +48,7 @@ typedef enum {
 #define GET_STATES (INITIALIZATION | STEP_COMPLETE | STEP_FAILED | ERROR_STATE | TERMINATED)
 
 typedef struct {
-    CamDrive *drive;
+    CamInstance *drive;
     fmi2CallbackLogger logger;
     fmi2ComponentEnvironment environment;
     char *name;
@@ -104,14 +103,14 @@ static int allowed(Instance *S, int states, const char *call) {
     return 0;
 }
 
-static fmi2Status drive_status(Instance *S, CamStatus status, const char *call) {
+static fmi2Status drive_status(Instance *S, int status, const char *call) {
     if (status == CAM_OK) return fmi2OK;
-    if (status == CAM_DISCARD) {
-        log_message(S, fmi2Discard, "logStatusDiscard", "%s: %s", call, cam_drive_message(S->drive));
+    if (status == CAM_ERR_REJECTED) {
+        log_message(S, fmi2Discard, "logStatusDiscard", "%s: %s", call, cam_instance_message(S->drive));
         S->state = STEP_FAILED;
         return fmi2Discard;
     }
-    return fail(S, call, cam_drive_message(S->drive));
+    return fail(S, call, cam_instance_message(S->drive));
 }
 
 /* ------------------------------------------------------------------ common functions */
@@ -147,10 +146,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     S = calloc(1, sizeof *S);
     if (!S) return NULL;
     S->name = malloc(strlen(instanceName) + 1);
-    S->drive = cam_drive_new();
+    S->drive = cam_instance_new();
     if (!S->name || !S->drive) {
         free(S->name);
-        cam_drive_free(S->drive);
+        cam_instance_free(S->drive);
         free(S);
         log_message(&probe, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
         return NULL;
@@ -166,7 +165,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 void fmi2FreeInstance(fmi2Component c) {
     Instance *S = c;
     if (!S) return;
-    cam_drive_free(S->drive);
+    cam_instance_free(S->drive);
     free(S->name);
     free(S);
 }
@@ -212,7 +211,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     fmi2Status status;
     if (!S) return fmi2Error;
     if (!allowed(S, INITIALIZATION, "fmi2ExitInitializationMode")) return fmi2Error;
-    status = drive_status(S, cam_drive_initialize(S->drive, S->start_time), "fmi2ExitInitializationMode");
+    status = drive_status(S, cam_instance_initialize(S->drive, S->start_time), "fmi2ExitInitializationMode");
     if (status == fmi2OK) {
         S->state = STEP_COMPLETE;
         S->last_successful_time = S->start_time;
@@ -231,7 +230,7 @@ fmi2Status fmi2Terminate(fmi2Component c) {
 fmi2Status fmi2Reset(fmi2Component c) {
     Instance *S = c;
     if (!S) return fmi2Error;
-    cam_drive_reset(S->drive);
+    cam_instance_reset(S->drive);
     S->state = INSTANTIATED;
     S->start_time = S->last_successful_time = 0.0;
     return fmi2OK;
@@ -274,8 +273,8 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     if (!allowed(S, GET_STATES, "fmi2GetReal")) return fmi2Error;
     if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2GetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++)
-        if (cam_drive_get_real(S->drive, vr[k], &value[k]) != CAM_OK)
-            return fail(S, "fmi2GetReal", cam_drive_message(S->drive));
+        if (cam_instance_get_real(S->drive, vr[k], &value[k]) != CAM_OK)
+            return fail(S, "fmi2GetReal", cam_instance_message(S->drive));
     return fmi2OK;
 }
 
@@ -297,8 +296,8 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (!allowed(S, GET_STATES, "fmi2GetBoolean")) return fmi2Error;
     if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2GetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) {
-        if (cam_drive_get_boolean(S->drive, vr[k], &v) != CAM_OK)
-            return fail(S, "fmi2GetBoolean", cam_drive_message(S->drive));
+        if (cam_instance_get_boolean(S->drive, vr[k], &v) != CAM_OK)
+            return fail(S, "fmi2GetBoolean", cam_instance_message(S->drive));
         value[k] = v ? fmi2True : fmi2False;
     }
     return fmi2OK;
@@ -312,9 +311,9 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     if (!allowed(S, GET_STATES, "fmi2GetString")) return fmi2Error;
     if (!check_references(S, vr, nvr, value, CAM_STRING, "fmi2GetString")) return fmi2Error;
     for (k = 0; k < nvr; k++)
-        if (cam_drive_get_string(S->drive, vr[k], &value[k]) != CAM_OK) {
+        if (cam_instance_get_string(S->drive, vr[k], &value[k]) != CAM_OK) {
             value[k] = "";
-            return fail(S, "fmi2GetString", cam_drive_message(S->drive));
+            return fail(S, "fmi2GetString", cam_instance_message(S->drive));
         }
     return fmi2OK;
 }
@@ -329,11 +328,11 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     if (!allowed(S, SET_STATES, "fmi2SetReal")) return fmi2Error;
     if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2SetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* all or nothing: every value is checked before one is written */
-        if (cam_drive_check_real(S->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
+        if (cam_instance_check_real(S->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
             return fail(S, "fmi2SetReal", text);
     for (k = 0; k < nvr; k++)
-        if (cam_drive_set_real(S->drive, vr[k], value[k]) != CAM_OK)
-            return fail(S, "fmi2SetReal", cam_drive_message(S->drive));
+        if (cam_instance_set_real(S->drive, vr[k], value[k]) != CAM_OK)
+            return fail(S, "fmi2SetReal", cam_instance_message(S->drive));
     return fmi2OK;
 }
 
@@ -353,11 +352,11 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (!allowed(S, SET_STATES, "fmi2SetBoolean")) return fmi2Error;
     if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2SetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* booleans are parameters: the drive refuses them after initialisation */
-        if (cam_drive_initialized(S->drive))
+        if (cam_instance_initialized(S->drive))
             return fail(S, "fmi2SetBoolean", "parameters are fixed after initialisation (fmi2Reset first)");
     for (k = 0; k < nvr; k++)
-        if (cam_drive_set_boolean(S->drive, vr[k], value[k] != fmi2False) != CAM_OK)
-            return fail(S, "fmi2SetBoolean", cam_drive_message(S->drive));
+        if (cam_instance_set_boolean(S->drive, vr[k], value[k] != fmi2False) != CAM_OK)
+            return fail(S, "fmi2SetBoolean", cam_instance_message(S->drive));
     return fmi2OK;
 }
 
@@ -371,16 +370,16 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
         if (!value[k]) return fail(S, "fmi2SetString", "a string value must not be NULL");
     /* Strings are checked as they are set; a multi-value set is undone on refusal by saving first. */
     {
-        size_t size = cam_drive_state_size(S->drive);
+        size_t size = cam_instance_state_size(S->drive);
         unsigned char *saved = malloc(size ? size : 1);
-        if (!saved || cam_drive_save(S->drive, saved, size) != CAM_OK) {
+        if (!saved || cam_instance_save(S->drive, saved, size) != CAM_OK) {
             free(saved);
             return fail(S, "fmi2SetString", "out of memory");
         }
         for (k = 0; k < nvr; k++)
-            if (cam_drive_set_string(S->drive, vr[k], value[k], strlen(value[k])) != CAM_OK) {
-                fmi2Status status = fail(S, "fmi2SetString", cam_drive_message(S->drive));
-                cam_drive_restore(S->drive, saved, size);
+            if (cam_instance_set_string(S->drive, vr[k], value[k], strlen(value[k])) != CAM_OK) {
+                fmi2Status status = fail(S, "fmi2SetString", cam_instance_message(S->drive));
+                cam_instance_restore(S->drive, saved, size);
                 free(saved);
                 return status;
             }
@@ -400,7 +399,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
     (void)noSetFMUStatePriorToCurrentPoint;
     if (!S) return fmi2Error;
     if (!allowed(S, STEP_COMPLETE, "fmi2DoStep")) return fmi2Error;
-    now = cam_drive_time(S->drive);
+    now = cam_instance_time(S->drive);
     if (!isfinite(currentCommunicationPoint) || fabs(currentCommunicationPoint - now) > TIME_SLACK(now)) {
         snprintf(text, sizeof text, "currentCommunicationPoint = %.17g s is not where the FMU is, t = %.17g s "
                  "(allowed difference %.3g s)", currentCommunicationPoint, now, TIME_SLACK(now));
@@ -411,8 +410,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                  communicationStepSize);
         return fail(S, "fmi2DoStep", text);
     }
-    status = drive_status(S, cam_drive_step(S->drive, now, communicationStepSize), "fmi2DoStep");
-    if (status == fmi2OK) S->last_successful_time = cam_drive_time(S->drive);
+    status = drive_status(S, cam_instance_step(S->drive, now, communicationStepSize), "fmi2DoStep");
+    if (status == fmi2OK) S->last_successful_time = cam_instance_time(S->drive);
     return status;
 }
 
@@ -490,11 +489,11 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
 /* ------------------------------------------------------------------ FMU states */
 
 static SavedState *save_state(Instance *S) {
-    size_t size = cam_drive_state_size(S->drive);
+    size_t size = cam_instance_state_size(S->drive);
     SavedState *saved = malloc(sizeof *saved + size);
     if (!saved) return NULL;
     saved->size = size;
-    if (cam_drive_save(S->drive, saved->bytes, size) != CAM_OK) {
+    if (cam_instance_save(S->drive, saved->bytes, size) != CAM_OK) {
         free(saved);
         return NULL;
     }
@@ -514,11 +513,11 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
 
 static fmi2Status restore(Instance *S, const SavedState *saved, const char *call) {
     /* the instance state follows the drive's: initialised states go to step mode */
-    if (cam_drive_restore(S->drive, saved->bytes, saved->size) != CAM_OK)
-        return fail(S, call, cam_drive_message(S->drive));
-    if (cam_drive_initialized(S->drive)) {
+    if (cam_instance_restore(S->drive, saved->bytes, saved->size) != CAM_OK)
+        return fail(S, call, cam_instance_message(S->drive));
+    if (cam_instance_initialized(S->drive)) {
         S->state = STEP_COMPLETE;
-        S->last_successful_time = cam_drive_time(S->drive);
+        S->last_successful_time = cam_instance_time(S->drive);
     } else {
         S->state = INSTANTIATED;
     }

@@ -1,0 +1,63 @@
+/* One cam drive as an FMI host sees it: variables by value reference, initialisation,
+ * communication steps, outputs, and the saved state (parameters included). The FMI glues
+ * (csrc/fmi/) call only these functions; the drive behind them is cam_model.h's CamInstance.
+ *
+ * Value references are those of the generated variable table (cam_variables.h, generated from
+ * cam_fmu/physics/parameters.py and variables.py): the inputs, then the outputs, then the
+ * parameters, in table order, from 0.
+ *
+ * Every function that can refuse returns a CamStatus other than CAM_OK (CAM_ERR_REJECTED for a step
+ * the solver cannot complete at this size: fmi2Discard) and leaves its message, which names the variable or setting and its
+ * allowed range, in cam_instance_message(). A refused call changes nothing. No globals.
+ */
+#ifndef CAM_INSTANCE_H
+#define CAM_INSTANCE_H
+
+#include <stddef.h>
+
+#include "cam_model.h"
+
+typedef struct CamInstance CamInstance;
+
+/* A new drive: parameters at their defaults, inputs at their start values; NULL if out of memory. */
+CamInstance *cam_instance_new(void);
+void cam_instance_free(CamInstance *d);
+
+/* Back to the state of cam_instance_new (parameters at their defaults, not initialised). */
+void cam_instance_reset(CamInstance *d);
+
+/* The message of the last refusal (empty if none); valid until the next call on d. */
+const char *cam_instance_message(const CamInstance *d);
+
+/* Variables. Setting a parameter is allowed only before cam_instance_initialize; an input any time;
+ * an output never. A value outside its range is refused with the variable's name and range.
+ * Getting an output before initialisation computes it from the parameters and inputs. */
+int cam_instance_get_real(CamInstance *d, unsigned vr, double *value);
+int cam_instance_set_real(CamInstance *d, unsigned vr, double value);
+int cam_instance_check_real(const CamInstance *d, unsigned vr, double value, char *err, size_t err_len);
+int cam_instance_get_boolean(CamInstance *d, unsigned vr, int *value);
+int cam_instance_set_boolean(CamInstance *d, unsigned vr, int value);
+/* Strings are copied in (len bytes, UTF-8, no NUL needed) and out (valid until the next call). */
+int cam_instance_get_string(CamInstance *d, unsigned vr, const char **value);
+int cam_instance_set_string(CamInstance *d, unsigned vr, const char *value, size_t len);
+
+/* Validate the parameters together, build the cam program and the initial state at start_time [s]. */
+int cam_instance_initialize(CamInstance *d, double start_time);
+int cam_instance_initialized(const CamInstance *d);
+
+/* Advance from t to t + h [s] with the inputs held; t must be where the drive is (to rounding).
+ * CAM_DISCARD: the state is as before the step (restore or retry a shorter step). */
+int cam_instance_step(CamInstance *d, double t, double h);
+double cam_instance_time(const CamInstance *d);
+
+/* The outputs in table order (cam_variables.h), current for the state and inputs. */
+const double *cam_instance_outputs(CamInstance *d);
+
+/* The whole state as bytes: size, save into a buffer of that size, restore (validated whole:
+ * a blob of another build, a truncated or edited blob whose values are not a valid state is
+ * refused with what is wrong, and nothing changes). */
+size_t cam_instance_state_size(const CamInstance *d);
+int cam_instance_save(const CamInstance *d, unsigned char *buffer, size_t size);
+int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t size);
+
+#endif
