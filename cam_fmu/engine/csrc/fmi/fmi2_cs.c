@@ -78,15 +78,23 @@ static const char *state_name(InstanceState s) {
 }
 
 static void log_message(Instance *S, fmi2Status status, const char *category, const char *format, ...) {
-    char text[MESSAGE_MAX];
+    char text[MESSAGE_MAX], escaped[2 * MESSAGE_MAX];
+    size_t k, n = 0;
     va_list args;
     if (!S->logger || (status == fmi2OK && !S->logging_on)) return;
     va_start(args, format);
     vsnprintf(text, sizeof text, format, args);
     va_end(args);
     if (strlen(text) == sizeof text - 1) memcpy(text + sizeof text - 5, "...", 4);
-    /* the text as an argument, never as the format: a value may contain '%' */
-    S->logger(S->environment, S->name, status, category, "%s", text);
+    /* The text is the logger's format with every '%' doubled and no arguments: hosts that format
+     * it (printf-style, as the standard says) and hosts that cannot see varargs (ctypes) both
+     * show the message itself. */
+    for (k = 0; text[k] && n + 2 < sizeof escaped; k++) {
+        if (text[k] == '%') escaped[n++] = '%';
+        escaped[n++] = text[k];
+    }
+    escaped[n] = '\0';
+    S->logger(S->environment, S->name, status, category, escaped);
 }
 
 static fmi2Status fail(Instance *S, const char *format_name, const char *text) {

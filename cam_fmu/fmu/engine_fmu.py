@@ -1,0 +1,98 @@
+"""Build cam.fmu from the C engine: a binary FMU that needs nothing but the C library.
+
+Build time only. Steps:
+
+1. The GUID: a hash of the variable table (``model_description.variable_rows``)
+   and of the engine's sources (``engine.build.digest``).
+2. The generated headers (``engine.codegen``: the variable and parameter tables of
+   ``physics/parameters.py`` and ``physics/variables.py``) in a temporary folder.
+3. The binary: every engine source (``engine/csrc/src/*.c``) and the FMI 2.0
+   glue (``engine/csrc/fmi/fmi2_cs.c``) compiled into one shared library with the
+   official FMI headers (fmpy's copy), only the FMI functions exported, linked
+   with libc and libm only: ``binaries/linux64/cam.so``.
+4. ``modelDescription.xml``: ``model_description.skeleton`` completed by
+   ``model_description.postprocess`` (units, ranges, structure, the default
+   experiment of the paper's fig. 6 scene).
+5. The C sources under ``sources/`` (anyone can rebuild the binary for another
+   platform: ``cc -shared -fPIC -Isources sources/*.c -lm``).
+"""
+from __future__ import annotations
+
+import shutil
+import subprocess
+import tempfile
+import zipfile
+from pathlib import Path
+from typing import Sequence
+
+from ..engine import build as engine_build
+from ..engine import codegen
+from . import model_description
+
+MODEL_IDENTIFIER = "cam"
+DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
+               "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
+GLUE = engine_build.CSRC / "fmi" / "fmi2_cs.c"
+# Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
+BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
+
+
+class FmuBuildError(RuntimeError):
+    """The FMU could not be built; the message says why."""
+
+
+def default_experiment() -> tuple[float, float, float]:
+    """(start, stop, step) [s] of the paper's fig. 6 scene: the FMU's default experiment."""
+    from ..experiments.scenes import find_scene
+
+    scene = find_scene("paper_fig6")
+    return 0.0, float(scene.stop_time), float(scene.step_size)
+
+
+def engine_guid() -> str:
+    """The GUID of a cam.fmu built from this checkout."""
+    return model_description.guid(model_description.variable_rows(), engine_build.digest())
+
+
+def compile_binary(dest: Path, guid: str, generated: Path, compiler: str | None = None,
+                   extra_flags: Sequence[str] = ()) -> Path:
+    """Compile the engine and the FMI 2.0 glue into the shared library ``dest``."""
+    cc = compiler or engine_build.find_compiler()
+    sources = [str(p) for p in sorted(engine_build.SOURCES.glob("*.c"))] + [str(GLUE)]
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [cc, *engine_build.CFLAGS, *BINARY_FLAGS, *extra_flags, f'-DCAM_GUID="{guid}"',
+           f"-I{engine_build.INCLUDE}", f"-I{generated}", f"-I{engine_build.fmi_headers()}",
+           *sources, "-o", str(dest), *engine_build.LDFLAGS]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise FmuBuildError(f"compiling cam.fmu's binary failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")
+    return dest
+
+
+def build(dest: Path) -> Path:
+    """Build cam.fmu at ``dest`` (a path ending in .fmu) and return it."""
+    dest = Path(dest).resolve()
+    if dest.suffix != ".fmu":
+        raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
+    rows = model_description.variable_rows()
+    guid = engine_guid()
+    with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
+        root = Path(tmp)
+        generated = codegen.write_headers(root / "generated")
+        compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid, generated)
+        xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
+                                            default_experiment(), DESCRIPTION, rows)
+        (root / "fmu" / "modelDescription.xml").write_bytes(xml)
+        sources = root / "fmu" / "sources"
+        sources.mkdir()
+        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), GLUE,
+                     *generated.glob("*.h")]:
+            shutil.copyfile(path, sources / path.name)
+        out = root / f"{MODEL_IDENTIFIER}.fmu"
+        with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
+            for path in sorted((root / "fmu").rglob("*")):
+                if path.is_file():
+                    z.write(path, path.relative_to(root / "fmu").as_posix())
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(out, dest)
+    return dest
