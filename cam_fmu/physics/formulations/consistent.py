@@ -19,12 +19,17 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from ...kernel.drive_kernel import EVENT_NAMES, SIDE_HYSTERESIS
 from ..drive import DriveModel
 from ..variables import output_record
 
 THETA, OMEGA, CURRENT = 0, 1, 2  # slots of the continuous state y
-STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES  # the kernel's event codes index these
+# The events of the hybrid system (docs/model.md section 10); an engine's event codes index this tuple.
+EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
+STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES
+# N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
+# exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch
+# back and forth at one instant (it did: the reference looped at a break-away from theta = 0).
+SIDE_HYSTERESIS = 1e-9
 
 
 @dataclass
