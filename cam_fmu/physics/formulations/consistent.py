@@ -4,9 +4,10 @@ Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A]
 (slots THETA, OMEGA, CURRENT).
 Discrete mode: stuck (shaft held by static friction), direction of motion,
 backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
-gap) and the follower's position while free. Both the FMU stepper and the
-scipy reference integrate ``derivative`` and stop at the zeros of
-``event_values``: one physics code, two integrators (docs/model.md sections 5-6).
+gap) and the follower's position while free. The scipy reference integrates
+``derivative`` and stops at the zeros of ``event_values`` (docs/model.md sections
+5-6); so do the engine's fixed-step solvers, while its rk45 runs the drive
+kernel's own copy of the formulas and calls back here for the transitions.
 ``consistent_voltage.ConsistentVoltage`` is this formulation under a voltage input,
 advanced by the engine's integrator.
 
