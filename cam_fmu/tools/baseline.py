@@ -249,7 +249,8 @@ def write(directory: Path = RECORD_DIR) -> list[Path]:
         for case in cases:
             case["result"] = replay(case)
         path = directory / f"{stem}.json"
-        path.write_text(json.dumps({"recorded_with": about, "cases": cases}, indent=None, separators=(",", ":")))
+        rows = ",\n".join(json.dumps(case, separators=(",", ":")) for case in cases)  # a case per line
+        path.write_text(f'{{"recorded_with":{json.dumps(about)},\n"cases":[\n{rows}]}}\n')
         written.append(path)
         print(f"{path}: {len(cases)} cases, {path.stat().st_size / 1e3:.0f} kB", flush=True)
     return written
