@@ -78,19 +78,19 @@ def scene_cases(name: str) -> list[dict[str, Any]]:
 
     scene = find_scene(name)
     inputs = {k: _signal_dict(s) for k, s in every_input(input_signals(scene)).items()}
-    formulations = FORMULATIONS if scene.drive == "voltage" else ("speed",)
+    formulations = FORMULATIONS if scene.drive == "voltage" else (None,)  # the speed drive: its own
     cases, seen = [], []
     for run in scene.runs:
         for solver in SOLVERS:
             for formulation in formulations:
                 params = dict(run.overrides, solver=solver)
-                if formulation != "speed":
+                if formulation:
                     params["formulation"] = formulation
                 resolved = resolve(params)
                 if resolved in seen:
                     continue
                 seen.append(resolved)
-                cases.append({"name": f"{name}/{run.label}/{solver}/{formulation}", "params": params,
+                cases.append({"name": f"{name}/{run.label}/{solver}/{formulation or scene.drive}", "params": params,
                               "comm_step": scene.output_interval, "stop_time": scene.stop_time, "inputs": inputs})
     return cases
 
