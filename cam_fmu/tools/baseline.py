@@ -20,7 +20,8 @@ The cases:
   constants of the modules imported so far: the same derandomised test draws other cases when
   the engine was imported before it, as in the full suite, than when run alone).
 Each case is stored whole (parameters, communication step, stop time, input signals), so the
-replay needs neither the scene files nor hypothesis: an edited scene does not move the baseline.
+replay needs neither the scene files nor the draw; the test checks apart that every run of
+every shipped scene is among the recorded cases (an edited scene fails there, not in the replay).
 
 The replay: inputs set at t = 0, then communication step k (k = 1..n, n = round(stop /
 comm)) from t = (k-1) comm to k comm (the clock of extremes.run), inputs = each signal's
