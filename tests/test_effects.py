@@ -46,8 +46,8 @@ def test_a_switched_off_follower_costs_no_profile_evaluation():
         off.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
         on.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
     assert off.steps_taken >= 100
-    assert off.model.kernel.evaluations <= 101
-    assert on.model.kernel.evaluations > 6 * on.steps_taken  # rk45 reads it at every stage
+    assert off.kernel.evaluations <= 101
+    assert on.kernel.evaluations > 6 * on.steps_taken  # rk45 reads it at every stage
 
 
 def test_inductance_switch_off_ignores_L():

@@ -94,3 +94,61 @@ def test_no_string_dispatch_on_solver_or_formulation_outside_the_registries():
             if pattern.search(line):
                 found.append(f"{rel}:{k}: {line.strip()}")
     assert found == []
+
+
+def _package_imports(path: Path) -> set[str]:
+    """Dotted names of the cam_fmu modules that module ``path`` imports (relative imports resolved;
+    ``from . import x`` counts as importing the package and its member ``x``)."""
+    parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+    package = parts[:-1]  # a module's package; an __init__.py's parts end in "__init__": the package itself
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = ".".join(package[:len(package) - node.level + 1]) if node.level else ""
+            module = ".".join(filter(None, (base, node.module)))
+            found.add(module)
+            found |= {f"{module}.{a.name}" for a in node.names}
+    return {name for name in found if name.split(".")[0] == "cam_fmu"}
+
+
+# The run-time engine: the reference's readable model must not use its code (issue 18: FMU against
+# reference is a check of two implementations).
+ENGINE = ("cam_fmu.kernel", "cam_fmu.solvers", "cam_fmu.engine", "cam_fmu.fmu")
+# The one engine module that still lives under physics: the consistent formulation as the engine
+# steps it (its state in the kernel, the fixed-step solvers); it goes with the Cython kernel.
+ENGINE_STEPPER = PACKAGE / "physics" / "formulations" / "consistent_voltage.py"
+
+
+def _under(name: str, prefixes: tuple[str, ...]) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+def test_the_model_and_the_reference_import_nothing_of_the_engine():
+    """physics, kinematics and reference never import the kernel, the solvers or the engine: the scipy
+    reference integrates physics, a model written independently of the code that runs in the FMU."""
+    layers = [PACKAGE / layer for layer in ("physics", "kinematics", "reference")]
+    checked = [p for p in MODULES if any(layer in p.parents for layer in layers) and p != ENGINE_STEPPER]
+    assert len(checked) >= 20
+    found = [f"{p.relative_to(PACKAGE)}: {name}" for p in checked for name in sorted(_package_imports(p))
+             if _under(name, ENGINE)]
+    assert found == []
+    # the exception is still needed (else it goes): it is the one that imports the engine's solvers
+    assert any(_under(name, ENGINE) for name in _package_imports(ENGINE_STEPPER))
+
+
+def test_kinematics_imports_no_other_layer():
+    kinematics = PACKAGE / "kinematics"
+    found = [f"{p.relative_to(PACKAGE)}: {name}" for p in MODULES if kinematics in p.parents
+             for name in sorted(_package_imports(p)) if not _under(name, ("cam_fmu.kinematics",))]
+    assert found == []
+
+
+def test_the_import_check_resolves_relative_imports():
+    """The checks above see through relative imports (the package's only kind)."""
+    assert "cam_fmu.physics.drive" in _package_imports(PACKAGE / "reference" / "integrate.py")
+    assert "cam_fmu.physics.variables" in _package_imports(PACKAGE / "kernel" / "drive_kernel.py")
+    formulations = _package_imports(PACKAGE / "physics" / "formulations" / "__init__.py")
+    assert {"cam_fmu.physics.formulations.base", "cam_fmu.physics.drive"} <= formulations
+    assert "cam_fmu.solvers.dopri" in _package_imports(ENGINE_STEPPER)

@@ -24,8 +24,8 @@ import math
 from array import array
 from typing import Any, Mapping
 
+from ..kernel.drive_kernel import DriveKernel, EnergyBudget
 from ..physics.drive import DriveModel
-from ..physics.energy import EnergyBudget
 from ..physics.formulations import formulation_for
 from ..physics.variables import INPUT_RANGES, INPUT_STARTS, INPUTS, OUTPUT_NAMES, OUTPUTS, check_input
 from ..solvers import SOLVERS, SimulationError
@@ -50,7 +50,10 @@ class DriveSimulator:
         self.omega_ref = INPUT_STARTS["omega_ref"]
         self.omega_dot_ref = INPUT_STARTS["omega_dot_ref"]
         self.steps_taken = 0  # internal steps, for benchmarks
-        self.formulation = formulation_for(model, self.u, self.omega_ref)
+        # The hot path (profile, right-hand side, rk45 with events, the checks of the outputs): one per drive.
+        self.kernel = DriveKernel(model.program, model.J_m, model.m, model.M_f, model.F_gx, model.G_y, model.N_g,
+                                  model.mu, model.r_b, model.c, model.R, model.L, model.c_e, model.c_m)
+        self.formulation = formulation_for(model, self.u, self.omega_ref, self.kernel)
         self.budget: EnergyBudget | None = None  # set at the first step (voltage drive)
         # The outputs in OUTPUTS order: ``values`` holds the published ones (the FMU reads it), ``_scratch``
         # those of a step not yet checked; ``_stale`` until the current state's are computed.
@@ -83,8 +86,7 @@ class DriveSimulator:
             self.budget = EnergyBudget(self.model, out[_THETA], out[_OMEGA], out[_I], out[_S], out[_J])
         out, formulation = self._scratch, self.formulation
         # the step, its outputs into out and the kernel's verdict on them (the energy budget books the step)
-        verdict = formulation.advance_checked(h, self.integrator, self.time, out, self.budget, self.u,
-                                              self.model.kernel)
+        verdict = formulation.advance_checked(h, self.integrator, self.time, out, self.budget, self.u, self.kernel)
         self.steps_taken += formulation.steps
         self.time = t + h
         if verdict:

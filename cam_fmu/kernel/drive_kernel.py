@@ -1,9 +1,12 @@
 # cython: language_level=3, annotation_typing=False, boundscheck=False, wraparound=False, cdivision=True, cpow=True, initializedcheck=False
 """The cam drive's hot path: profile, right-hand side, Dormand-Prince steps, events and breakpoints.
 
-Plain Python with ``math`` only, and the one source of these formulas: the
-physics classes (``physics.drive.DriveModel``, ``physics.formulations.consistent``)
-and the scipy reference call them, and ``compile.py`` compiles this file with
+Plain Python with ``math`` only: the run-time engine's own copy of the
+formulas of ``physics.drive.DriveModel`` (profile, omega_dot, side force, load,
+guide friction) and ``physics.energy.EnergyBudget``, in the same order of
+operations, so the scipy reference (which integrates ``physics``) checks a
+second implementation. It imports the event names and constants from
+``physics``, never the reverse. ``compile.py`` compiles this file with
 the C types of ``drive_kernel.pxd`` (Cython, pure-Python mode). Compiled and
 pure-Python runs execute the same IEEE operations in the same order: they agree
 to the last bit (tests/test_kernel_paths.py).
@@ -22,6 +25,8 @@ from __future__ import annotations
 import math
 from array import array
 
+from ..physics.energy import RELATIVE_SLACK
+from ..physics.formulations.consistent import EVENT_NAMES, SIDE_HYSTERESIS
 from ..physics.variables import OUTPUT_NAMES
 
 # Constants spelled out: compiled, ``math`` here is C's libc math (the .pxd), which has no pi, inf or nan.
@@ -215,13 +220,10 @@ B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784
 E1, E3, E4, E5, E6, E7 = (71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0,
                           -1.0 / 40.0)  # b5 - b4 (E2 = 0)
 
-# Event codes; EVENT_NAMES[code] is the formulation's name for it.
-STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = 0, 1, 2, 3, 4, 5
-EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
-# N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
-# exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch
-# back and forth at one instant (it did: the reference looped at a break-away from theta = 0).
-SIDE_HYSTERESIS = 1e-9
+# Event codes; EVENT_NAMES[code] is the formulation's name for it (physics.formulations.consistent).
+STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = (
+    EVENT_NAMES.index(name) for name in ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force"))
+# N [N]: the side-force event's hysteresis (physics.formulations.consistent.SIDE_HYSTERESIS says why).
 _HYSTERESIS = SIDE_HYSTERESIS  # the compiled module's C copy (a cdef global is not a Python attribute)
 EVENT_ITERATIONS = 60  # Illinois iterations at most per located zero
 
@@ -723,15 +725,12 @@ class DriveKernel(Profile):
         return self.publishable(out, budget, u, h)
 
 
-# Relative slack of the bound (integration error, rounding), of the energy scale |E| + r sum |W_in|.
-# Every solver on every shipped voltage scene stays at least 0.74 of that scale below the
-# bound (measured: losses dominate); a diverged or energy-making step overshoots it.
-RELATIVE_SLACK = 1e-3
+# Relative slack of the bound (physics.energy.RELATIVE_SLACK says why).
 _SLACK = RELATIVE_SLACK  # the compiled module's C copy
 
 
 class EnergyBudget:
-    """Tracks W_in and the bound for one drive (SI units): physics/energy.py explains the bound."""
+    """Tracks W_in and the bound for one drive (SI units): the engine's copy of physics.energy.EnergyBudget."""
 
     def __init__(self, model, theta: float, omega: float, i: float, s: float, J: float) -> None:
         self.c_e, self.L, self.R, self.F_gx = model.c_e, model.L, model.R, model.F_gx

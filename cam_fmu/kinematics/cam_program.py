@@ -14,18 +14,15 @@ Convention at a breakpoint (only s'' and s''' can differ between the sides):
 the piece *ending* there is used (left limit), except at theta = 0 (mod 2 pi),
 which is the start of the rise (right limit, as MotionLaw does at T = 0).
 
-This module imports math, numpy and the drive kernel (its breakpoint search): it is bundled into the FMU.
+This module imports math and numpy only (kinematics imports no other layer): it is bundled into the FMU.
 """
 
 from __future__ import annotations
 
 import math
-from array import array
 from typing import Sequence, Union
 
 import numpy as np
-
-from ..kernel.drive_kernel import first_angle_crossed
 
 from .motion_law import SHAPE_CONST, MotionLaw, golden_max
 from .presets import law
@@ -228,10 +225,37 @@ def first_crossed(points, start: float, end: float) -> float | None:
     """The first of the periodic points (in [0, 2 pi)) passed going from start to end [rad], or None.
 
     Strictly between start and end, like ``crossed``; its cost does not grow with |end - start|
-    (the drive kernel's search, which the integrators use at every step).
+    (the integrators use it at every step).
     """
-    found = first_angle_crossed(array("d", points), len(points), start, end)
+    found = first_angle_crossed(points, start, end)
     return None if math.isnan(found) else found
+
+
+def first_angle_crossed(points: Sequence[float], start: float, end: float) -> float:
+    """The first of the periodic angles ``points`` (each in [0, 2 pi)) strictly between start and end [rad],
+    in the direction of travel, or NaN (none); its cost does not grow with |end - start|.
+
+    Each point's nearest copy p + 2 pi k beyond start (k from one ceil or floor,
+    not a loop over turns) is a candidate; the nearest candidate wins if it lies
+    before end.
+    """
+    if end > start:
+        best = math.inf
+        for p in points:
+            angle = p + math.ceil((start - p) / TWO_PI) * TWO_PI
+            if angle <= start:
+                angle += TWO_PI
+            best = min(best, angle)
+        return best if best < end else math.nan
+    if end < start:
+        best = -math.inf
+        for p in points:
+            angle = p + math.floor((start - p) / TWO_PI) * TWO_PI
+            if angle >= start:
+                angle -= TWO_PI
+            best = max(best, angle)
+        return best if best > end else math.nan
+    return math.nan
 
 
 def paper_program(A: float = 0.035) -> CamProgram:

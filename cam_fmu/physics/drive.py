@@ -1,7 +1,8 @@
 """Physics of the cam drive: follower forces, load torque, inertia, motor.
 
-Plain functions of plain floats (``math`` only), shared by the reference
-integration, the FMU and the tests. Equations and corrections: docs/model.md
+Plain functions of plain floats (``math`` only): the readable model that the
+scipy reference integrates, independent of the run-time engine's code (which
+keeps its own copy of these formulas). Equations and corrections: docs/model.md
 sections 3-6. Sign conventions: X is the rise direction, theta and omega are
 positive in the cam's forward sense, v = ds/dt and a = d2s/dt2 are signed.
 
@@ -15,7 +16,6 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
-from ..kernel.drive_kernel import DriveKernel, solve_guide_friction
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
@@ -25,6 +25,27 @@ from .parameters import ParameterError, law_spec, resolve
 def sign(x: float) -> float:
     """+1, -1 or 0 (Coulomb friction's sgn, with sgn(0) = 0)."""
     return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+
+def solve_guide_friction(n0: float, kappa: float, sigma: float, mu: float, n_support: float,
+                         side: float = 0.0) -> float:
+    """Guide friction force f >= 0 [N] solving f = mu (|n0 + sigma kappa f| + n_support) (docs/model.md 4.2).
+
+    The side force N_r = n0 + sigma kappa f [N] depends on f itself (through the
+    contact force): solved exactly on its two linear branches instead of lagging
+    f by a step. Unique because mu |kappa| < 1. ``side`` +1/-1 takes the branch
+    where N_r has that sign (held between the integrators' side-force events);
+    0 chooses the branch that holds: N_r >= 0 if its f is >= 0 and keeps N_r >= 0.
+    """
+    if mu == 0.0:
+        return 0.0
+    if side != 0.0:
+        return mu * (side * n0 + n_support) / (1.0 - side * mu * sigma * kappa)
+    sk = sigma * kappa
+    f = mu * (n0 + n_support) / (1.0 - mu * sk)
+    if f >= 0.0 and n0 + sk * f >= 0.0:
+        return f
+    return mu * (n_support - n0) / (1.0 + mu * sk)
 
 
 def check_self_locking(program: ProgramBase, mu: float, r_b: float) -> None:
@@ -62,6 +83,19 @@ def build_program(p: Mapping[str, Any]) -> ProgramBase:
     except ValueError as exc:
         raise ParameterError(f"parameters 'rise_law'/'rise_T1'..'rise_T6', 'return_law'/'return_T1'..'return_T6': "
                              f"{exc}") from None
+
+
+@dataclass
+class GuideTerms:
+    """The coupled friction problem of docs/model.md 4.4 at one instant (SI units)."""
+
+    J: float  # kg m2, equivalent inertia J_m + m s'^2
+    s1: float  # m/rad, ds/dtheta
+    x0: float  # rad/s2, omega_dot without guide friction
+    sigma: float  # sgn(v): the direction the friction opposes
+    f: float  # N, guide friction force (0 without guide friction)
+    n0: float  # N, side force N_r without friction: N_r = n0 + sigma kappa f
+    kappa: float  # (J_m / J) tan(alpha)
 
 
 @dataclass
@@ -106,37 +140,82 @@ class DriveModel:
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
-        # The hot path (profile, right-hand side, rk45 with events): one object per model.
-        self.kernel = DriveKernel(self.program, self.J_m, self.m, self.M_f, self.F_gx, self.G_y, self.N_g,
-                                  self.mu, self.r_b, self.c, self.R, self.L, self.c_e, self.c_m)
 
     # ----------------------------------------------------------- mechanics
+    def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float) -> GuideTerms:
+        """The consistent equation's terms at theta [rad], omega [rad/s] (docs/model.md 4.4 and 5.1).
+
+        ``drive`` is the shaft's torque c_m i - M_f d [N m]. Without guide friction
+        the terms after x0 are 0; with it, f solves the coupling of f and omega_dot
+        exactly (``solve_guide_friction`` with kappa' = (J_m / J) tan(alpha)).
+        """
+        s, s1, s2, _ = self.program.derivatives(theta)
+        m = self.m
+        J = self.J_m + m * s1 * s1
+        inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
+        x0 = (drive - inertial * s1) / J
+        if self.mu == 0.0:
+            return GuideTerms(J, s1, x0, 0.0, 0.0, 0.0, 0.0)
+        sigma = sign(s1 * direction)
+        tan_a = s1 / (self.r_b + s)
+        n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
+        kappa = self.J_m / J * tan_a
+        f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g, side)
+        return GuideTerms(J, s1, x0, sigma, f, n0, kappa)
+
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
                   side: float = 0.0) -> float:
-        """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5).
+        """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5.1).
 
+        omega_dot = (c_m i - M_f d - (m s'' omega^2 - F_gx) s' - sigma f s') / (J_m + m s'^2).
         ``torque`` is the motor torque c_m i [N m]; ``direction`` is sgn(omega),
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
         False means the follower is free in the backlash gap (J = J_m, no load).
         ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
         branch, held between events so the right-hand side is smooth); 0 chooses it.
-        The formula is the drive kernel's (kernel/drive_kernel.py), compiled where it can be.
         """
-        return self.kernel.omega_dot(theta, omega, torque, direction, engaged, side)
+        drive = torque - self.M_f * direction
+        if not (engaged and self.follower):
+            return drive / self.J_m
+        g = self.guide_terms(theta, omega, drive, direction, side)
+        if self.mu == 0.0:
+            return g.x0
+        return g.x0 - g.sigma * g.f * g.s1 / g.J
 
     def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
         """The guide's side force N_r [N] while the follower is engaged and moving (0 without guide friction).
 
         |N_r| has a kink where N_r changes sign (the friction mu |N_r| does): the
-        integrators locate that zero as an event instead of stepping over it.
+        integrators locate that zero as an event instead of stepping over it
+        (docs/model.md sections 4.2 and 10).
         """
-        return self.kernel.side_force(theta, omega, torque, direction, side)
+        if self.mu == 0.0 or not self.follower:
+            return 0.0
+        g = self.guide_terms(theta, omega, torque - self.M_f * direction, direction, side)
+        return g.n0 + g.sigma * g.kappa * g.f
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
-        """Load torque, inertia and follower motion for a known omega_dot (the kernel's formula)."""
-        k = self.kernel
-        k.load(theta, omega, omega_dot, direction, engaged)
-        return LoadState(omega_dot, k.load_M, k.load_J, k.load_f, k.load_v, k.load_a, k.load_alpha, k.load_s)
+        """Load torque, inertia and follower motion for a known omega_dot [rad/s2] (docs/model.md 4.1-4.3).
+
+        v = s' omega, a = s'' omega^2 + s' omega_dot; the guide friction with
+        kappa = tan(alpha) (omega_dot given, no coupling left); M = M_f d +
+        (m a - F_gx + sigma f) s'. Free in the gap (``engaged`` False): only M_f d
+        and J_m.
+        """
+        s, s1, s2, _ = self.program.derivatives(theta)
+        tan_a = s1 / (self.r_b + s)
+        shaft = self.M_f * direction
+        alpha = math.atan(tan_a)
+        if not engaged:
+            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, alpha, s)
+        v = s1 * omega
+        a = s2 * omega * omega + s1 * omega_dot
+        sigma = sign(s1 * direction)
+        push = self.m * a - self.F_gx  # N, axial force without friction
+        f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
+        M = shaft + (push + sigma * f) * s1
+        J = self.J_m + self.m * s1 * s1
+        return LoadState(omega_dot, M, J, f, v, a, alpha, s)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True) -> float:
         """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).

@@ -8,6 +8,8 @@ the ``base.Formulation`` methods plus one entry here.
 """
 from __future__ import annotations
 
+from typing import Any
+
 from ..drive import DriveModel
 from .base import Formulation
 from .consistent_voltage import ConsistentVoltage
@@ -26,9 +28,14 @@ def formulation_name(model: DriveModel) -> str:
     return "speed" if model.drive == "speed" else model.formulation
 
 
-def formulation_for(model: DriveModel, u: float, omega_ref: float) -> Formulation:
-    """The formulation the model's parameters ask for, built at the given start inputs."""
+def formulation_for(model: DriveModel, u: float, omega_ref: float, kernel: Any) -> Formulation:
+    """The formulation the model's parameters ask for, built at the given start inputs.
+
+    ``kernel``: the engine's drive kernel of ``model``, where the consistent formulation keeps its state.
+    """
     cls = FORMULATIONS[formulation_name(model)]
+    if cls is ConsistentVoltage:
+        return ConsistentVoltage(model, u, kernel)
     return cls(model, omega_ref) if cls is SpeedDrive else cls(model, u)
 
 

@@ -4,9 +4,10 @@ Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A]
 (slots THETA, OMEGA, CURRENT).
 Discrete mode: stuck (shaft held by static friction), direction of motion,
 backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
-gap) and the follower's position while free. Both the FMU stepper and the
-scipy reference integrate ``derivative`` and stop at the zeros of
-``event_values``: one physics code, two integrators (docs/model.md sections 5-6).
+gap) and the follower's position while free. The scipy reference integrates
+``derivative`` and stops at the zeros of ``event_values`` (docs/model.md sections
+5-6); so do the engine's fixed-step solvers, while its rk45 runs the drive
+kernel's own copy of the formulas and calls back here for the transitions.
 ``consistent_voltage.ConsistentVoltage`` is this formulation under a voltage input,
 advanced by the engine's integrator.
 
@@ -19,12 +20,17 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from ...kernel.drive_kernel import EVENT_NAMES, SIDE_HYSTERESIS
 from ..drive import DriveModel
 from ..variables import output_record
 
 THETA, OMEGA, CURRENT = 0, 1, 2  # slots of the continuous state y
-STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES  # the kernel's event codes index these
+# The events of the hybrid system (docs/model.md section 10); an engine's event codes index this tuple.
+EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
+STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES
+# N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
+# exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch
+# back and forth at one instant (it did: the reference looped at a break-away from theta = 0).
+SIDE_HYSTERESIS = 1e-9
 
 
 @dataclass

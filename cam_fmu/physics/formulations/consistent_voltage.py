@@ -1,8 +1,10 @@
 """The consistent formulation under a voltage input, as the engine steps it (its state lives in the kernel).
 
 ``HybridDrive`` (consistent.py) holds the physics of the modes and events;
-this class keeps the state in the model's drive kernel, where rk45 advances it
+this class keeps the state in the engine's drive kernel, where rk45 advances it
 compiled, and hands the fixed-step solvers to ``solvers.hybrid.HybridIntegrator``.
+Part of the run-time engine (not of the readable model): it imports ``solvers``;
+the kernel is handed to it, so importing it does not import the kernel.
 """
 from __future__ import annotations
 
@@ -10,28 +12,27 @@ import math
 from typing import Any
 
 from ...errors import SimulationError, StepRejected
-from ...kernel.drive_kernel import EVENT_NAMES
 from ...solvers.dopri import step_floor_message
 from ..drive import DriveModel
 from .base import Formulation
-from .consistent import CURRENT, OMEGA, THETA, HybridDrive, Mode
+from .consistent import CURRENT, EVENT_NAMES, OMEGA, THETA, HybridDrive, Mode
 
 
 class ConsistentVoltage(Formulation):
     """The energy-consistent drive under the voltage input u, stepped by the engine's integrator.
 
-    The state lives in the model's drive kernel (``y`` and ``mode`` read and
-    write it): rk45 advances it there, compiled, and calls back into
-    ``HybridDrive`` for the transitions (events, rest); the fixed-step solvers
-    advance it through ``solvers.hybrid.HybridIntegrator``.
+    The state lives in ``kernel``, the engine's ``DriveKernel`` of this model
+    (``y`` and ``mode`` read and write it): rk45 advances it there, compiled,
+    and calls back into ``HybridDrive`` for the transitions (events, rest); the
+    fixed-step solvers advance it through ``solvers.hybrid.HybridIntegrator``.
     """
 
     energy_bounded = True
 
-    def __init__(self, model: DriveModel, u: float) -> None:
+    def __init__(self, model: DriveModel, u: float, kernel: Any) -> None:
         p = model.params
         self.hybrid = HybridDrive(model)
-        self.kernel = kernel = model.kernel
+        self.kernel = kernel
         self.y, self.mode = self.hybrid.initial(p["theta0"], p["omega0"], p["i0"])
         self.u = u
         self._settle(u)
