@@ -33,7 +33,7 @@ typedef struct {
     double c[CAM_MAX_STAGES];                     /* nodes (unused by autonomous stages; documentation) */
     int fsal;                                     /* 1: f at the new state is stage s + 1 (first same as last) */
     double e[CAM_MAX_STAGES + 1];                 /* error weights b - b_hat, the FSAL stage last; all 0: none */
-    int error_order;                              /* q of the embedded pair: the step factor is norm^(-1/(q+1)) */
+    double error_exponent;                        /* -1/(q+1) for an embedded pair of order q (dopri5: -0.2) */
 } CamTableau;
 
 /* Scratch of one step: the stages, the new state, its error and f at it. */
