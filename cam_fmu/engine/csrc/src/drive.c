@@ -15,7 +15,7 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     d->form = cam_formulation(d->model.formulation);
     if (d->form == NULL) {
         cam_model_free(&d->model);
-        return cam_fail(err, CAM_ERR_PARAMETER, "formulation %d is not yet available in the C engine",
+        return cam_error(err, CAM_ERR_PARAMETER, "formulation %d is not yet available in the C engine",
                         (int)d->model.formulation);
     }
     d->time = 0.0;
@@ -42,8 +42,8 @@ static int check_input(int index, double value, CamError *err)
     char shown[40];
     if (s->low <= value && value <= s->high)
         return CAM_OK;
-    return cam_fail(err, CAM_ERR_SIMULATION, "input '%s' = %s [%s] is outside the allowed range [%g, %g] %s", s->name,
-                    cam_repr(value, shown, sizeof shown), s->unit, s->low, s->high, s->unit);
+    return cam_error(err, CAM_ERR_SIMULATION, "input '%s' = %s [%s] is outside the allowed range [%g, %g] %s", s->name,
+                    cam_num(value, shown), s->unit, s->low, s->high, s->unit);
 }
 
 int cam_drive_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref, CamError *err)
@@ -71,21 +71,21 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
             ;
         if (k == CAM_N_OUTPUTS)   /* the sum overflowed, every output finite */
             k = 0;
-        return cam_fail(err, CAM_ERR_SIMULATION, "output '%s' became %s at t = %g s with solver '%s', h_max = %g s: "
+        return cam_error(err, CAM_ERR_SIMULATION, "output '%s' became %s at t = %g s with solver '%s', h_max = %g s: "
                         "reduce h_max or use 'rk45'/'etdrk4'", cam_output_spec(k)->name,
-                        cam_repr(out[k], shown, sizeof shown), d->time, solver->choices[d->model.solver],
+                        cam_num(out[k], shown), d->time, solver->choices[d->model.solver],
                         d->model.h_max);
     }
     d->form->advice(d, advice, sizeof advice);
     if (verdict == CAM_PUBLISH_CLEARANCE)
-        return cam_fail(err, CAM_ERR_SIMULATION, "the follower is %.6g m from the cam at t = %g s, beyond the "
+        return cam_error(err, CAM_ERR_SIMULATION, "the follower is %.6g m from the cam at t = %g s, beyond the "
                         "clearance c = %g m: a contact event was missed; %s", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]),
                         d->time, d->model.c, advice);
     {
         double excess, tolerance;
         cam_energy_excess(&d->budget, out[CAM_O_OMEGA], out[CAM_O_S], out[CAM_O_J], out[CAM_O_I], &excess,
                           &tolerance);
-        return cam_fail(err, CAM_ERR_SIMULATION, "the state at t = %g s holds %.6g J more energy than the source "
+        return cam_error(err, CAM_ERR_SIMULATION, "the state at t = %g s holds %.6g J more energy than the source "
                         "delivered (tolerance %.3g J): energy was created, the result cannot be trusted; %s", d->time,
                         excess, tolerance, advice);
     }
@@ -99,8 +99,8 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
     long steps = 0;
     int status, verdict;
     if (!(h > 0.0 && isfinite(h)))
-        return cam_fail(err, CAM_ERR_SIMULATION, "communication step size = %s s: allowed (0, inf)",
-                        cam_repr(h, shown, sizeof shown));
+        return cam_error(err, CAM_ERR_SIMULATION, "communication step size = %s s: allowed (0, inf)",
+                        cam_num(h, shown));
     if ((status = cam_drive_set_inputs(d, u, omega_ref, omega_dot_ref, err)) != CAM_OK)
         return status;
     if (!d->have_budget && d->form->energy_bounded) {

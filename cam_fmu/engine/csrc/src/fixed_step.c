@@ -6,6 +6,6 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt,
 {
     *dt = remaining;
     *retries = 0;
-    return cam_fail(err, CAM_ERR_SIMULATION, "solver '%s' is not yet available in the C engine (model %p)",
+    return cam_error(err, CAM_ERR_SIMULATION, "solver '%s' is not yet available in the C engine (model %p)",
                     it->method->name, (void *)d);
 }

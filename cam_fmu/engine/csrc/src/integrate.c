@@ -71,7 +71,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
             snprintf(c, sizeof c, "%g", floor_);
             snprintf(e, sizeof e, "%g", time);
             *dt_out = dt;
-            return cam_fail(err, CAM_ERR_REJECTED,
+            return cam_error(err, CAM_ERR_REJECTED,
                             "solver 'rk45' cannot meet rtol = %s, atol = %s: its step fell below %s s (1e-12 of "
                             "the communication step) at t = %s s: loosen rtol/atol, or check the inputs and "
                             "parameters for a near-singular drive", a, b, c, e);
@@ -180,7 +180,7 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
     else
         snprintf(advice, sizeof advice, "raise max_steps or h_max (now %g s), or shorten the communication step; "
                  "'%s' takes steps no longer than its stability limit", m->h_max, method->name);
-    return cam_fail(err, CAM_ERR_REJECTED, "solver '%s' needed more than max_steps = %ld internal steps in one "
+    return cam_error(err, CAM_ERR_REJECTED, "solver '%s' needed more than max_steps = %ld internal steps in one "
                     "communication step of %g s at t = %g s: %s", method->name, m->max_steps, h, time, advice);
 }
 
@@ -269,7 +269,7 @@ int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err
     memset(&it, 0, sizeof it);
     it.method = cam_method(d->model.solver);
     if (it.method == NULL)
-        return cam_fail(err, CAM_ERR_SIMULATION, "solver choice %d is not available in the engine", d->model.solver);
+        return cam_error(err, CAM_ERR_SIMULATION, "solver choice %d is not available in the engine", d->model.solver);
     memcpy(x, d->x, sizeof x);
     status = advance(d, &it, h, time, steps, err);
     if (status != CAM_OK) {   /* a refused step leaves the state as before it (fmi2Discard) */

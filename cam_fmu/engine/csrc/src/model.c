@@ -170,7 +170,7 @@ static int max_pressure_angle(const CamProfile *p, double r_b, double *best, dou
     size_t count = (size_t)n + p->n_points, k, used = 0, at = 0;
     double *grid = malloc(count * sizeof *grid), step = TWO_PI / n, a, b, c, dd, fc, fd, alpha;
     if (grid == NULL)
-        return cam_fail(err, CAM_ERR_MEMORY, "out of memory checking the pressure angle");
+        return cam_error(err, CAM_ERR_MEMORY, "out of memory checking the pressure angle");
     for (k = 0; k < (size_t)n; k++)
         grid[k] = (double)k * step;
     for (k = 0; k < p->n_points; k++)
@@ -246,7 +246,7 @@ static int build_program(CamModel *model, CamError *err)
     why[0] = '\0';
     if (has_text(p->motion_table)) {
         if (cam_profile_init_table(&model->profile, p->motion_table, strlen(p->motion_table), why, sizeof why))
-            return cam_fail(err, CAM_ERR_PARAMETER, "parameter 'motion_table': %s", why);
+            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'motion_table': %s", why);
         return CAM_OK;
     }
     law_T(p, CAM_P_RISE_LAW, CAM_P_RISE_T1, rise);
@@ -254,7 +254,7 @@ static int build_program(CamModel *model, CamError *err)
     if (cam_profile_init_laws(&model->profile, rise, ret, p->v[CAM_P_LIFT], p->v[CAM_P_RISE_ANGLE],
                               p->v[CAM_P_UPPER_DWELL], p->v[CAM_P_RETURN_ANGLE], p->v[CAM_P_LOWER_DWELL], why,
                               sizeof why))
-        return cam_fail(err, CAM_ERR_PARAMETER, "parameters 'rise_law'/'rise_T1'..'rise_T6', "
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_law'/'rise_T1'..'rise_T6', "
                         "'return_law'/'return_T1'..'return_T6': %s", why);
     return CAM_OK;
 }
@@ -302,7 +302,7 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->max_steps = (long)v[CAM_P_MAX_STEPS];
     model->feature_angle = model->profile.feature_angle;
     if (model->mu > 0.0) {
-        double alpha, theta, locking;
+        double alpha = 0.0, theta = 0.0, locking;
         char a[40], b[40];
         if ((status = max_pressure_angle(&model->profile, model->r_b, &alpha, &theta, err)) != CAM_OK) {
             cam_model_free(model);
@@ -310,11 +310,11 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
         }
         locking = model->mu * tan(alpha);
         if (locking >= 1.0 - 1e-12) {
-            status = cam_fail(err, CAM_ERR_PARAMETER,
+            status = cam_error(err, CAM_ERR_PARAMETER,
                               "parameters 'mu' = %s and 'r_b' = %s m make the follower self-lock in its guide: "
                               "mu tan(alpha) = %.4g >= 1 at theta = %.4g deg (pressure angle alpha = %.4g deg); "
                               "allowed: mu tan(max alpha) < 1 (lower mu below %.4g or raise r_b)",
-                              cam_repr(model->mu, a, sizeof a), cam_repr(model->r_b, b, sizeof b), locking,
+                              cam_num(model->mu, a), cam_num(model->r_b, b), locking,
                               theta * (180.0 / 3.141592653589793), alpha * (180.0 / 3.141592653589793),
                               1.0 / tan(alpha));
             cam_model_free(model);

@@ -39,7 +39,7 @@ int cam_params_copy(CamParams *dst, const CamParams *src, CamError *err)
     if (src->motion_table != NULL) {
         dst->motion_table = duplicate(src->motion_table, strlen(src->motion_table));
         if (dst->motion_table == NULL)
-            return cam_fail(err, CAM_ERR_MEMORY, "out of memory copying the parameter 'motion_table'");
+            return cam_error(err, CAM_ERR_MEMORY, "out of memory copying the parameter 'motion_table'");
     }
     return CAM_OK;
 }
@@ -70,8 +70,8 @@ int cam_params_unknown(const char *name, CamError *err)
     for (k = 0; k < CAM_N_PARAMS && pos < sizeof known; k++)
         pos += (size_t)snprintf(known + pos, sizeof known - pos, "%s%s", k ? ", " : "",
                                 cam_param_spec(order[k])->name);
-    return cam_fail(err, CAM_ERR_PARAMETER, "unknown parameter %s; known: %s",
-                    cam_repr_text(name, strlen(name), shown, sizeof shown), known);
+    return cam_error(err, CAM_ERR_PARAMETER, "unknown parameter %s; known: %s",
+                    cam_text(name, strlen(name), shown, sizeof shown), known);
 }
 
 /* ParameterSpec.allowed(): the allowed range as the messages show it. */
@@ -101,13 +101,13 @@ int cam_params_set_real(CamParams *p, int index, double value, CamError *err)
     char range[256], number[40];
     int too_low;
     if (s == NULL)
-        return cam_fail(err, CAM_ERR_PARAMETER, "no parameter has index %d", index);
+        return cam_error(err, CAM_ERR_PARAMETER, "no parameter has index %d", index);
     if (s->kind == CAM_KIND_BOOLEAN) {
         p->v[index] = value != 0.0 ? 1.0 : 0.0;   /* bool(value) */
         return CAM_OK;
     }
     if (s->kind == CAM_KIND_STRING)
-        return cam_fail(err, CAM_ERR_PARAMETER, "parameter '%s' is a string: allowed %s", s->name,
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter '%s' is a string: allowed %s", s->name,
                         allowed(s, range, sizeof range));
     too_low = s->low_open ? value <= s->low : value < s->low;
     if (s->zero_ok && value == 0.0) {
@@ -115,8 +115,8 @@ int cam_params_set_real(CamParams *p, int index, double value, CamError *err)
         return CAM_OK;
     }
     if (!isfinite(value) || too_low || value > s->high)
-        return cam_fail(err, CAM_ERR_PARAMETER, "parameter '%s' = %s [%s] is outside the allowed range %s", s->name,
-                        cam_repr(value, number, sizeof number), s->unit, allowed(s, range, sizeof range));
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter '%s' = %s [%s] is outside the allowed range %s", s->name,
+                        cam_num(value, number), s->unit, allowed(s, range, sizeof range));
     p->v[index] = value;
     return CAM_OK;
 }
@@ -138,7 +138,7 @@ int cam_params_set_string(CamParams *p, int index, const char *text, size_t len,
     char range[256], shown[160];
     int k;
     if (s == NULL)
-        return cam_fail(err, CAM_ERR_PARAMETER, "no parameter has index %d", index);
+        return cam_error(err, CAM_ERR_PARAMETER, "no parameter has index %d", index);
     if (s->kind == CAM_KIND_BOOLEAN) {
         static const char *const yes[] = {"true", "1", "yes", "on"}, *const no[] = {"false", "0", "no", "off"};
         for (k = 0; k < 4; k++) {
@@ -151,8 +151,8 @@ int cam_params_set_string(CamParams *p, int index, const char *text, size_t len,
                 return CAM_OK;
             }
         }
-        return cam_fail(err, CAM_ERR_PARAMETER, "parameter '%s' = %s: allowed %s", s->name,
-                        cam_repr_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter '%s' = %s: allowed %s", s->name,
+                        cam_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
     }
     if (s->kind == CAM_KIND_REAL) {
         char buf[64], *end;
@@ -169,13 +169,13 @@ int cam_params_set_string(CamParams *p, int index, const char *text, size_t len,
             if (*end == '\0' && !(buf[0] == '0' && (buf[1] == 'x' || buf[1] == 'X')))
                 return cam_params_set_real(p, index, number, err);
         }
-        return cam_fail(err, CAM_ERR_PARAMETER, "parameter '%s' = %s is not a number: allowed %s", s->name,
-                        cam_repr_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter '%s' = %s is not a number: allowed %s", s->name,
+                        cam_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
     }
     if (s->n_choices == 0) {   /* free text: the motion table */
         char *copy = duplicate(text, len);
         if (copy == NULL)
-            return cam_fail(err, CAM_ERR_MEMORY, "out of memory storing the parameter '%s'", s->name);
+            return cam_error(err, CAM_ERR_MEMORY, "out of memory storing the parameter '%s'", s->name);
         free(p->motion_table);
         p->motion_table = copy;
         return CAM_OK;
@@ -185,8 +185,8 @@ int cam_params_set_string(CamParams *p, int index, const char *text, size_t len,
             p->v[index] = (double)k;
             return CAM_OK;
         }
-    return cam_fail(err, CAM_ERR_PARAMETER, "parameter '%s' = %s: allowed %s", s->name,
-                    cam_repr_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
+    return cam_error(err, CAM_ERR_PARAMETER, "parameter '%s' = %s: allowed %s", s->name,
+                    cam_text(text, len, shown, sizeof shown), allowed(s, range, sizeof range));
 }
 
 int cam_params_check(const CamParams *p, CamError *err)
@@ -196,9 +196,9 @@ int cam_params_check(const CamParams *p, CamError *err)
                    + p->v[CAM_P_LOWER_DWELL];
     char a[40], b[40];
     if (fabs(total - two_pi) > 1e-9)
-        return cam_fail(err, CAM_ERR_PARAMETER,
+        return cam_error(err, CAM_ERR_PARAMETER,
                         "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' = %s rad must "
-                        "equal 2 pi = %s rad (to 1e-9 rad)", cam_repr(total, a, sizeof a),
-                        cam_repr(two_pi, b, sizeof b));
+                        "equal 2 pi = %s rad (to 1e-9 rad)", cam_num(total, a),
+                        cam_num(two_pi, b));
     return CAM_OK;
 }

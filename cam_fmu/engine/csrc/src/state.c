@@ -57,22 +57,22 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
     int k;
     CamMode mode;
     if (s[CAM_S_VERSION] != CAM_STATE_VERSION)
-        return cam_fail(err, CAM_ERR_SIMULATION, "state version %s: this engine reads version %g",
-                        cam_repr(s[CAM_S_VERSION], shown, sizeof shown), CAM_STATE_VERSION);
+        return cam_error(err, CAM_ERR_SIMULATION, "state version %s: this engine reads version %g",
+                        cam_num(s[CAM_S_VERSION], shown), CAM_STATE_VERSION);
     if (s[CAM_S_FORMULATION] != (double)d->model.formulation)
-        return cam_fail(err, CAM_ERR_SIMULATION, "state of formulation %s, this drive's is %d",
-                        cam_repr(s[CAM_S_FORMULATION], shown, sizeof shown), (int)d->model.formulation);
+        return cam_error(err, CAM_ERR_SIMULATION, "state of formulation %s, this drive's is %d",
+                        cam_num(s[CAM_S_FORMULATION], shown), (int)d->model.formulation);
     for (k = CAM_S_TIME; k <= CAM_S_H_NEXT; k++)
         if (!isfinite(s[k]))
-            return cam_fail(err, CAM_ERR_SIMULATION, "state entry '%s' = %s is not finite", ENTRY[k],
-                            cam_repr(s[k], shown, sizeof shown));
+            return cam_error(err, CAM_ERR_SIMULATION, "state entry '%s' = %s is not finite", ENTRY[k],
+                            cam_num(s[k], shown));
     if (!(s[CAM_S_STEPS_TAKEN] >= 0.0 && s[CAM_S_STEPS_TAKEN] <= 9.0e15))
-        return cam_fail(err, CAM_ERR_SIMULATION, "state entry 'steps_taken' = %s is not a count",
-                        cam_repr(s[CAM_S_STEPS_TAKEN], shown, sizeof shown));
+        return cam_error(err, CAM_ERR_SIMULATION, "state entry 'steps_taken' = %s is not a count",
+                        cam_num(s[CAM_S_STEPS_TAKEN], shown));
     for (k = CAM_S_X; k < CAM_S_END; k++)
         if (!isfinite(s[k]))
-            return cam_fail(err, CAM_ERR_SIMULATION, "state entry %d = %s is not finite", k,
-                            cam_repr(s[k], shown, sizeof shown));
+            return cam_error(err, CAM_ERR_SIMULATION, "state entry %d = %s is not finite", k,
+                            cam_num(s[k], shown));
     mode.stuck = s[CAM_S_STUCK] != 0.0;
     mode.direction = s[CAM_S_DIRECTION];
     mode.contact = (int)s[CAM_S_CONTACT];
@@ -81,7 +81,7 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
     if ((s[CAM_S_STUCK] != 0.0 && s[CAM_S_STUCK] != 1.0) || (mode.direction != 1.0 && mode.direction != -1.0)
         || (mode.side != 1.0 && mode.side != -1.0) || (double)mode.contact != s[CAM_S_CONTACT]
         || mode.contact < -1 || mode.contact > 1 || (s[CAM_S_HAVE_BUDGET] != 0.0 && s[CAM_S_HAVE_BUDGET] != 1.0))
-        return cam_fail(err, CAM_ERR_SIMULATION, "state mode (stuck %g, direction %g, contact %g, side %g) is not a "
+        return cam_error(err, CAM_ERR_SIMULATION, "state mode (stuck %g, direction %g, contact %g, side %g) is not a "
                         "valid mode", s[CAM_S_STUCK], s[CAM_S_DIRECTION], s[CAM_S_CONTACT], s[CAM_S_SIDE]);
     d->stale = 1;
     d->time = s[CAM_S_TIME];
