@@ -24,6 +24,7 @@
 #define CAM_TABLE_MAX_ROWS 10000000     /* rows of a motion table, at most */
 #define CAM_TABLE_MAX_LIFT_MM 10000.0   /* mm: a table's lifts lie in [0, 10 m], the lift parameter's range */
 #define CAM_TABLE_MAX_NUMBER 100        /* characters of one number in a table, at most */
+#define CAM_TABLE_MIN_SPACING_DEG 1e-6  /* deg: rows closer than this are refused (the third derivative would overflow) */
 
 typedef enum { CAM_PROGRAM_LAWS = 0, CAM_PROGRAM_TABLE = 1 } CamProgramKind;
 
