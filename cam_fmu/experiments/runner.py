@@ -70,11 +70,16 @@ def _reference(scene: Scene, run: Run) -> dict[str, np.ndarray]:
 
 
 # ------------------------------------------------------------------------ fmu
+def input_signals(scene: Scene) -> dict[str, Signal | None]:
+    """The scene's signal for each FMU input (None: held at its start value); omega_dot_ref is
+    the slope of omega_ref."""
+    return {"u": scene.u, "omega_ref": scene.omega_ref,
+            "omega_dot_ref": scene.omega_ref.slope_signal() if scene.omega_ref else None}
+
+
 def input_table(scene: Scene) -> np.ndarray:
     """The scene's input signals as fmpy's structured input array (time, u, omega_ref, omega_dot_ref)."""
-    return signals_table({"u": scene.u, "omega_ref": scene.omega_ref,
-                          "omega_dot_ref": scene.omega_ref.slope_signal() if scene.omega_ref else None},
-                         scene.stop_time)
+    return signals_table(input_signals(scene), scene.stop_time)
 
 
 def signals_table(given: Mapping[str, Signal | None], stop: float) -> np.ndarray:
@@ -83,7 +88,7 @@ def signals_table(given: Mapping[str, Signal | None], stop: float) -> np.ndarray
     An input not given is held at the FMU's start value (the drive ignores it).
     Jumps are repeated time stamps (left value, then right value), as fmpy reads them.
     """
-    signals = {name: given.get(name) or constant(start) for name, _unit, start, _desc in INPUTS}
+    signals = every_input(given)
     times: set[float] = {0.0, stop}
     for sig in signals.values():
         times.update(t for t in as_table(sig, stop)[0] if 0.0 <= t <= stop)
@@ -95,6 +100,11 @@ def signals_table(given: Mapping[str, Signal | None], stop: float) -> np.ndarray
         rows.append((t, *(sig.value(t) for sig in signals.values())))
     dtype = [("time", np.float64)] + [(name, np.float64) for name in signals]
     return np.array(rows, dtype=dtype)
+
+
+def every_input(given: Mapping[str, Signal | None]) -> dict[str, Signal]:
+    """A signal for every FMU input, in INPUTS order: an input not given is held at its start value."""
+    return {name: given.get(name) or constant(start) for name, _unit, start, _desc in INPUTS}
 
 
 def _jumps_at(sig: Signal, t: float) -> bool:

@@ -1,0 +1,292 @@
+"""The drive engine's outputs recorded as a baseline, and a replay that holds any engine to it.
+
+    python -m cam_fmu.tools.baseline --write    # record (the engine of this checkout)
+    python -m cam_fmu.tools.baseline --check    # replay and compare; prints the largest difference
+
+Engine-agnostic: a case runs through the public in-process API only,
+``DriveSimulator(params)``, ``set_inputs``, ``do_step(t, h, u, omega_ref, omega_dot_ref)``
+and ``outputs()``, so a new engine behind that API is compared with the old one's record
+(tests/test_engine_baseline.py).
+
+The cases:
+- every shipped scene (experiments/scene_files) x each of its runs x every solver x each
+  formulation the scene admits ('consistent' and 'paper' for a voltage scene; the speed drive
+  is its own formulation, run with every solver all the same), with the run's own parameters,
+  the scene's input signals (``runner.input_signals``, what its FMU runs get), output interval
+  and stop time. Runs that come out with the same parameters are recorded once;
+- 60 cases of the extremes property test (tests/test_extremes_property.py): its own
+  ``extremes.draw``, with random.Random(seed) for seeds 0..59. Not the test's hypothesis draws
+  themselves: those are not reproducible outside it (hypothesis mixes into its draws the
+  constants of the modules imported so far: the same derandomised test draws other cases when
+  the engine was imported before it, as in the full suite, than when run alone).
+Each case is stored whole (parameters, communication step, stop time, input signals), so the
+replay needs neither the scene files nor hypothesis: an edited scene does not move the baseline.
+
+The replay: inputs set at t = 0, then communication step k (k = 1..n, n = round(stop /
+comm)) from t = (k-1) comm to k comm (the clock of extremes.run), inputs = each signal's
+value at the step's start. A case that is refused or stops with an exception records the
+exception's class, the step k at which it was raised (0: at DriveSimulator(params) or
+set_inputs) and its message: that is behaviour too.
+
+What is recorded, and why it suffices: every output at step 0 and at every s-th step,
+s = max(1, n // 100) (>= 100 samples per run; all steps of the short extremes cases), always
+the last step reached, and the full outputs at the end. The engine carries its state from
+step to step, so a difference at any step (a constant, an operation order, an event found one
+step later, a changed step size of rk45) shows in every later sample: sampling loses nothing
+but the step at which a divergence began. Floats are written by ``json`` with ``repr``, which
+round-trips exactly. The files also hold the Python, numpy, scipy, hypothesis and Cython
+versions, whether the compiled kernel ran, and the git commit the record was made at.
+
+The comparison (``compare``): every recorded sample to RTOL = 1e-12 relative, where a value
+below ZERO = 1e-3 of its output's scale (the largest |value| of that output over the case's
+samples) is held to the absolute floor RTOL * ZERO * scale (about 5 ulp of the scale); an
+output that is 0 throughout must stay 0. An error case: the same class at the same step, the
+same message with its numbers (printed to 6 digits) equal to 1e-5 relative.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import re
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any, Iterator
+
+ROOT = Path(__file__).resolve().parents[2]
+RECORD_DIR = ROOT / "tests" / "data" / "engine_baseline"
+EXTREMES = 60  # extremes cases, as many as the property test draws
+SAMPLES = 100  # at least this many samples per run
+RTOL = 1e-12
+ZERO = 1e-3  # |value| < ZERO * scale counts as ~0
+MESSAGE_RTOL = 1e-5
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|\b(?:nan|inf)\b")
+
+
+# ------------------------------------------------------------------ cases
+def _signal_dict(sig: Any) -> dict[str, Any]:
+    return {"times": list(sig.times), "values": list(sig.values), "hold": sig.hold}
+
+
+def scene_cases(name: str) -> list[dict[str, Any]]:
+    """The cases of one shipped scene: its runs x solvers x formulations, duplicates dropped."""
+    from ..experiments.runner import every_input, input_signals
+    from ..experiments.scenes import find_scene
+    from ..physics.parameters import FORMULATIONS, SOLVERS, resolve
+
+    scene = find_scene(name)
+    inputs = {k: _signal_dict(s) for k, s in every_input(input_signals(scene)).items()}
+    formulations = FORMULATIONS if scene.drive == "voltage" else (None,)  # the speed drive: its own
+    cases, seen = [], []
+    for run in scene.runs:
+        for solver in SOLVERS:
+            for formulation in formulations:
+                params = dict(run.overrides, solver=solver)
+                if formulation:
+                    params["formulation"] = formulation
+                resolved = resolve(params)
+                if resolved in seen:
+                    continue
+                seen.append(resolved)
+                cases.append({"name": f"{name}/{run.label}/{solver}/{formulation or scene.drive}", "params": params,
+                              "comm_step": scene.output_interval, "stop_time": scene.stop_time, "inputs": inputs})
+    return cases
+
+
+def extremes_cases(count: int = EXTREMES) -> list[dict[str, Any]]:
+    """``count`` cases of the extremes property (``extremes.draw``), drawn with random.Random(seed)
+    for seeds 0..count-1."""
+    import random
+
+    from . import extremes
+
+    cases = []
+    for seed in range(count):
+        case = extremes.draw(random.Random(seed))
+        u = {"times": [t for t, _u in case.u_steps], "values": [u for _t, u in case.u_steps], "hold": True}
+        inputs = {"u": u, "omega_ref": {"times": [0.0], "values": [case.omega_ref], "hold": False},
+                  "omega_dot_ref": {"times": [0.0], "values": [0.0], "hold": False}}
+        cases.append({"name": f"extremes/seed{seed}", "params": dict(case.params), "comm_step": case.comm_step,
+                      "stop_time": case.stop_time, "inputs": inputs})
+    return cases
+
+
+# ------------------------------------------------------------------ replay
+def stride(n: int) -> int:
+    """Record every stride(n)-th of n communication steps: at least SAMPLES samples."""
+    return max(1, n // SAMPLES)
+
+
+def replay(case: dict[str, Any]) -> dict[str, Any]:
+    """Run one case on the engine: the sampled outputs, the final outputs and the error (or None)."""
+    from ..experiments.signals import Signal
+    from ..fmu.engine import DriveSimulator
+    from ..physics.variables import OUTPUT_NAMES
+
+    signals = {name: Signal(tuple(s["times"]), tuple(s["values"]), s["hold"]) for name, s in case["inputs"].items()}
+    comm = case["comm_step"]
+    n = max(1, round(case["stop_time"] / comm))
+    every = stride(n)
+    steps: list[int] = []
+    samples: dict[str, list[float]] = {name: [] for name in OUTPUT_NAMES}
+    error = None
+    out: dict[str, float] = {}
+
+    def sample(k: int) -> None:
+        steps.append(k)
+        for name in OUTPUT_NAMES:
+            samples[name].append(out[name])
+
+    k = 0
+    try:
+        sim = DriveSimulator(case["params"])
+        sim.set_inputs(*(sig.value(0.0) for sig in signals.values()))
+        out = sim.outputs()
+        sample(0)
+        for k in range(1, n + 1):
+            t = (k - 1) * comm
+            sim.do_step(t, k * comm - t, *(sig.value(t) for sig in signals.values()))
+            out = sim.outputs()
+            if k % every == 0 or k == n:
+                sample(k)
+    except Exception as exc:  # noqa: BLE001 - a refusal or a failure is recorded as behaviour
+        error = {"class": type(exc).__name__, "step": k, "message": str(exc)}
+        if steps and steps[-1] != k - 1 and k > 0:
+            sample(k - 1)  # the last step reached
+    return {"steps": steps, "outputs": samples, "final": dict(out), "error": error}
+
+
+# ------------------------------------------------------------------ compare
+def compare(recorded: dict[str, Any], result: dict[str, Any]) -> tuple[list[str], float]:
+    """The differences of ``result`` (a replay) from ``recorded``, and the largest
+    |difference| / tolerance over the samples (<= 1 passes; 0: bit-identical)."""
+    problems, worst = [], 0.0
+    if result["error"] is None or recorded["error"] is None:
+        if result["error"] != recorded["error"]:
+            problems.append(f"error {recorded['error']} recorded, {result['error']} now")
+    else:
+        problems += _compare_error(recorded["error"], result["error"])
+    if result["steps"] != recorded["steps"]:
+        problems.append(f"sampled steps differ: recorded up to {recorded['steps'][-1:]}, now {result['steps'][-1:]}")
+        return problems, math.inf
+    for name, old in recorded["outputs"].items():
+        new = result["outputs"][name]
+        scale = max((abs(x) for x in old), default=0.0)
+        for k, a, b in zip(recorded["steps"], old, new):
+            if a == b or (math.isnan(a) and math.isnan(b)):
+                continue
+            tol = RTOL * max(abs(a), ZERO * scale)
+            ratio = abs(a - b) / tol if tol > 0.0 else math.inf
+            worst = max(worst, ratio)
+            if not ratio <= 1.0:
+                problems.append(f"{name} at step {k}: recorded {a!r}, now {b!r} (|diff| = {abs(a - b):.3g}, "
+                                f"tolerance {tol:.3g})")
+                break  # the first divergence per output: later samples follow from it
+    return problems, worst
+
+
+def _compare_error(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
+    if (old["class"], old["step"]) != (new["class"], new["step"]):
+        return [f"error {old['class']} at step {old['step']} recorded, {new['class']} at step {new['step']} now"]
+    words_old, words_new = _NUMBER.sub("#", old["message"]), _NUMBER.sub("#", new["message"])
+    numbers = zip(_NUMBER.findall(old["message"]), _NUMBER.findall(new["message"]))
+    if words_old != words_new or not all(_close(a, b) for a, b in numbers):
+        return [f"message {old['message']!r} recorded, {new['message']!r} now"]
+    return []
+
+
+def _close(a: str, b: str) -> bool:
+    x, y = float(a), float(b)
+    return x == y or (math.isnan(x) and math.isnan(y)) or abs(x - y) <= MESSAGE_RTOL * max(abs(x), abs(y))
+
+
+# ------------------------------------------------------------------ files
+def groups() -> Iterator[tuple[str, list[dict[str, Any]]]]:
+    """(file stem, cases): one group per shipped scene, then 'extremes'."""
+    from ..experiments.scenes import scene_names
+
+    for name in scene_names():
+        yield name, scene_cases(name)
+    yield "extremes", extremes_cases()
+
+
+def provenance() -> dict[str, Any]:
+    """Versions, platform, kernel path and git commit of this recording."""
+    import numpy
+    import scipy
+
+    info: dict[str, Any] = {"python": platform.python_version(), "numpy": numpy.__version__,
+                            "scipy": scipy.__version__, "machine": platform.machine()}
+    for module in ("hypothesis", "Cython"):
+        try:
+            info[module.lower()] = __import__(module).__version__
+        except ImportError:
+            info[module.lower()] = None
+    try:
+        from ..kernel import compiled
+        info["kernel"] = "compiled" if compiled() else "pure-python"
+    except ImportError:
+        info["kernel"] = None
+    git = ["git", "-C", str(ROOT)]
+    try:
+        commit = subprocess.run(git + ["rev-parse", "HEAD"], capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(git + ["status", "--porcelain", "--", "cam_fmu"], capture_output=True, text=True,
+                               check=True).stdout.strip()
+        info["commit"] = commit + ("+uncommitted changes in cam_fmu" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        info["commit"] = None
+    return info
+
+
+def write(directory: Path = RECORD_DIR) -> list[Path]:
+    """Record every group into directory/<stem>.json."""
+    directory.mkdir(parents=True, exist_ok=True)
+    about = provenance()
+    written = []
+    for stem, cases in groups():
+        for case in cases:
+            case["result"] = replay(case)
+        path = directory / f"{stem}.json"
+        rows = ",\n".join(json.dumps(case, separators=(",", ":")) for case in cases)  # a case per line
+        path.write_text(f'{{"recorded_with":{json.dumps(about)},\n"cases":[\n{rows}]}}\n')
+        written.append(path)
+        print(f"{path}: {len(cases)} cases, {path.stat().st_size / 1e3:.0f} kB", flush=True)
+    return written
+
+
+def load(directory: Path = RECORD_DIR) -> dict[str, dict[str, Any]]:
+    """The recorded files, by stem."""
+    return {path.stem: json.loads(path.read_text()) for path in sorted(directory.glob("*.json"))}
+
+
+def check(directory: Path = RECORD_DIR) -> int:
+    """Replay every recorded case; print the problems and the largest difference."""
+    failures, worst = 0, 0.0
+    for stem, data in load(directory).items():
+        for case in data["cases"]:
+            problems, ratio = compare(case["result"], replay(case))
+            worst = max(worst, ratio)
+            if problems:
+                failures += 1
+                print(f"{case['name']}: " + "; ".join(problems[:3]), flush=True)
+    print(f"{failures} case(s) differ; largest |difference| / tolerance = {worst:.3g}")
+    return 1 if failures else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m cam_fmu.tools.baseline", description=__doc__.split("\n\n")[0])
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--write", action="store_true", help=f"record the baseline into {RECORD_DIR}")
+    what.add_argument("--check", action="store_true", help="replay the recorded cases and compare")
+    parser.add_argument("--dir", type=Path, default=RECORD_DIR, help="where the JSON files are")
+    args = parser.parse_args(argv)
+    if args.write:
+        write(args.dir)
+        return 0
+    return check(args.dir)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,116 @@
+"""The engine against its recorded baseline (issue 18): any engine behind DriveSimulator must
+reproduce the outputs the Cython-kernel engine recorded, on every shipped scene x solver x
+formulation and on 60 extremes cases, to 1e-12 relative, and the same error at the same step.
+
+The record and the comparison are cam_fmu.tools.baseline (its docstring says what is recorded,
+the tolerance and its floor for values near 0). Re-record only on purpose:
+``python -m cam_fmu.tools.baseline --write``.
+"""
+from __future__ import annotations
+
+import copy
+import math
+
+import pytest
+
+from cam_fmu.experiments.scenes import find_scene, scene_names
+from cam_fmu.physics.parameters import FORMULATIONS, SOLVERS, resolve
+from cam_fmu.physics.variables import OUTPUT_NAMES
+from cam_fmu.tools import baseline
+
+RECORDED = baseline.load()
+CASES = [case for data in RECORDED.values() for case in data["cases"]]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[case["name"] for case in CASES])
+def test_the_engine_reproduces_its_baseline(case):
+    problems, _worst = baseline.compare(case["result"], baseline.replay(case))
+    assert problems == [], f"{case['name']}: " + "\n".join(problems)
+
+
+def test_every_shipped_scene_is_recorded_with_every_solver_and_formulation():
+    """Each run of each scene x solver x formulation is a recorded case (a run that resolves to the
+    same parameters as an earlier one, as fig. 6's 'paper' run with formulation 'paper', is
+    recorded once), with >= SAMPLES samples up to its last step."""
+    for name in scene_names():
+        scene = find_scene(name)
+        cases = RECORDED[name]["cases"]
+        recorded = [resolve(case["params"]) for case in cases]
+        formulations = FORMULATIONS if scene.drive == "voltage" else (None,)
+        for run in scene.runs:
+            for solver in SOLVERS:
+                for formulation in formulations:
+                    params = dict(run.overrides, solver=solver, **({"formulation": formulation} if formulation else {}))
+                    assert resolve(params) in recorded, (name, run.label, solver, formulation)
+        n = round(scene.stop_time / scene.output_interval)
+        for case in cases:
+            assert (case["comm_step"], case["stop_time"]) == (scene.output_interval, scene.stop_time)
+            steps = case["result"]["steps"]
+            if case["result"]["error"] is None:
+                assert len(steps) > baseline.SAMPLES and steps[-1] == n, case["name"]
+            assert set(case["result"]["final"]) == set(case["result"]["outputs"]) == set(OUTPUT_NAMES)
+
+
+def test_the_extremes_cases_are_recorded_with_their_errors():
+    cases = RECORDED["extremes"]["cases"]
+    assert len(cases) == baseline.EXTREMES
+    errors = [case["result"]["error"] for case in cases if case["result"]["error"]]
+    assert errors, "no extremes case ends in an error: the error path is not held"
+    assert all(e["class"] and e["step"] >= 0 and e["message"] for e in errors)
+
+
+def test_the_record_says_what_made_it():
+    for data in RECORDED.values():
+        about = data["recorded_with"]
+        assert {"python", "numpy", "scipy", "commit", "kernel"} <= set(about)
+        assert about["commit"] and len(about["commit"].split("+")[0]) == 40
+
+
+def _a_run():
+    return next(case["result"] for case in RECORDED["paper_fig6"]["cases"] if case["result"]["error"] is None)
+
+
+def test_compare_fails_a_change_above_1e_12_and_passes_one_below():
+    recorded = _a_run()
+    index = len(recorded["steps"]) // 2
+    for factor, expected in ((1.0 + 3e-12, False), (1.0 + 3e-13, True)):
+        now = copy.deepcopy(recorded)
+        now["outputs"]["theta"][index] *= factor
+        problems, worst = baseline.compare(recorded, now)
+        assert (problems == []) is expected and (worst <= 1.0) is expected
+
+
+def test_compare_holds_values_near_zero_to_the_floor_of_their_output_scale():
+    recorded = copy.deepcopy(_a_run())
+    scale = max(abs(x) for x in recorded["outputs"]["omega"])
+    recorded["outputs"]["omega"][1] = 0.0
+    for shift, expected in ((2 * baseline.RTOL * baseline.ZERO * scale, False),
+                            (0.5 * baseline.RTOL * baseline.ZERO * scale, True)):
+        now = copy.deepcopy(recorded)
+        now["outputs"]["omega"][1] = shift
+        assert (baseline.compare(recorded, now)[0] == []) is expected
+
+
+def test_compare_fails_another_error_step_or_message():
+    recorded = copy.deepcopy(_a_run())
+    recorded["error"] = {"class": "SimulationError", "step": 7, "message": "output 'omega' became nan at t = 0.007 s"}
+    for change, expected in (({"step": 8}, False), ({"class": "StepRejected"}, False),
+                             ({"message": "output 'theta' became nan at t = 0.007 s"}, False),
+                             ({"message": "output 'omega' became nan at t = 0.0071 s"}, False),
+                             ({"message": "output 'omega' became nan at t = 0.00700000001 s"}, True)):
+        now = copy.deepcopy(recorded)
+        now["error"] = {**recorded["error"], **change}
+        assert (baseline.compare(recorded, now)[0] == []) is expected, change
+    now = copy.deepcopy(recorded)
+    now["error"] = None
+    assert baseline.compare(recorded, now)[0] != []
+
+
+def test_compare_fails_a_run_that_stops_early():
+    recorded = _a_run()
+    now = copy.deepcopy(recorded)
+    now["steps"] = now["steps"][:-1]
+    for name in now["outputs"]:
+        now["outputs"][name] = now["outputs"][name][:-1]
+    problems, worst = baseline.compare(recorded, now)
+    assert problems and math.isinf(worst)
