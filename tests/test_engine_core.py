@@ -156,3 +156,37 @@ def test_the_energy_guard_is_the_same_error():
     errors = [_error(lambda sim=sim: sim, 0.2, 1e-3, 3.5, 1.0) for sim in sims]
     assert errors[0][0] is SimulationError and "energy was created" in errors[0][1]
     assert errors[1] == errors[0]
+
+
+def _baseline_cases():
+    """The recorded cases (tests/data/engine_baseline) of the consistent voltage drive with rk45."""
+    from cam_fmu.tools import baseline
+    cases = []
+    for data in baseline.load().values():
+        for case in data["cases"]:
+            p = resolve(case["params"])
+            if (p["drive"], p["formulation"], p["solver"]) == ("voltage", "consistent", "rk45"):
+                cases.append(pytest.param(case, id=case["name"]))
+    return cases
+
+
+BASELINE = _baseline_cases()
+
+
+def test_the_baseline_holds_scenes_and_extremes_of_this_path():
+    names = [case.values[0]["name"] for case in BASELINE]
+    assert len(names) >= 15 and sum(name.startswith("extremes/") for name in names) >= 8
+
+
+@pytest.mark.parametrize("case", BASELINE)
+def test_the_engine_reproduces_the_recorded_baseline_to_the_bit(case, monkeypatch):
+    """The recorded run (the Cython-kernel engine) replayed on the C engine: every sample, the final
+    outputs and the error (class, step, message) exactly equal."""
+    from cam_fmu.fmu import engine as python_engine
+    from cam_fmu.tools import baseline
+    monkeypatch.setattr(python_engine, "DriveSimulator", EngineSimulator)
+    result = baseline.replay(case)
+    recorded = case["result"]
+    assert result["error"] == recorded["error"]
+    assert result["steps"] == recorded["steps"]
+    assert result["outputs"] == recorded["outputs"] and result["final"] == recorded["final"]
