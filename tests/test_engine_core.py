@@ -190,3 +190,32 @@ def test_the_engine_reproduces_the_recorded_baseline_to_the_bit(case, monkeypatc
     assert result["error"] == recorded["error"]
     assert result["steps"] == recorded["steps"]
     assert result["outputs"] == recorded["outputs"] and result["final"] == recorded["final"]
+
+
+def _probes():
+    """For every parameter, values on and beyond its range's edges (or bad choices/texts)."""
+    from cam_fmu.physics.parameters import PARAMETERS
+    probes = []
+    for spec in PARAMETERS:
+        if spec.kind == "real":
+            values = [spec.low, spec.high, spec.low - 1.0 - abs(spec.low), 2.0 * spec.high + 1.0, 0.0,
+                      float("nan"), float("-inf"), "1e-3", "x", None]
+        elif spec.kind == "boolean":
+            values = [True, 0, "yes", "Off", "maybe"]
+        elif spec.choices:
+            values = [spec.choices[0], "nope", 3]
+        else:
+            continue
+        probes += [pytest.param({spec.name: value}, id=f"{spec.name}={value!r}") for value in values]
+    return probes
+
+
+@pytest.mark.parametrize("params", _probes())
+def test_every_parameter_is_checked_with_the_same_message(params):
+    """The C engine's checks (generated from physics/parameters.py) against ParameterSpec.check and
+    resolve: the same refusal with the same text, or both accept (then the same first outputs)."""
+    old, new = _error(lambda: DriveSimulator(params)), _error(lambda: EngineSimulator(params))
+    assert new == old
+    if old is None and resolve(params)["drive"] == "voltage" and resolve(params)["formulation"] == "consistent" \
+            and resolve(params)["solver"] == "rk45":
+        assert _bits(DriveSimulator(params).outputs()) == _bits(EngineSimulator(params).outputs())

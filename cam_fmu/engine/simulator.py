@@ -95,6 +95,8 @@ def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any
         lib.cam_params_unknown(name.encode(), ctypes.byref(err))
         raise_for(err)
     kind = BY_NAME[name].kind
+    if kind == "string" and not isinstance(value, str):
+        value = BY_NAME[name].check(value)  # its message shows the value as given (3, not '3')
     if kind == "string" or isinstance(value, str):
         data = str(value).encode("utf-8")
         status = lib.cam_params_set_string(params, index, data, len(data), ctypes.byref(err))
