@@ -219,3 +219,36 @@ def test_every_parameter_is_checked_with_the_same_message(params):
     if old is None and resolve(params)["drive"] == "voltage" and resolve(params)["formulation"] == "consistent" \
             and resolve(params)["solver"] == "rk45":
         assert _bits(DriveSimulator(params).outputs()) == _bits(EngineSimulator(params).outputs())
+
+
+def _from_state(params, steps, change, step):
+    """Both engines: ``steps`` steps at 3.5 V, the state changed by ``change``, then ``step``: the error."""
+    sims = [DriveSimulator(params), EngineSimulator(params)]
+    for sim in sims:
+        for k in range(steps):
+            sim.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
+    state = sims[0].get_state()
+    change(state, sims[0].outputs())
+    for sim in sims:
+        sim.set_state(state)
+    return [_error(lambda sim=sim: sim, *step) for sim in sims]
+
+
+def test_the_step_floor_is_the_same_step_rejected():
+    """A diverging state (omega = 1e200: the right-hand side overflows) drives rk45's step below its floor."""
+    def change(state, out):
+        state["y"] = [0.5, 1e200]
+        state["mode"] = dict(state["mode"], stuck=False)
+    old, new = _from_state({}, 0, change, (0.0, 1e-3, 3.5, 1.0))
+    assert old[0] is StepRejected and "its step fell below 1e-15 s" in old[1]
+    assert new == old
+
+
+def test_the_clearance_guard_is_the_same_error():
+    """A follower 10 mm off the cam in a 0.5 mm gap, held at rest (u = 0): a missed contact."""
+    def change(state, out):
+        state["y"] = [state["y"][0], 0.0]
+        state["mode"] = dict(state["mode"], stuck=True, contact=0, s_free=out["s_cam"] + 0.01)
+    old, new = _from_state({"c": 5e-4}, 100, change, (0.1, 1e-3, 0.0, 1.0))
+    assert old[0] is SimulationError and "a contact event was missed" in old[1]
+    assert new == old
