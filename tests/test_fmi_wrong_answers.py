@@ -144,7 +144,7 @@ def test_a_million_row_table_runs_and_restores(unzipped):
     """A table of 10^6 rows: initialisation, steps that cross thousands of knots, and state restores."""
     angles = np.arange(1_000_000) * (360.0 / 1_000_000)
     lifts = 20.0 * (1.0 - np.cos(np.radians(angles)))
-    text = "\n".join(f"{a!r},{h!r}" for a, h in zip(angles, lifts))
+    text = "\n".join(f"{float(a)!r},{float(h)!r}" for a, h in zip(angles, lifts))
     s = Slave(unzipped)
     try:
         assert s.init(motion_table=text, drive="speed", omega_ref=10.0) == OK

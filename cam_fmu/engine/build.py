@@ -98,18 +98,20 @@ def library_dir() -> Path:
     return cache
 
 
-def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str | None = None) -> Path:
-    """Compile every engine source into the shared library ``dest``; returns ``dest``."""
+def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str | None = None,
+                    extra_sources: Sequence[Path] = (), include: Sequence[Path] = ()) -> Path:
+    """Compile every engine source (and ``extra_sources``, with the folders ``include``) into the shared
+    library ``dest``; returns ``dest``. The FMU's binary is this library plus its FMI glue."""
     cc = compiler or find_compiler()
-    sources = [str(p) for p in sorted(SOURCES.glob("*.c"))]
+    sources = [str(p) for p in sorted(SOURCES.glob("*.c"))] + [str(p) for p in extra_sources]
     if not sources:
         raise EngineBuildError(f"no C sources in {SOURCES}")
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
         generated = [str(p) for p in codegen.write(Path(gen)) if p.suffix == ".c"]
-        cmd = [cc, *CFLAGS, *extra_flags, f"-I{INCLUDE}", f"-I{gen}", *sources, *generated, "-o", str(tmp),
-               *LDFLAGS]
+        cmd = [cc, *CFLAGS, *extra_flags, f"-I{INCLUDE}", f"-I{gen}", *(f"-I{p}" for p in include), *sources,
+               *generated, "-o", str(tmp), *LDFLAGS]
         proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         tmp.unlink(missing_ok=True)

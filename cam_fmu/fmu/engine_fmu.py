@@ -13,13 +13,13 @@ Build time only. Steps:
 4. ``modelDescription.xml``: ``model_description.skeleton`` completed by
    ``model_description.postprocess`` (units, ranges, structure, the default
    experiment of the paper's fig. 6 scene).
-5. The C sources under ``sources/`` (anyone can rebuild the binary for another
-   platform: ``cc -shared -fPIC -Isources sources/*.c -lm``).
+5. The C sources under ``sources/``, with the generated table and the official
+   headers: anyone can rebuild the binary for another platform
+   (``cc -std=c99 -shared -fPIC -include sources/guid.h -Isources sources/*.c -lm``).
 """
 from __future__ import annotations
 
 import shutil
-import subprocess
 import tempfile
 import zipfile
 from pathlib import Path
@@ -32,7 +32,8 @@ from . import model_description
 MODEL_IDENTIFIER = "cam"
 DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
                "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
-GLUE = engine_build.CSRC / "fmi" / "fmi2_cs.c"
+FMI = engine_build.CSRC / "fmi"
+GLUE = (FMI / "instance.c", FMI / "fmi2_cs.c")  # the instance layer and the FMI 2.0 glue
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
 BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
 
@@ -46,7 +47,7 @@ def default_experiment() -> tuple[float, float, float]:
     from ..experiments.scenes import find_scene
 
     scene = find_scene("paper_fig6")
-    return 0.0, float(scene.stop_time), float(scene.step_size)
+    return 0.0, float(scene.stop_time), float(scene.output_interval)
 
 
 def engine_guid() -> str:
@@ -54,19 +55,13 @@ def engine_guid() -> str:
     return model_description.guid(model_description.variable_rows(), engine_build.digest())
 
 
-def compile_binary(dest: Path, guid: str, generated: Path, compiler: str | None = None,
-                   extra_flags: Sequence[str] = ()) -> Path:
-    """Compile the engine and the FMI 2.0 glue into the shared library ``dest``."""
-    cc = compiler or engine_build.find_compiler()
-    sources = [str(p) for p in sorted(engine_build.SOURCES.glob("*.c"))] + [str(GLUE)]
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [cc, *engine_build.CFLAGS, *BINARY_FLAGS, *extra_flags, f'-DCAM_GUID="{guid}"',
-           f"-I{engine_build.INCLUDE}", f"-I{generated}", f"-I{engine_build.fmi_headers()}",
-           *sources, "-o", str(dest), *engine_build.LDFLAGS]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise FmuBuildError(f"compiling cam.fmu's binary failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")
-    return dest
+def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = ()) -> Path:
+    """Compile the engine, the instance layer and the FMI 2.0 glue into the shared library ``dest``."""
+    try:
+        return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DCAM_GUID="{guid}"', *extra_flags), compiler,
+                                            extra_sources=GLUE, include=(engine_build.fmi_headers(),))
+    except engine_build.EngineBuildError as exc:
+        raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
 
 
 def build(dest: Path) -> Path:
@@ -78,16 +73,18 @@ def build(dest: Path) -> Path:
     guid = engine_guid()
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         root = Path(tmp)
-        generated = codegen.write_headers(root / "generated")
-        compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid, generated)
+        compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid)
         xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
                                             default_experiment(), DESCRIPTION, rows)
         (root / "fmu" / "modelDescription.xml").write_bytes(xml)
         sources = root / "fmu" / "sources"
-        sources.mkdir()
-        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), GLUE,
-                     *generated.glob("*.h")]:
+        generated = codegen.write(sources)  # the generated table, beside the hand-written sources
+        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *FMI.glob("*.[ch]"),
+                     *(engine_build.fmi_headers() / f"fmi2{name}.h" for name in ("Functions", "FunctionTypes",
+                                                                                   "TypesPlatform"))]:
             shutil.copyfile(path, sources / path.name)
+        (sources / "guid.h").write_text(f'#define CAM_GUID "{guid}"\n')
+        del generated
         out = root / f"{MODEL_IDENTIFIER}.fmu"
         with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
             for path in sorted((root / "fmu").rglob("*")):

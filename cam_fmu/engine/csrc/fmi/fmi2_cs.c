@@ -2,7 +2,7 @@
  *
  * Thin by design: the FMI state machine, argument checks, logging and the FMU state objects.
  * Everything the drive does is behind cam_instance_*; an FMI 3.0 glue would replace only this file.
- * Compiled into the FMU's binary with the engine (csrc/src/*.c) and the official FMI 2.0 headers
+ * Compiled into the FMU's binary with the engine (csrc/src/ *.c) and the official FMI 2.0 headers
  * (those fmpy ships); CAM_GUID is defined at build time from the model description.
  *
  * Rules kept here (docs/fmu.md, "Errors"):
@@ -10,8 +10,11 @@
  * - A refused request writes nothing: a multi-value set checks every value before writing one.
  * - Output arrays of get calls are filled with safe values (0, false, "") before anything is
  *   checked, so a host that ignores a refusal never reads garbage.
- * - After fmi2Error only get calls, state calls, fmi2Reset, fmi2Terminate and fmi2FreeInstance
- *   are allowed; fmi2SetFMUstate or fmi2Reset makes the instance usable again.
+ * - A refused request (a value out of range, an unknown variable, a call out of order) is fmi2Error
+ *   and changes nothing: the instance goes on. An error of the model itself (initialisation or a
+ *   step that cannot be computed correctly) puts the instance into the error state: then only get
+ *   calls, state calls, fmi2Reset, fmi2Terminate and fmi2FreeInstance are allowed, and
+ *   fmi2SetFMUstate or fmi2Reset makes it usable again.
  * - fmi2Discard (a step the solver cannot complete at this size) leaves the state as before the
  *   step: fmi2GetBooleanStatus(fmi2Terminated) is true, fmi2LastSuccessfulTime where it stands.
  */
@@ -97,9 +100,10 @@ static void log_message(Instance *S, fmi2Status status, const char *category, co
     S->logger(S->environment, S->name, status, category, escaped);
 }
 
-static fmi2Status fail(Instance *S, const char *format_name, const char *text) {
-    log_message(S, fmi2Error, "logStatusError", "%s: %s", format_name, text);
-    if (S->state != INSTANTIATED) S->state = ERROR_STATE;
+/* A refused request: fmi2Error with the message; the instance stays as it was (nothing of the
+ * request was done), so the host may correct the request and go on. */
+static fmi2Status fail(Instance *S, const char *call, const char *text) {
+    log_message(S, fmi2Error, "logStatusError", "%s: %s", call, text);
     return fmi2Error;
 }
 
@@ -111,6 +115,8 @@ static int allowed(Instance *S, int states, const char *call) {
     return 0;
 }
 
+/* The drive's verdict on initialisation or a step: a discarded step (the state as before it) or an
+ * error of the model (the instance goes to the error state: fmi2Reset or fmi2SetFMUstate). */
 static fmi2Status drive_status(Instance *S, int status, const char *call) {
     if (status == CAM_OK) return fmi2OK;
     if (status == CAM_ERR_REJECTED) {
@@ -118,7 +124,9 @@ static fmi2Status drive_status(Instance *S, int status, const char *call) {
         S->state = STEP_FAILED;
         return fmi2Discard;
     }
-    return fail(S, call, cam_instance_message(S->drive));
+    log_message(S, fmi2Error, "logStatusError", "%s: %s", call, cam_instance_message(S->drive));
+    S->state = ERROR_STATE;
+    return fmi2Error;
 }
 
 /* ------------------------------------------------------------------ common functions */
@@ -247,25 +255,26 @@ fmi2Status fmi2Reset(fmi2Component c) {
 /* ------------------------------------------------------------------ variables */
 
 static int check_references(Instance *S, const fmi2ValueReference vr[], size_t nvr, const void *value,
-                            CamVariableType type, const char *call) {
+                            CamKind type, const char *call) {
     char text[300];
     size_t k;
+    CamKind kind;
+    const char *name;
     if (nvr == 0) return 1;
     if (!vr || !value) {
         fail(S, call, "the value reference and value arrays must not be NULL");
         return 0;
     }
     for (k = 0; k < nvr; k++) {
-        if (vr[k] >= CAM_N_VARIABLES) {
+        if (!cam_instance_variable(vr[k], &kind, &name)) {
             snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %d)", vr[k],
-                     CAM_N_VARIABLES - 1);
+                     CAM_VR_PARAMS + CAM_N_PARAMS - 1);
             fail(S, call, text);
             return 0;
         }
-        if (CAM_VARIABLES[vr[k]].type != type) {
-            snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s",
-                     CAM_VARIABLES[vr[k]].name, vr[k], cam_type_name(CAM_VARIABLES[vr[k]].type),
-                     cam_type_name(type));
+        if (kind != type) {
+            snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s", name, vr[k],
+                     cam_kind_name(kind), cam_kind_name(type));
             fail(S, call, text);
             return 0;
         }
@@ -279,7 +288,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     if (value) for (k = 0; k < nvr; k++) value[k] = 0.0;
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetReal")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2GetReal")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_REAL, "fmi2GetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (cam_instance_get_real(S->drive, vr[k], &value[k]) != CAM_OK)
             return fail(S, "fmi2GetReal", cam_instance_message(S->drive));
@@ -289,6 +298,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
     Instance *S = c;
     size_t k;
+    (void)vr;
     if (value) for (k = 0; k < nvr; k++) value[k] = 0;
     if (!S) return fmi2Error;
     if (nvr == 0) return fmi2OK;
@@ -302,7 +312,7 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (value) for (k = 0; k < nvr; k++) value[k] = fmi2False;
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetBoolean")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2GetBoolean")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_BOOLEAN, "fmi2GetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) {
         if (cam_instance_get_boolean(S->drive, vr[k], &v) != CAM_OK)
             return fail(S, "fmi2GetBoolean", cam_instance_message(S->drive));
@@ -317,7 +327,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     if (value) for (k = 0; k < nvr; k++) value[k] = "";
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetString")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_STRING, "fmi2GetString")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_STRING, "fmi2GetString")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (cam_instance_get_string(S->drive, vr[k], &value[k]) != CAM_OK) {
             value[k] = "";
@@ -334,7 +344,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetReal")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2SetReal")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_REAL, "fmi2SetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* all or nothing: every value is checked before one is written */
         if (cam_instance_check_real(S->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
             return fail(S, "fmi2SetReal", text);
@@ -358,7 +368,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetBoolean")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2SetBoolean")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_BOOLEAN, "fmi2SetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* booleans are parameters: the drive refuses them after initialisation */
         if (cam_instance_initialized(S->drive))
             return fail(S, "fmi2SetBoolean", "parameters are fixed after initialisation (fmi2Reset first)");
@@ -373,7 +383,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetString")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_STRING, "fmi2SetString")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_STRING, "fmi2SetString")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (!value[k]) return fail(S, "fmi2SetString", "a string value must not be NULL");
     /* Strings are checked as they are set; a multi-value set is undone on refusal by saving first. */
