@@ -1,12 +1,14 @@
-"""Motion-table programs: periodic cubic spline against scipy's, its stated
-continuity, its accuracy order on a table sampled from a CamProgram, the
-CamProgram interface, math-only evaluation, the drive physics, and errors."""
+"""Motion-table programs: the shape-preserving periodic cubic against scipy's Hermite
+cubic on the stated slopes, its stated continuity, its accuracy order on a table
+sampled from a CamProgram, the CamProgram interface, math-only evaluation, the
+drive physics, and errors. (The C engine's parser and curve against this model,
+and the shape properties on random tables: tests/test_engine_profile.py.)"""
 
 import math
 
 import numpy as np
 import pytest
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicHermiteSpline
 
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.kinematics import motion_table
@@ -23,45 +25,65 @@ def _table(prog, step_deg):
     return TableProgram(th, prog.evaluate(th)[0])
 
 
-def test_matches_scipy_periodic_spline_on_uneven_knots():
+def _stated_slopes(th, y):
+    """The slopes docs/cam_design.md states, vectorised: the parabola through each knot and its
+    neighbours, 0 where the chords differ in sign or one is 0, at most 3 times the smaller chord."""
+    h = np.diff(np.append(th, th[0] + TWO_PI))
+    chord = (np.roll(y, -1) - y) / h
+    a, b, ha = np.roll(chord, 1), chord, np.roll(h, 1)
+    d = (h * a + ha * b) / (ha + h)
+    limit = 3.0 * np.minimum(np.abs(a), np.abs(b))
+    d = np.sign(d) * np.minimum(np.abs(d), limit)
+    return np.where(a * b > 0.0, d, 0.0)
+
+
+def test_matches_scipy_hermite_cubic_with_the_stated_slopes_on_uneven_knots():
     rng = np.random.default_rng(7)
     deg = np.sort(rng.choice(np.arange(5.0, 355.0, 0.5), size=40, replace=False))
     lift = 10.0 + 5.0 * np.sin(np.radians(deg)) + rng.uniform(0.0, 1.0, deg.size)
+    lift[10:14] = lift[10]                                   # a dwell
     text = "angle_deg,lift_mm\n" + "\n".join(f"{a},{s}" for a, s in zip(deg, lift))
     prog = program_from_table_text(text)
-    th = np.radians(deg)
-    ref = CubicSpline(np.append(th, th[0] + TWO_PI), np.append(lift, lift[0]) * 1e-3, bc_type="periodic")
+    th, y = np.radians(deg), lift * 1e-3
+    slopes = _stated_slopes(th, y)
+    assert np.allclose(prog.slopes, slopes, rtol=1e-12, atol=0.0)
+    ref = CubicHermiteSpline(np.append(th, th[0] + TWO_PI), np.append(y, y[0]), np.append(slopes, slopes[0]))
     x = rng.uniform(-TWO_PI, 2 * TWO_PI, 2000)
     xr = th[0] + np.mod(x - th[0], TWO_PI)
-    for k, q in enumerate(prog.evaluate(x)[:3]):
-        assert np.allclose(q, ref(xr, k), rtol=1e-10, atol=1e-13 * 10 ** k)
+    for k, q in enumerate(prog.evaluate(x)):
+        assert np.allclose(q, ref(xr, k), rtol=1e-9, atol=1e-13 * 10 ** k)
     for xi in x[:200]:            # the math-only scalar path
         d = prog.derivatives(float(xi))
         xi_r = th[0] + (xi - th[0]) % TWO_PI
-        assert all(d[k] == pytest.approx(float(ref(xi_r, k)), rel=1e-9, abs=1e-12) for k in range(3))
+        assert all(d[k] == pytest.approx(float(ref(xi_r, k)), rel=1e-9, abs=1e-12) for k in range(4))
 
 
-def test_stated_continuity_s_s1_s2_continuous_s3_jumps_at_the_knots():
+def test_stated_continuity_s_s1_continuous_s2_jumps_at_the_knots():
     prog = _table(PROG, 5.0)
     knots = np.array(prog.breakpoints())
     assert np.allclose(knots, np.radians(np.arange(0.0, 360.0, 5.0)), atol=1e-15)
     eps = 1e-9
     left = np.array([prog.derivatives(k - eps) for k in knots])
     right = np.array([prog.derivatives(k + eps) for k in knots])   # knot 0 wraps around 360 deg
-    # across a knot a continuous derivative changes by at most 2 eps max|next derivative|
+    # across a knot a continuous quantity changes by at most 2 eps max|its derivative|
     bound = 2 * eps * np.abs(np.vstack([left, right])).max(axis=0) * 1.01 + 1e-16
-    for k in range(3):
+    for k in range(2):
         assert np.abs(left[:, k] - right[:, k]).max() < bound[k + 1]
-    jumps = np.abs(left[:, 3] - right[:, 3])
-    assert jumps.max() > 1e-2 * np.abs(left[:, 3]).max()       # the third derivative is only piecewise constant
-    # interpolates the table and repeats every 360 deg
-    assert np.allclose(prog.evaluate(knots)[0], np.array(prog.lifts), atol=1e-15)
+    jumps = np.abs(left[:, 2] - right[:, 2])
+    assert jumps.max() > 1e-3 * np.abs(left[:, 2]).max()       # s'' is only piecewise linear
+    # s''' is constant on each piece
+    inside = np.array([prog.derivatives(k + f * (knots[1] - knots[0]))[3] for k in knots for f in (0.1, 0.5, 0.9)])
+    assert np.array_equal(inside.reshape(-1, 3)[:, 0], inside.reshape(-1, 3)[:, 2])
+    # interpolates the table exactly and repeats every 360 deg
+    assert np.array_equal(prog.evaluate(knots)[0], np.array(prog.lifts))
     th = np.linspace(0.0, TWO_PI, 97) + 1e-3     # off the knots
     for a, b in zip(prog.evaluate(th), prog.evaluate(th + 3 * TWO_PI)):
         assert np.allclose(a, b, atol=1e-12)
 
 
 def test_accuracy_order_on_a_sampled_cam_program():
+    """Three-point slopes are second-order accurate: O(h^3) in s, O(h^2) in s', O(h) in s''
+    (the program's extremes are dwells here, which the curve keeps exactly)."""
     grid = np.linspace(0.0, TWO_PI, 20001)
     exact = PROG.evaluate(grid)[:3]
     errs = []
@@ -70,16 +92,17 @@ def test_accuracy_order_on_a_sampled_cam_program():
         errs.append([np.abs(a - b).max() for a, b in zip(approx, exact)])
     errs = np.array(errs)
     order = np.log2(errs[0] / errs[-1]) / 3.0          # over three halvings of the spacing
-    assert order[0] > 3.7 and order[1] > 2.7 and order[2] > 1.8      # O(h^4), O(h^3), O(h^2)
+    assert order[0] > 2.8 and order[1] > 1.8 and order[2] > 0.9
 
 
 def test_cam_program_interface_and_pressure_angle():
     table = _table(paper_program(), 0.5)
     a_t, at_t = table.max_pressure_angle(0.1)
     a_p, at_p = paper_program().max_pressure_angle(0.1)
-    assert a_t == pytest.approx(a_p, abs=1e-6)
+    assert a_t == pytest.approx(a_p, abs=1e-5)          # s' is O(h^2): 3e-6 rad at 0.5 deg
     # rise and return of the paper profile are mirror images: the maximum is at theta or 2 pi - theta
-    assert min(abs(at_t - at_p), abs(at_t - (TWO_PI - at_p))) < 1e-3
+    # (its location is that of a flat maximum: O(h) when the value is O(h^2))
+    assert min(abs(at_t - at_p), abs(at_t - (TWO_PI - at_p))) < 1e-2
     assert table.lift == pytest.approx(paper_program().lift, rel=1e-12)
     s, ds, d2s, d3s = table.derivatives(1.0)
     assert all(type(v) is float for v in (s, ds, d2s, d3s))
@@ -126,12 +149,28 @@ def test_parse_format():
 
 
 @pytest.mark.parametrize("text, fragment", [
-    ("a,b\n0,0\n90,1\n", "at least 3 rows"),
-    ("a,b\n0,0\n90,1\n90,2\n", "increase strictly, row 3 (90 deg) follows 90 deg"),
-    ("a,b\n0,0\n90,1\n180,2\n360,1\n", "must repeat the lift at 0 deg (0 mm), got 1 mm"),
-    ("a,b\n0,0\n90,-1\n180,2\n", "line 3: lift must be a finite number >= 0 mm"),
-    ("a,b\n0,0\n400,1\n180,2\n", "line 3: angle must lie in [0, 360] deg"),
-    ("a,b\n0,0\n90,x\n180,2\n", "line 3: expected two numbers"),
+    ("a,b\n0,0\n", "need at least 2 rows 'angle_deg, lift_mm' (a closing row at 360 deg not counted), got 1"),
+    ("a,b\n0,0\n360,0\n", "got 1"),
+    ("a,b\n0,0\n90,1\n90,2\n", "line 4 (row 3): angle '90' deg repeats '90' deg of row 2 (line 3); "
+                                 "angles must increase strictly"),
+    ("a,b\n0,0\n90,1\n80,2\n", "line 4 (row 3): angle '80' deg is below '90' deg of row 2 (line 3)"),
+    ("a,b\n0,0\n90,1\n180,2\n360,1\n", "line 5 (row 4): the closing row at 360 deg must repeat the lift of "
+                                         "row 1 (line 2), '0' mm, got '1' mm"),
+    ("a,b\n5,0\n90,1\n360,0\n", "line 4 (row 3): a row at 360 deg closes the period: it must come last, "
+                                 "after a first row at 0 deg"),
+    ("a,b\n0,0\n90,1\n360,0\n100,1\n", "line 5 (row 4): no row may follow the closing row at 360 deg "
+                                        "(row 3, line 4)"),
+    ("a,b\n0,0\n90,-1\n180,2\n", "line 3 (row 2): lift_mm must be a number in [0, 10000], got '-1'"),
+    ("a,b\n0,0\n90,1e5\n180,2\n", "line 3 (row 2): lift_mm must be a number in [0, 10000], got '1e5'"),
+    ("a,b\n0,0\n400,1\n180,2\n", "line 3 (row 2): angle_deg must lie in [0, 360) (or be 360 in a closing row), "
+                                  "got '400'"),
+    ("a,b\n0,0\nnan,1\n", "line 3 (row 2): angle_deg must lie in [0, 360)"),
+    ("a,b\n0,0\n90,x\n180,2\n", "line 3 (row 2): the lift_mm field is not a number: 'x'"),
+    ("0,O\n90,1\n180,0\n", "line 1 (row 1): the lift_mm field is not a number: 'O'"),
+    ("a,b\n0;0,5\n", "line 2 (row 1): expected 2 fields 'angle_deg, lift_mm', got 3: '0;0,5'"),
+    ("a,b\n0,0\n1_0,1\n", "line 3 (row 2): the angle_deg field is not a number: '1_0'"),
+    ("a,b\n0,0\n10," + "1" * 101 + "\n", "line 3 (row 2): the lift_mm field has more than 100 characters: '"
+     + "1" * 40 + "...'"),
 ])
 def test_table_errors(text, fragment):
     with pytest.raises(ValueError) as exc:
@@ -139,9 +178,31 @@ def test_table_errors(text, fragment):
     assert fragment in str(exc.value)
 
 
+def test_format_bom_optional_header_comments_and_line_ends():
+    rows = "0,1\r\n90,2 # peak\r180;1\n\n# note\n270\t0.5\n"
+    expected = ([0.0, 90.0, 180.0, 270.0], [1.0, 2.0, 1.0, 0.5])
+    for text in (rows, "\ufeff" + rows, "angle_deg,lift_mm\n" + rows, "\ufeffangle;lift\n" + rows):
+        assert parse_motion_table(text) == expected
+    # the first line is a header only when none of its fields is a number
+    with pytest.raises(ValueError, match="line 1 \\(row 1\\): the angle_deg field is not a number: 'deg'"):
+        parse_motion_table("deg,2\n0,1\n90,2\n")
+
+
+def test_the_issue_table_keeps_its_dwell_and_range():
+    """0,0 / 90,40 / 180,0: from 180 to 360 deg the lift stays 0 (the periodic spline went to -24 mm),
+    and nowhere does it leave [0, 40] mm."""
+    prog = program_from_table_text("angle_deg,lift_mm\n0,0\n90,40\n180,0\n")
+    th = np.radians(np.linspace(180.0, 360.0, 1801))
+    s, s1, s2, s3 = prog.evaluate(th)
+    assert np.all(s == 0.0) and np.all(s1 == 0.0) and np.all(s2[1:] == 0.0) and np.all(s3[1:] == 0.0)
+    s_all = prog.evaluate(np.linspace(0.0, TWO_PI, 3601))[0]
+    assert s_all.min() == 0.0 and s_all.max() == 0.040
+
+
 @pytest.mark.parametrize("angles, lifts, fragment", [
-    ([0.0, 1.0, TWO_PI], [0.0, 1.0, 0.0], "span less than 360 deg"),
-    ([0.0, 1.0], [0.0, 1.0], "at least 3 points"),
+    ([0.0, 1.0, TWO_PI], [0.0, 1.0, 0.0], "must lie in [0, 2 pi) rad: point 3"),
+    ([-0.5, 1.0], [0.0, 1.0], "must lie in [0, 2 pi) rad: point 1"),
+    ([0.0], [0.0], "at least 2 points"),
     ([0.0, 2.0, 1.0], [0.0, 1.0, 0.0], "increase strictly: point 3"),
     ([0.0, 1.0, 2.0], [0.0, -1.0, 0.0], "lift must be >= 0"),
 ])
@@ -169,8 +230,12 @@ def test_the_fmu_engine_runs_a_motion_table_parameter():
             sim.do_step(k * 1e-3, 1e-3, 3.5, 1.0, 0.0)
         return sim.outputs()["theta"]
 
-    law = theta_after_1s({})
-    errors = [abs(theta_after_1s({"motion_table": _table_text(paper_program(), step)}) - law) for step in (1.0, 0.25)]
+    # s'' jumps at every knot, where the solver stops: at the default rtol the restarts' error
+    # (~5e-7 rad after 1 s) hides the table's, so the convergence is measured at a tight tolerance
+    tight = {"rtol": 1e-12, "atol": 1e-14}
+    law = theta_after_1s(tight)
+    errors = [abs(theta_after_1s({"motion_table": _table_text(paper_program(), step), **tight}) - law)
+              for step in (1.0, 0.25)]
     assert law > 4.0  # the cam turned
     assert errors[0] < 1e-6 and errors[1] < errors[0] / 4
 

@@ -24,8 +24,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     add_law_options(p)
     add_program_options(p, "cam program (defaults: the paper's profile)")
     p.add_argument("--table", metavar="FILE.csv",
-                   help="motion table 'angle_deg, lift_mm' (header line, periodic over 360 deg) "
-                        "instead of the law options; interpolated by a periodic cubic spline")
+                   help="motion table 'angle_deg, lift_mm' (optional header line, periodic over 360 deg) "
+                        "instead of the law options; a shape-preserving periodic cubic through the rows")
     g = p.add_argument_group("follower and checks")
     g.add_argument("--roller-radius-mm", type=float, required=True, help="roller radius r_r [mm], 0 < r_r < r_b")
     g.add_argument("--offset-mm", type=float, default=0.0,

@@ -7,7 +7,8 @@ derivatives of the lift over the cam angle.
 
 Peaks are exact: for a CamProgram from the laws' characteristic values
 (Vm, Am, Jm of each phase scaled by h / b^k, at the law's T times b); for a
-TableProgram from the spline's pieces (s'' linear, s''' constant on each).
+TableProgram from its cubic pieces (s'' linear on each and jumping at the
+knots, s''' constant on each).
 Where s'' jumps (a law with unbounded jerk), the peak jerk is None and
 ``jerk_unbounded`` is True.
 """
@@ -81,13 +82,16 @@ def _cam_program_peaks(p: CamProgram):
 
 def _table_peaks(p: TableProgram):
     v, a, j = [], [], []
-    for x, w, (c0, c1, c2, c3) in zip(p.angles, p.widths, p.coefficients):
+    for x, w, (c0, c1, c2, c3), end in zip(p.angles, p.widths, p.coefficients, p.end_coefficients):
         v.append((abs(c1), x))                          # s' at the knot
         if c3 != 0.0:                                   # s'' = 0 inside: extreme of s'
             u = -c2 / (3.0 * c3)
             if 0.0 < u < w:
                 v.append((abs(c1 + u * (2.0 * c2 + 3.0 * c3 * u)), x + u))
-        a.append((abs(2.0 * c2), x))                    # s'' is linear: extremes at knots
+        # s'' is linear on the piece and jumps at the knots: its extremes are the two one-sided
+        # limits at the piece's ends (right limit 2 c2 at x, left limit 2 e2 at x + w)
+        a.append((abs(2.0 * c2), x))
+        a.append((abs(2.0 * end[2]), x + w))
         j.append((abs(6.0 * c3), x))                    # s''' constant on the piece (from x on)
     return _best(v), _best(a), _best(j)
 

@@ -111,8 +111,8 @@ _PROGRAM = (
     _P("upper_dwell", "rad", 0.0, "cam angle of the upper dwell", low=0.0, high=2 * math.pi),
     _P("return_angle", "rad", math.pi, "cam angle of the return", low=1e-3, high=2 * math.pi),
     _P("lower_dwell", "rad", 0.0, "cam angle of the lower dwell", low=0.0, high=2 * math.pi),
-    _P("motion_table", "", "", "a user motion table as CSV text 'angle_deg,lift_mm' with a header line "
-       "(periodic cubic spline; when given, the laws, lift and angles above are not used)", kind="string"),
+    _P("motion_table", "", "", "a user motion table as CSV text 'angle_deg,lift_mm' (optional header line; "
+       "shape-preserving periodic cubic, docs/cam_design.md; when given, the laws, lift and angles above are not used)", kind="string"),
 )
 
 _MODE = (

@@ -21,6 +21,11 @@
 #define CAM_SHAPE_SIN 1             /* A = c sin(x) */
 #define CAM_SHAPE_COS 2             /* A = c cos(x) */
 
+#define CAM_TABLE_MAX_ROWS 10000000     /* rows of a motion table, at most */
+#define CAM_TABLE_MAX_LIFT_MM 10000.0   /* mm: a table's lifts lie in [0, 10 m], the lift parameter's range */
+#define CAM_TABLE_MAX_NUMBER 100        /* characters of one number in a table, at most */
+#define CAM_TABLE_MIN_SPACING_DEG 1e-6  /* deg: rows closer than this are refused (the third derivative would overflow) */
+
 typedef enum { CAM_PROGRAM_LAWS = 0, CAM_PROGRAM_TABLE = 1 } CamProgramKind;
 
 /* One dimensionless law: its non-empty segments, CAM_SEGMENT_FIELDS doubles each. */
@@ -29,12 +34,22 @@ typedef struct {
     int n_segments;
 } CamLaw;
 
-/* A user's motion table after parsing: knots of the periodic interpolant (SI units). */
+/* A user's motion table after parsing: knots of the periodic interpolant (SI units).
+ * Piece i runs from knot i to knot i + 1 (the last piece to knot 0 + 2 pi). With
+ * u = theta - angle[i] in [0, width[i]] and v = u - width[i]:
+ *   s = lift[i]   + u (slope[i]   + u (c2[i] + u c3[i]))     for u <= width[i] / 2,
+ *   s = lift[i+1] + v (slope[i+1] + v (e2[i] + v c3[i]))     beyond (exact at both knots),
+ * s clamped to the range of the piece's two lifts. All arrays are one allocation that
+ * starts at angle and is owned by the table. */
 typedef struct {
     double *angle;      /* rad, strictly increasing, in [0, 2 pi) */
     double *lift;       /* m */
     double *slope;      /* m/rad: Hermite slopes at the knots */
-    size_t n;           /* knots */
+    double *width;      /* rad: piece widths, > 0 */
+    double *c2;         /* m/rad^2: s''/2 at a piece's start (right limit) */
+    double *e2;         /* m/rad^2: s''/2 at a piece's end (left limit) */
+    double *c3;         /* m/rad^3: s'''/6, constant on a piece */
+    size_t n;           /* knots = pieces */
 } CamTable;
 
 typedef struct {
@@ -47,36 +62,55 @@ typedef struct {
     double kd0, kd1, kd2, kd3;      /* the same of the return */
     /* table */
     CamTable table;
-    /* breakpoints of the program (rad, each in [0, 2 pi)), ascending */
+    /* breakpoints of the program (rad, each in [0, 2 pi)), ascending: CamProgram.breakpoints()
+     * for laws (an allocation of its own), the knots for a table (the array table.angle) */
     double *points;
     size_t n_points;
-    double feature_angle;           /* rad: the program's finest angular detail */
+    double feature_angle;           /* rad: the program's finest angular detail (as the Python programs') */
 } CamProfile;
 
 /* The law with split points T[0..5] = T1..T6 (checked: finite, in [0, 1], ordered,
- * T3 > 0, T4 < 1); ``name`` names the parameters in messages (e.g. "rise"). */
+ * T3 > 0, T4 < 1); ``name`` names the parameters in messages ("rise": "rise law: ...
+ * rise_T3=0.0 ..."); NULL or "" gives MotionLaw's own messages ("T3=0.0"). */
 int cam_law_init(CamLaw *law, const double T[6], const char *name, char *err, size_t err_len);
 
 /* (S, V, A, J) of a dimensionless law at T into out[0..3]; dwells outside [0, 1]. */
 void cam_law_eval(const CamLaw *law, double T, double out[4]);
 
-/* A program of two laws and dwells; the four angles must sum to 2 pi (to 1e-9 rad). */
+/* A program of two laws and dwells (CamProgram's checks: lift finite > 0, angles finite >= 0,
+ * rise and return > 0); the four angles must sum to 2 pi to 1e-9 rad (physics/parameters.py's
+ * message). */
 int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double return_T[6], double lift,
                           double rise_angle, double upper_dwell, double return_angle, double lower_dwell,
                           char *err, size_t err_len);
 
 /* A program from the CSV text of a motion table (see docs/cam_design.md for the format and the
- * refusals); ``text_len`` bytes, not necessarily NUL-terminated. */
+ * refusals); ``text_len`` bytes, not necessarily NUL-terminated. O(text_len) time, O(rows) memory. */
 int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, char *err, size_t err_len);
+
+/* sizeof(CamProfile), for bindings that mirror the structure (ctypes). */
+size_t cam_profile_sizeof(void);
 
 /* Free what an init allocated; safe on a zeroed or already freed profile. */
 void cam_profile_free(CamProfile *p);
 
-/* s [m], ds/dtheta [m/rad], d2s/dtheta2, d3s/dtheta3 at theta [rad] into d[0..3]. */
+/* s [m], ds/dtheta [m/rad], d2s/dtheta2, d3s/dtheta3 at theta [rad] into d[0..3].
+ * Laws: exactly drive_kernel.Profile.profile (a NaN or infinite theta gives the lower dwell there).
+ * Tables: the piece ending at a knot (left limit; knot 0 ends the last piece); O(log n);
+ * a NaN or infinite theta gives NaN. */
 void cam_profile_eval(const CamProfile *p, double theta, double d[4]);
+
+/* cam_profile_eval that also adds to *comparisons (if not NULL) the knot comparisons of a
+ * table's binary search (at most ceil(log2(n + 1))): the complexity, observable in tests. */
+void cam_profile_eval_counted(const CamProfile *p, double theta, double d[4], size_t *comparisons);
 
 /* The first breakpoint angle [rad] strictly between start and end in the direction of travel
  * (periodic: the angle itself, not reduced), or NaN when none; O(log n_points). */
 double cam_profile_first_breakpoint(const CamProfile *p, double start, double end);
+
+/* The same over ascending points[0..n-1] in [0, 2 pi): drive_kernel.first_angle_crossed's result
+ * to the bit. Adds to *evaluations (if not NULL) the number of points whose crossing angle it
+ * computed: a few per group of equal turn counts (at most 3 groups), O(log n) comparisons. */
+double cam_first_crossed(const double *points, size_t n, double start, double end, size_t *evaluations);
 
 #endif

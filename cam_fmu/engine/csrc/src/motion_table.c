@@ -1,0 +1,500 @@
+/* A user's motion table: the CSV parser (untrusted bytes) and the shape-preserving periodic
+ * piecewise cubic Hermite interpolant through its rows. docs/cam_design.md states the format,
+ * the refusals and the curve; kinematics/motion_table.py is the same model in Python (the same
+ * messages and, operation for operation, the same doubles).
+ *
+ * Slopes: at each knot the slope of the parabola through it and its two neighbours, then
+ * limited as Fritsch and Carlson's monotone cubic interpolation requires (Hyman's filter):
+ * 0 where the chords on either side differ in sign or one is 0 (a local extremum or the edge
+ * of a dwell), otherwise at most 3 times the smaller chord slope. Each piece is then monotone
+ * between its two lifts: no overshoot, and a run of equal lifts is exactly flat.
+ */
+#include "cam_profile.h"
+#include "cam_table.h"
+#include "cam_text.h"
+
+#include <locale.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TWO_PI (2.0 * 3.141592653589793)
+#define DEG (3.141592653589793 / 180.0)   /* Python's math.radians factor */
+#define MSG 600                           /* room for one message with two quoted texts */
+
+typedef struct {
+    const char *s;
+    size_t n;
+} Span;
+
+enum { NOT_NUMBER = 0, DECIMAL = 1, INF_WORD = 2, NAN_WORD = 3 };
+
+static int is_sep(char c)
+{
+    return c == ' ' || c == '\t' || c == ',' || c == ';';
+}
+
+static int is_digit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+static int word_is(const char *s, size_t n, const char *word)
+{
+    size_t i;
+    if (n != strlen(word)) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        char c = s[i];
+        if (c >= 'A' && c <= 'Z') {
+            c = (char)(c - 'A' + 'a');
+        }
+        if (c != word[i]) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* What a field is: [+-] (digits [. digits] | . digits) [(e|E) [+-] digits], or [+-] inf, infinity, nan
+ * (any case): Python's float() without its underscores and surrounding blanks. */
+static int classify(Span f)
+{
+    const char *s = f.s;
+    size_t n = f.n, i = 0, digits = 0;
+    if (i < n && (s[i] == '+' || s[i] == '-')) {
+        i++;
+    }
+    if (word_is(s + i, n - i, "inf") || word_is(s + i, n - i, "infinity")) {
+        return INF_WORD;
+    }
+    if (word_is(s + i, n - i, "nan")) {
+        return NAN_WORD;
+    }
+    while (i < n && is_digit(s[i])) {
+        i++;
+        digits++;
+    }
+    if (i < n && s[i] == '.') {
+        i++;
+        while (i < n && is_digit(s[i])) {
+            i++;
+            digits++;
+        }
+    }
+    if (digits == 0) {
+        return NOT_NUMBER;
+    }
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        size_t e = 0;
+        i++;
+        if (i < n && (s[i] == '+' || s[i] == '-')) {
+            i++;
+        }
+        while (i < n && is_digit(s[i])) {
+            i++;
+            e++;
+        }
+        if (e == 0) {
+            return NOT_NUMBER;
+        }
+    }
+    return i == n ? DECIMAL : NOT_NUMBER;
+}
+
+/* The value of a field that classify() accepted: correctly rounded (strtod), whatever the C locale's
+ * decimal point. 0 on success. */
+static int to_double(Span f, int kind, double *value)
+{
+    char buf[CAM_TABLE_MAX_NUMBER + 16], *end;
+    const char *point = localeconv()->decimal_point;
+    size_t i, pos = 0, plen = point != NULL ? strlen(point) : 0;
+    int negative = f.n > 0 && f.s[0] == '-';
+    if (kind == INF_WORD) {
+        *value = negative ? -INFINITY : INFINITY;
+        return 0;
+    }
+    if (kind == NAN_WORD) {
+        *value = NAN;
+        return 0;
+    }
+    if (plen == 0 || plen > 8) {
+        point = ".";
+        plen = 1;
+    }
+    for (i = 0; i < f.n; i++) {
+        if (f.s[i] == '.') {
+            memcpy(buf + pos, point, plen);
+            pos += plen;
+        } else {
+            buf[pos++] = f.s[i];
+        }
+    }
+    buf[pos] = '\0';
+    *value = strtod(buf, &end);
+    return end != buf + pos;
+}
+
+/* Growable (angle, lift) columns. */
+typedef struct {
+    double *angle, *lift;
+    size_t n, cap;
+} Rows;
+
+static int push(Rows *r, double angle, double lift)
+{
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 64;
+        double *a, *l;
+        if (cap > CAM_TABLE_MAX_ROWS) {
+            cap = CAM_TABLE_MAX_ROWS;
+        }
+        a = realloc(r->angle, cap * sizeof *a);
+        if (a == NULL) {
+            return 1;
+        }
+        r->angle = a;
+        l = realloc(r->lift, cap * sizeof *l);
+        if (l == NULL) {
+            return 1;
+        }
+        r->lift = l;
+        r->cap = cap;
+    }
+    r->angle[r->n] = angle;
+    r->lift[r->n] = lift;
+    r->n++;
+    return 0;
+}
+
+/* The interpolant's slopes and piece coefficients from knots angle[0..n-1], lift[0..n-1] (n >= 2). */
+static void build(CamTable *t)
+{
+    size_t n = t->n, i;
+    double *delta = t->c3;  /* chord slopes, overwritten last */
+    for (i = 0; i < n; i++) {
+        double next = i + 1 < n ? t->angle[i + 1] : t->angle[0] + TWO_PI;
+        t->width[i] = next - t->angle[i];
+        delta[i] = (t->lift[i + 1 < n ? i + 1 : 0] - t->lift[i]) / t->width[i];
+    }
+    for (i = 0; i < n; i++) {
+        size_t j = i > 0 ? i - 1 : n - 1;
+        double a = delta[j], b = delta[i], ha = t->width[j], hb = t->width[i], d = 0.0;
+        if ((a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)) {
+            double limit = 3.0 * fmin(fabs(a), fabs(b));
+            d = (hb * a + ha * b) / (ha + hb);
+            if (fabs(d) > limit) {
+                d = copysign(limit, d);
+            }
+        }
+        t->slope[i] = d;
+    }
+    for (i = 0; i < n; i++) {
+        double w = t->width[i], d0 = t->slope[i], d1 = t->slope[i + 1 < n ? i + 1 : 0], chord = delta[i];
+        t->c2[i] = (3.0 * chord - 2.0 * d0 - d1) / w;
+        t->e2[i] = (d0 + 2.0 * d1 - 3.0 * chord) / w;
+        t->c3[i] = (d0 + d1 - 2.0 * chord) / (w * w);
+    }
+}
+
+void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *comparisons)
+{
+    size_t n = t->n, lo = 0, hi = n, i, count = 0;
+    double th, u, w, y0, y1, c3, s;
+    if (!isfinite(theta) || n == 0) {
+        d[0] = d[1] = d[2] = d[3] = NAN;
+        return;
+    }
+    th = fmod(theta, TWO_PI);  /* [0, 2 pi): a knot is its own reduction, so rows come back exactly */
+    if (th < 0.0) {
+        th += TWO_PI;
+        if (th >= TWO_PI) {  /* -tiny + 2 pi rounds to 2 pi */
+            th = 0.0;
+        }
+    }
+    while (lo < hi) {  /* bisect_left: the first knot >= th */
+        size_t mid = lo + (hi - lo) / 2;
+        count++;
+        if (t->angle[mid] < th) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    if (comparisons != NULL) {
+        *comparisons += count;
+    }
+    if (lo == 0) {  /* up to knot 0 (included): the last piece, which ends at knot 0 + 2 pi */
+        i = n - 1;
+        u = (th + TWO_PI) - t->angle[i];
+    } else {
+        i = lo - 1;
+        u = th - t->angle[i];
+    }
+    w = t->width[i];
+    y0 = t->lift[i];
+    y1 = t->lift[i + 1 < n ? i + 1 : 0];
+    c3 = t->c3[i];
+    if (u <= 0.5 * w) {
+        double c1 = t->slope[i], c2 = t->c2[i];
+        s = y0 + u * (c1 + u * (c2 + u * c3));
+        d[1] = c1 + u * (2.0 * c2 + 3.0 * c3 * u);
+        d[2] = 2.0 * c2 + 6.0 * c3 * u;
+    } else {
+        double v = u - w, c1 = t->slope[i + 1 < n ? i + 1 : 0], c2 = t->e2[i];
+        s = y1 + v * (c1 + v * (c2 + v * c3));
+        d[1] = c1 + v * (2.0 * c2 + 3.0 * c3 * v);
+        d[2] = 2.0 * c2 + 6.0 * c3 * v;
+    }
+    d[3] = 6.0 * c3;
+    /* the piece is monotone between y0 and y1; rounding must not take s outside */
+    d[0] = fmin(fmax(s, fmin(y0, y1)), fmax(y0, y1));
+}
+
+/* "motion table line L (row R): " */
+static int row_fail(char *err, size_t err_len, size_t line, size_t row, const char *what)
+{
+    return cam_fail(err, err_len, "motion table line %lu (row %lu): %s", (unsigned long)line, (unsigned long)row,
+                    what);
+}
+
+/* The number in field f (named name) or a refusal. */
+static int field_value(Span f, const char *name, size_t line, size_t row, double *value, char *err,
+                       size_t err_len)
+{
+    char msg[MSG], q[200];
+    int kind = classify(f);
+    cam_quote(f.s, f.n, q, sizeof q);
+    if (kind == NOT_NUMBER) {
+        snprintf(msg, sizeof msg, "the %s field is not a number: %s", name, q);
+        return row_fail(err, err_len, line, row, msg);
+    }
+    if (f.n > CAM_TABLE_MAX_NUMBER) {
+        snprintf(msg, sizeof msg, "the %s field has more than %d characters: %s", name, CAM_TABLE_MAX_NUMBER, q);
+        return row_fail(err, err_len, line, row, msg);
+    }
+    if (to_double(f, kind, value)) {
+        snprintf(msg, sizeof msg, "the %s field could not be read as a number: %s", name, q);
+        return row_fail(err, err_len, line, row, msg);
+    }
+    return 0;
+}
+
+typedef struct {
+    size_t line, row;   /* where a row was */
+    Span angle, lift;   /* its texts */
+    double degrees, radians, mm;
+} RowInfo;
+
+static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err_len)
+{
+    char msg[MSG], q1[200], q2[200];
+    size_t pos = 0, line = 0, row = 0;
+    int first_line = 1, closed = 0;
+    RowInfo first, prev, closing;
+    memset(&first, 0, sizeof first);
+    memset(&prev, 0, sizeof prev);
+    memset(&closing, 0, sizeof closing);
+    if (len >= 3 && (unsigned char)text[0] == 0xef && (unsigned char)text[1] == 0xbb &&
+        (unsigned char)text[2] == 0xbf) {
+        pos = 3;  /* a UTF-8 byte order mark, as spreadsheets write it */
+    }
+    while (pos < len) {
+        size_t start = pos, end = pos, stop, k, n_fields = 0;
+        Span field[2];
+        RowInfo r;
+        int numbers = 0;
+        while (end < len && text[end] != '\n' && text[end] != '\r') {
+            end++;
+        }
+        pos = end;
+        if (pos < len) {
+            pos += (text[pos] == '\r' && pos + 1 < len && text[pos + 1] == '\n') ? 2 : 1;
+        }
+        line++;
+        stop = start;
+        while (stop < end && text[stop] != '#') {
+            stop++;  /* '#' starts a comment */
+        }
+        for (k = start; k < stop;) {
+            size_t f0;
+            if (is_sep(text[k])) {
+                k++;
+                continue;
+            }
+            f0 = k;
+            while (k < stop && !is_sep(text[k])) {
+                k++;
+            }
+            if (n_fields < 2) {
+                field[n_fields].s = text + f0;
+                field[n_fields].n = k - f0;
+            }
+            if (classify((Span){text + f0, k - f0}) != NOT_NUMBER) {
+                numbers++;
+            }
+            n_fields++;
+        }
+        if (n_fields == 0) {
+            continue;  /* blank or comment */
+        }
+        if (first_line) {
+            first_line = 0;
+            if (numbers == 0) {
+                continue;  /* a header: no field is a number */
+            }
+        }
+        row++;
+        if (closed) {
+            snprintf(msg, sizeof msg, "no row may follow the closing row at 360 deg (row %lu, line %lu)",
+                     (unsigned long)closing.row, (unsigned long)closing.line);
+            return row_fail(err, err_len, line, row, msg);
+        }
+        if (n_fields != 2) {
+            size_t a = start, b = stop;
+            while (a < b && is_sep(text[a])) {
+                a++;
+            }
+            while (b > a && is_sep(text[b - 1])) {
+                b--;
+            }
+            cam_quote(text + a, b - a, q1, sizeof q1);
+            snprintf(msg, sizeof msg, "expected 2 fields 'angle_deg, lift_mm', got %lu: %s", (unsigned long)n_fields,
+                     q1);
+            return row_fail(err, err_len, line, row, msg);
+        }
+        memset(&r, 0, sizeof r);
+        r.line = line;
+        r.row = row;
+        r.angle = field[0];
+        r.lift = field[1];
+        if (field_value(r.angle, "angle_deg", line, row, &r.degrees, err, err_len) ||
+            field_value(r.lift, "lift_mm", line, row, &r.mm, err, err_len)) {
+            return 1;
+        }
+        if (!(isfinite(r.degrees) && r.degrees >= 0.0 && r.degrees <= 360.0)) {
+            cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
+            snprintf(msg, sizeof msg, "angle_deg must lie in [0, 360) (or be 360 in a closing row), got %s", q1);
+            return row_fail(err, err_len, line, row, msg);
+        }
+        if (!(isfinite(r.mm) && r.mm >= 0.0 && r.mm <= CAM_TABLE_MAX_LIFT_MM)) {
+            cam_quote(r.lift.s, r.lift.n, q1, sizeof q1);
+            snprintf(msg, sizeof msg, "lift_mm must be a number in [0, 10000], got %s", q1);
+            return row_fail(err, err_len, line, row, msg);
+        }
+        if (r.degrees == 360.0) {
+            if (rows->n == 0 || first.degrees != 0.0) {
+                return row_fail(err, err_len, line, row, "a row at 360 deg closes the period: it must come last, "
+                                "after a first row at 0 deg");
+            }
+            if (fabs(r.mm - first.mm) > 1e-9 * fmax(1.0, fabs(first.mm))) {
+                cam_quote(first.lift.s, first.lift.n, q1, sizeof q1);
+                cam_quote(r.lift.s, r.lift.n, q2, sizeof q2);
+                snprintf(msg, sizeof msg, "the closing row at 360 deg must repeat the lift of row %lu (line %lu), "
+                         "%s mm, got %s mm", (unsigned long)first.row, (unsigned long)first.line, q1, q2);
+                return row_fail(err, err_len, line, row, msg);
+            }
+            closed = 1;
+            closing = r;
+            continue;
+        }
+        r.radians = r.degrees * DEG;
+        if (rows->n > 0) {
+            if (r.degrees <= prev.degrees) {
+                cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
+                cam_quote(prev.angle.s, prev.angle.n, q2, sizeof q2);
+                snprintf(msg, sizeof msg, "angle %s deg %s %s deg of row %lu (line %lu); angles must increase strictly",
+                         q1, r.degrees == prev.degrees ? "repeats" : "is below", q2, (unsigned long)prev.row,
+                         (unsigned long)prev.line);
+                return row_fail(err, err_len, line, row, msg);
+            }
+            if (r.degrees - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
+                cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
+                cam_quote(prev.angle.s, prev.angle.n, q2, sizeof q2);
+                snprintf(msg, sizeof msg, "angle %s deg is closer than 1e-06 deg to %s deg of row %lu (line %lu)",
+                         q1, q2, (unsigned long)prev.row, (unsigned long)prev.line);
+                return row_fail(err, err_len, line, row, msg);
+            }
+        }
+        if (rows->n >= CAM_TABLE_MAX_ROWS) {
+            return cam_fail(err, err_len, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
+                            (unsigned long)line);
+        }
+        if (push(rows, r.radians, r.mm * 1e-3)) {
+            return cam_fail(err, err_len, "motion table: out of memory at row %lu", (unsigned long)row);
+        }
+        if (rows->n == 1) {
+            first = r;
+        }
+        prev = r;
+    }
+    if (rows->n < 2) {
+        return cam_fail(err, err_len, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing row at "
+                        "360 deg not counted), got %lu", (unsigned long)rows->n);
+    }
+    if ((first.degrees + 360.0) - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
+        cam_quote(prev.angle.s, prev.angle.n, q1, sizeof q1);
+        cam_quote(first.angle.s, first.angle.n, q2, sizeof q2);
+        snprintf(msg, sizeof msg, "motion table line %lu (row %lu): angle %s deg is closer than 1e-06 deg to %s deg "
+                 "+ 360 deg of row %lu (line %lu), where the period starts again", (unsigned long)prev.line,
+                 (unsigned long)prev.row, q1, q2, (unsigned long)first.row, (unsigned long)first.line);
+        return cam_fail(err, err_len, "%s", msg);
+    }
+    return 0;
+}
+
+int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, char *err, size_t err_len)
+{
+    Rows rows;
+    CamTable *t;
+    double *block;
+    size_t n, i;
+    memset(p, 0, sizeof *p);
+    memset(&rows, 0, sizeof rows);
+    if (text == NULL && text_len > 0) {
+        return cam_fail(err, err_len, "motion table: no text");
+    }
+    if (parse(text, text_len, &rows, err, err_len)) {
+        free(rows.angle);
+        free(rows.lift);
+        return 1;
+    }
+    n = rows.n;
+    block = malloc(7 * n * sizeof *block);
+    if (block == NULL) {
+        free(rows.angle);
+        free(rows.lift);
+        return cam_fail(err, err_len, "motion table: out of memory for %lu rows", (unsigned long)n);
+    }
+    t = &p->table;
+    t->n = n;
+    t->angle = block;
+    t->lift = block + n;
+    t->slope = block + 2 * n;
+    t->width = block + 3 * n;
+    t->c2 = block + 4 * n;
+    t->e2 = block + 5 * n;
+    t->c3 = block + 6 * n;
+    memcpy(t->angle, rows.angle, n * sizeof *block);
+    memcpy(t->lift, rows.lift, n * sizeof *block);
+    free(rows.angle);
+    free(rows.lift);
+    build(t);
+    p->kind = CAM_PROGRAM_TABLE;
+    p->points = t->angle;
+    p->n_points = n;
+    p->feature_angle = t->width[0];
+    for (i = 1; i < n; i++) {
+        if (t->width[i] < p->feature_angle) {
+            p->feature_angle = t->width[i];
+        }
+    }
+    for (i = 0; i < n; i++) {
+        if (t->lift[i] > p->lift) {
+            p->lift = t->lift[i];  /* the largest lift [m], as TableProgram.lift */
+        }
+    }
+    return 0;
+}
