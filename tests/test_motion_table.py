@@ -122,7 +122,9 @@ def test_runtime_evaluation_uses_no_numpy(monkeypatch):
 
 def test_drive_physics_with_a_table_program():
     """The drive equations of DriveModel run unchanged on a table sampled every
-    0.25 deg from its own (paper) program, and agree to the spline's accuracy."""
+    0.25 deg from its own (paper) program, and agree to the curve's accuracy: s'' of the
+    shape-preserving cubic is first order, 1.7 % of max |s''| off at 0.25 deg rows where the law's
+    s'' has a kink (its segment joints), and omega_dot carries m s'' omega^2 (measured: 2.4 %)."""
     ref = DriveModel()
     model = DriveModel()
     table = _table(ref.program, 0.25)
@@ -132,11 +134,11 @@ def test_drive_physics_with_a_table_program():
         for omega in (-8.0, 3.0, 12.0):
             a, b = model.omega_dot(theta, omega, 0.3, math.copysign(1.0, omega)), \
                 ref.omega_dot(theta, omega, 0.3, math.copysign(1.0, omega))
-            assert a == pytest.approx(b, rel=2e-4, abs=1e-3)
+            assert a == pytest.approx(b, rel=3e-2, abs=1e-1)
             la, lb = model.load(theta, omega, 1.0, 1.0), ref.load(theta, omega, 1.0, 1.0)
-            assert la.M == pytest.approx(lb.M, rel=2e-4, abs=1e-5)
-            assert la.v == pytest.approx(lb.v, rel=1e-6, abs=1e-9)
-            assert la.s_cam == pytest.approx(lb.s_cam, abs=1e-10)
+            assert la.M == pytest.approx(lb.M, rel=3e-2, abs=1e-4)
+            assert la.v == pytest.approx(lb.v, rel=1e-3, abs=1e-6)  # s' is second order
+            assert la.s_cam == pytest.approx(lb.s_cam, abs=1e-8)  # s is third order: 0.45 nm measured
 
 
 def test_parse_format():
