@@ -137,7 +137,7 @@ def test_drive_physics_with_a_table_program():
             assert a == pytest.approx(b, rel=3e-2, abs=1e-1)
             la, lb = model.load(theta, omega, 1.0, 1.0), ref.load(theta, omega, 1.0, 1.0)
             assert la.M == pytest.approx(lb.M, rel=3e-2, abs=1e-4)
-            assert la.v == pytest.approx(lb.v, rel=1e-3, abs=1e-6)  # s' is second order
+            assert la.v == pytest.approx(lb.v, rel=1e-3, abs=1e-4)  # s' is second order (v's scale: 1.2 m/s)
             assert la.s_cam == pytest.approx(lb.s_cam, abs=1e-8)  # s is third order: 0.45 nm measured
 
 
