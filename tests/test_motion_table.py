@@ -130,15 +130,19 @@ def test_drive_physics_with_a_table_program():
     table = _table(ref.program, 0.25)
     model.program = table
     model._profile = table.derivatives     # the hot path binds the profile once at construction
+    rows = []
     for theta in np.linspace(0.1, 6.2, 13):
         for omega in (-8.0, 3.0, 12.0):
             a, b = model.omega_dot(theta, omega, 0.3, math.copysign(1.0, omega)), \
                 ref.omega_dot(theta, omega, 0.3, math.copysign(1.0, omega))
-            assert a == pytest.approx(b, rel=3e-2, abs=1e-1)
             la, lb = model.load(theta, omega, 1.0, 1.0), ref.load(theta, omega, 1.0, 1.0)
-            assert la.M == pytest.approx(lb.M, rel=3e-2, abs=1e-4)
-            assert la.v == pytest.approx(lb.v, rel=1e-3, abs=1e-4)  # s' is second order (v's scale: 1.2 m/s)
-            assert la.s_cam == pytest.approx(lb.s_cam, abs=1e-8)  # s is third order: 0.45 nm measured
+            rows.append((a, b, la.M, lb.M, la.v, lb.v, la.s_cam, lb.s_cam))
+    r = np.array(rows)
+    # the largest error of each quantity over the grid, relative to its largest value (measured at
+    # 0.25 deg rows: omega_dot 9.4e-4, M 2.7e-3, v 1.8e-5, s 3.0e-9; the bounds leave a factor 2-5)
+    for k, bound in ((0, 5e-3), (2, 1e-2), (4, 1e-4), (6, 1e-8)):
+        error = np.abs(r[:, k] - r[:, k + 1]).max() / np.abs(r[:, k + 1]).max()
+        assert error < bound, (k, error)
 
 
 def test_parse_format():
