@@ -124,7 +124,7 @@ def test_drive_physics_with_a_table_program():
     """The drive equations of DriveModel run unchanged on a table sampled every
     0.25 deg from its own (paper) program, and agree to the curve's accuracy: s'' of the
     shape-preserving cubic is first order, 1.7 % of max |s''| off at 0.25 deg rows where the law's
-    s'' has a kink (its segment joints), and omega_dot carries m s'' omega^2 (measured: 2.4 %)."""
+    s'' has a kink (its segment joints), and omega_dot and M carry it through m s'' omega^2."""
     ref = DriveModel()
     model = DriveModel()
     table = _table(ref.program, 0.25)
