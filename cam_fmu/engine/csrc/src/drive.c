@@ -13,10 +13,13 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
         return status;
     d->form = cam_formulation(d->model.formulation);
-    if (d->form == NULL) {
+    if (d->form == NULL || (d->model.formulation == CAM_FORM_CONSISTENT && cam_method(d->model.solver) == NULL)) {
+        const char *what = d->form == NULL ? (d->model.formulation == CAM_FORM_SPEED ? "the speed drive"
+                                              : "formulation 'paper'") : "this solver";
+        status = cam_error(err, CAM_ERR_PARAMETER, "%s is not yet available in the C engine (solver '%s')", what,
+                           cam_param_spec(CAM_P_SOLVER)->choices[d->model.solver]);
         cam_model_free(&d->model);
-        return cam_error(err, CAM_ERR_PARAMETER, "formulation %d is not yet available in the C engine",
-                        (int)d->model.formulation);
+        return status;
     }
     d->time = 0.0;
     d->u = cam_input_spec(CAM_I_U)->start;
