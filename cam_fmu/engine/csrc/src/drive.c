@@ -72,8 +72,10 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
     if (verdict == CAM_PUBLISH_NOT_FINITE) {
         for (k = 0; k < CAM_N_OUTPUTS && isfinite(out[k]); k++)
             ;
-        if (k == CAM_N_OUTPUTS)   /* the sum overflowed, every output finite */
-            k = 0;
+        if (k == CAM_N_OUTPUTS)   /* every output finite, their sum overflowed (DriveSimulator had no message) */
+            return cam_error(err, CAM_ERR_SIMULATION, "the outputs at t = %g s are too large to check (their sum "
+                             "is not finite) with solver '%s', h_max = %g s: reduce h_max or use 'rk45'/'etdrk4'",
+                             d->time, solver->choices[d->model.solver], d->model.h_max);
         return cam_error(err, CAM_ERR_SIMULATION, "output '%s' became %s at t = %g s with solver '%s', h_max = %g s: "
                         "reduce h_max or use 'rk45'/'etdrk4'", cam_output_spec(k)->name,
                         cam_num(out[k], shown), d->time, solver->choices[d->model.solver],
