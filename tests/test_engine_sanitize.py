@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from cam_fmu.engine import codegen
 from cam_fmu.engine.build import CSRC, INCLUDE, SOURCES
 from native_support import require
 
@@ -27,10 +28,12 @@ BAD_INPUTS = [b"0,O\n90,1\n", b"\xef\xbb\xbf", b"\xef\xbb", b"0,0\n90,", b"0,0\n
 @pytest.fixture(scope="module")
 def driver(tmp_path_factory):
     gcc = require("gcc")
-    exe = tmp_path_factory.mktemp("engine_c") / "fuzz_driver"
-    sources = sorted(str(p) for p in SOURCES.glob("*.c"))
-    cmd = [gcc, *FLAGS, f"-I{INCLUDE}", *sources, str(CSRC / "fuzz" / "fuzz_table.c"), str(DRIVER), "-o", str(exe),
-           "-lm"]
+    folder = tmp_path_factory.mktemp("engine_c")
+    exe = folder / "fuzz_driver"
+    generated = [str(p) for p in codegen.write(folder / "gen") if p.suffix == ".c"]  # the variable table
+    sources = sorted(str(p) for p in SOURCES.glob("*.c")) + generated
+    cmd = [gcc, *FLAGS, f"-I{INCLUDE}", f"-I{folder / 'gen'}", *sources, str(CSRC / "fuzz" / "fuzz_table.c"),
+           str(DRIVER), "-o", str(exe), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     return exe

@@ -1,0 +1,116 @@
+/* The solvers of the consistent formulation: one contract, Runge-Kutta methods as data.
+ *
+ * In the style of scipy's integrate/_ivp: an explicit Runge-Kutta method is its
+ * Butcher tableau (CamTableau) over one generic step (cam_rk_step), with an
+ * embedded error estimate where the tableau has one. A method that is not a
+ * plain tableau (etdrk4: exponential, exact on the electrical pole) provides its
+ * own step function with the same signature. One communication-step driver
+ * (cam_integrate) serves every method: profile breakpoints, event location
+ * (Illinois false position on re-stepped trial states), transitions, the work
+ * bound max_steps and its message, and rollback to the state before the step
+ * when the step is refused.
+ *
+ * Order of operations: the generic step evaluates a stage's increment as
+ * x + h * (a_1 k_1 + a_2 k_2 + ...) summed left to right over the nonzero
+ * coefficients only, except a row with a single nonzero coefficient, which is
+ * x + (h a) k; the error as h * (e_1 k_1 + ...). This is the order of the
+ * former Python/Cython kernel, so results agree with it to the last bit.
+ *
+ * C99, libc and libm only, no globals: the tableaus are const data.
+ */
+#ifndef CAM_SOLVER_H
+#define CAM_SOLVER_H
+
+#include "cam_model.h"
+
+#define CAM_MAX_STAGES 7
+
+/* An explicit Runge-Kutta method as data. */
+typedef struct {
+    int stages;                                   /* s: stages computed per step (FSAL stage excluded) */
+    double a[CAM_MAX_STAGES][CAM_MAX_STAGES];     /* a[i][j], j < i */
+    double b[CAM_MAX_STAGES];                     /* weights of the solution */
+    double c[CAM_MAX_STAGES];                     /* nodes (unused by autonomous stages; documentation) */
+    int fsal;                                     /* 1: f at the new state is stage s + 1 (first same as last) */
+    double e[CAM_MAX_STAGES + 1];                 /* error weights b - b_hat, the FSAL stage last; all 0: none */
+    double error_exponent;                        /* -1/(q+1) for an embedded pair of order q (dopri5: -0.2) */
+} CamTableau;
+
+/* Scratch of one step: the stages, the new state, its error and f at it. */
+typedef struct {
+    double k[CAM_MAX_STAGES + 1][CAM_NX];         /* k[0] = f(x) on entry (k1) */
+    double x_new[CAM_NX];
+    double error[CAM_NX];
+    double f_new[CAM_NX];                         /* f(x_new), valid when the method is FSAL */
+} CamStepWork;
+
+struct CamMethod;
+
+/* One step of size h [s] from x (mode and input u fixed, w->k[0] = f(x) already): x_new, and for an
+ * embedded pair error and f_new, into w. */
+typedef void (*CamStepFunction)(const struct CamMethod *method, const CamModel *m, const CamMode *mode,
+                                const double x[CAM_NX], double u, double h, CamStepWork *w);
+
+/* One solver (the parameter ``solver``). */
+typedef struct CamMethod {
+    const char *name;                 /* 'euler', 'rk4', 'rk45', 'etdrk4' */
+    const CamTableau *tableau;        /* NULL for a method with its own step */
+    CamStepFunction step;             /* cam_rk_step for a tableau method */
+    int adaptive;                     /* 1: error control on rtol, atol (needs tableau->e) */
+    double stability;                 /* h |lambda| allowed on the negative real axis (fixed step) */
+    double resolution;                /* fixed step: the cam turns at most this of the finest feature per step */
+    double max_sweep;                 /* fixed step without resolution: refuse a step sweeping more */
+    int exact_electrical_pole;        /* the pole -R/L needs no stability cut */
+} CamMethod;
+
+/* The method the parameter ``solver`` names (CAM_CHOICE_SOLVER_*), or NULL (methods.c). */
+const CamMethod *cam_method(int solver_choice);
+
+/* The tableaus: const data (no mutable state), Dormand-Prince 5(4) in rk.c. */
+extern const CamTableau cam_dopri5;
+
+/* The generic explicit Runge-Kutta step over method->tableau. */
+void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX],
+                 double u, double h, CamStepWork *w);
+
+/* The error norm of an embedded step: RMS over the nx slots of error / (atol + rtol max(|x|, |x_new|)),
+ * theta's scale capped at 2 pi (it enters the physics mod 2 pi). */
+double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w);
+
+/* What the communication-step driver keeps between its internal steps. */
+typedef struct {
+    const CamMethod *method;
+    CamStepWork work;
+    double x_end[CAM_NX];       /* the accepted step's end state */
+    double f_end[CAM_NX];       /* f there (valid when the step was a full FSAL step) */
+    double x_hit[CAM_NX];       /* locate: the state just past the zero */
+    double before[CAM_MAX_EVENTS], after[CAM_MAX_EVENTS];
+    int codes[CAM_MAX_EVENTS];
+    int n_events;
+    int have_before;            /* before[] holds the values at the current x */
+    int hit;                    /* the code of the event first found */
+} CamIntegrator;
+
+/* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
+ * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is
+ * 1e-12 of it); below the floor: CAM_ERR_REJECTED with solvers/dopri.py's message. */
+int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt,
+                      CamError *err);
+
+/* One fixed step inside the method's stability and resolution limits along the whole step:
+ * its length [s], the end state in it->x_end; the retries it took into *retries. */
+int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt, long *retries, CamError *err);
+
+/* The zero of event ``code`` (or, code -1, of the gap direction (target - theta)) in (0, dt] by Illinois
+ * false position on trial steps from d->x; it->x_hit holds the state at dt on entry and the state just
+ * past the zero on return; returns its time from the step start [s]. */
+double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, double g_lo, double g_hi, double dt);
+
+/* Advance the consistent formulation's state d->x, d->mode by one communication step h [s] from
+ * ``time`` with the method of d->model.solver: every step ends at the profile breakpoint it would
+ * cross and at the located zero of the first event, whose transition is cam_apply_event. More than
+ * max_steps internal steps: CAM_ERR_REJECTED naming the setting (hybrid.py's message). On any error
+ * the state, mode and solver state are as before the call. */
+int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err);
+
+#endif

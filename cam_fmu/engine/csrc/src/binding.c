@@ -1,0 +1,42 @@
+/* Accessors for bindings that hold the engine's structures as opaque memory (the ctypes binding). */
+#include "cam_model.h"
+
+size_t cam_params_sizeof(void)
+{
+    return sizeof(CamParams);
+}
+
+size_t cam_drive_sizeof(void)
+{
+    return sizeof(CamDrive);
+}
+
+size_t cam_model_sizeof(void)
+{
+    return sizeof(CamModel);
+}
+
+double cam_drive_time(const CamDrive *d)
+{
+    return d->time;
+}
+
+long cam_drive_steps_taken(const CamDrive *d)
+{
+    return d->steps_taken;
+}
+
+long cam_drive_last_steps(const CamDrive *d)
+{
+    return d->last_steps;
+}
+
+int cam_drive_nx(const CamDrive *d)
+{
+    return d->model.nx;
+}
+
+double *cam_drive_values(CamDrive *d)
+{
+    return d->values;
+}

@@ -1,0 +1,155 @@
+/* One cam drive stepped from one communication point to the next (fmu/engine.py DriveSimulator): the
+ * time, the inputs, the formulation and its checks on every published state. Holds no physics. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cam_solver.h"
+
+int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
+{
+    int status;
+    memset(d, 0, sizeof *d);
+    if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
+        return status;
+    d->form = cam_formulation(d->model.formulation);
+    if (d->form == NULL || (d->model.formulation == CAM_FORM_CONSISTENT && cam_method(d->model.solver) == NULL)) {
+        const char *what = d->form == NULL ? (d->model.formulation == CAM_FORM_SPEED ? "the speed drive"
+                                              : "formulation 'paper'") : "this solver";
+        status = cam_error(err, CAM_ERR_PARAMETER, "%s is not yet available in the C engine (solver '%s')", what,
+                           cam_param_spec(CAM_P_SOLVER)->choices[d->model.solver]);
+        cam_model_free(&d->model);
+        return status;
+    }
+    d->time = 0.0;
+    d->u = cam_input_spec(CAM_I_U)->start;
+    d->omega_ref = cam_input_spec(CAM_I_OMEGA_REF)->start;
+    d->omega_dot_ref = cam_input_spec(CAM_I_OMEGA_DOT_REF)->start;
+    d->solver.h_next = 1e-4 < d->model.h_max ? 1e-4 : d->model.h_max;
+    if ((status = d->form->init(d, err)) != CAM_OK) {
+        cam_model_free(&d->model);
+        return status;
+    }
+    d->stale = 1;
+    return CAM_OK;
+}
+
+void cam_drive_free(CamDrive *d)
+{
+    cam_model_free(&d->model);
+}
+
+static int check_input(int index, double value, CamError *err)
+{
+    const CamVariableSpec *s = cam_input_spec(index);
+    char shown[40];
+    if (s->low <= value && value <= s->high)
+        return CAM_OK;
+    return cam_error(err, CAM_ERR_SIMULATION, "input '%s' = %s [%s] is outside the allowed range [%g, %g] %s", s->name,
+                    cam_num(value, shown), s->unit, s->low, s->high, s->unit);
+}
+
+int cam_drive_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref, CamError *err)
+{
+    int status;
+    if ((status = check_input(CAM_I_U, u, err)) != CAM_OK || (status = check_input(CAM_I_OMEGA_REF, omega_ref, err))
+        || (status = check_input(CAM_I_OMEGA_DOT_REF, omega_dot_ref, err)))
+        return status;
+    d->u = u;
+    d->omega_ref = omega_ref;
+    d->omega_dot_ref = omega_dot_ref;
+    d->form->set_inputs(d, u, omega_ref, omega_dot_ref);
+    d->stale = 1;
+    return CAM_OK;
+}
+
+/* The error a guard's verdict on a step's outputs stands for, naming the cause. */
+static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
+{
+    char advice[512], shown[40];
+    const CamParamSpec *solver = cam_param_spec(CAM_P_SOLVER);
+    int k;
+    if (verdict == CAM_PUBLISH_NOT_FINITE) {
+        for (k = 0; k < CAM_N_OUTPUTS && isfinite(out[k]); k++)
+            ;
+        if (k == CAM_N_OUTPUTS)   /* every output finite, their sum overflowed (DriveSimulator had no message) */
+            return cam_error(err, CAM_ERR_SIMULATION, "the outputs at t = %g s are too large to check (their sum "
+                             "is not finite) with solver '%s', h_max = %g s: reduce h_max or use 'rk45'/'etdrk4'",
+                             d->time, solver->choices[d->model.solver], d->model.h_max);
+        return cam_error(err, CAM_ERR_SIMULATION, "output '%s' became %s at t = %g s with solver '%s', h_max = %g s: "
+                        "reduce h_max or use 'rk45'/'etdrk4'", cam_output_spec(k)->name,
+                        cam_num(out[k], shown), d->time, solver->choices[d->model.solver],
+                        d->model.h_max);
+    }
+    d->form->advice(d, advice, sizeof advice);
+    if (verdict == CAM_PUBLISH_CLEARANCE)
+        return cam_error(err, CAM_ERR_SIMULATION, "the follower is %.6g m from the cam at t = %g s, beyond the "
+                        "clearance c = %g m: a contact event was missed; %s", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]),
+                        d->time, d->model.c, advice);
+    {
+        double excess, tolerance;
+        cam_energy_excess(&d->budget, out[CAM_O_OMEGA], out[CAM_O_S], out[CAM_O_J], out[CAM_O_I], &excess,
+                          &tolerance);
+        return cam_error(err, CAM_ERR_SIMULATION, "the state at t = %g s holds %.6g J more energy than the source "
+                        "delivered (tolerance %.3g J): energy was created, the result cannot be trusted; %s", d->time,
+                        excess, tolerance, advice);
+    }
+}
+
+int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_ref, double omega_dot_ref,
+                      CamError *err)
+{
+    double out[CAM_N_OUTPUTS];
+    char shown[40];
+    long steps = 0;
+    int status, verdict;
+    if (!(h > 0.0 && isfinite(h)))
+        return cam_error(err, CAM_ERR_SIMULATION, "communication step size = %s s: allowed (0, inf)",
+                        cam_num(h, shown));
+    if ((status = cam_drive_set_inputs(d, u, omega_ref, omega_dot_ref, err)) != CAM_OK)
+        return status;
+    if (!d->have_budget && d->form->energy_bounded) {
+        if (d->stale)
+            d->form->outputs(d, d->values);
+        cam_energy_init(&d->budget, &d->model, d->values[CAM_O_THETA], d->values[CAM_O_OMEGA], d->values[CAM_O_I],
+                        d->values[CAM_O_S], d->values[CAM_O_J]);
+        d->have_budget = 1;
+    }
+    if ((status = d->form->advance(d, h, d->time, &steps, err)) != CAM_OK)
+        return status;
+    d->form->outputs(d, out);
+    verdict = cam_publishable(&d->model, out, d->have_budget ? &d->budget : NULL, d->u, h);
+    d->last_steps = steps;
+    d->steps_taken += steps;
+    d->time = t + h;
+    if (verdict != CAM_PUBLISH_OK)
+        return refuse(d, verdict, out, err);
+    memcpy(d->values, out, sizeof out);
+    d->stale = 0;
+    return CAM_OK;
+}
+
+const double *cam_drive_outputs(CamDrive *d)
+{
+    if (d->stale) {
+        d->form->outputs(d, d->values);
+        d->stale = 0;
+    }
+    return d->values;
+}
+
+int cam_drive_run(CamDrive *d, long n_steps, const double *table, double *out, long *done, CamError *err)
+{
+    long k;
+    int status;
+    *done = 0;
+    for (k = 0; k < n_steps; k++) {
+        const double *row = table + 5 * k;
+        status = cam_drive_do_step(d, row[0], row[1], row[2], row[3], row[4], err);
+        if (status != CAM_OK)
+            return status;
+        memcpy(out + (size_t)CAM_N_OUTPUTS * (size_t)k, d->values, sizeof d->values);
+        *done = k + 1;
+    }
+    return CAM_OK;
+}

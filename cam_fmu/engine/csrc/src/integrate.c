@@ -1,0 +1,281 @@
+/* One communication step of the consistent formulation with any method: adaptive steps with error
+ * control (or fixed steps inside the method's limits), profile breakpoints, events located by Illinois
+ * false position on re-stepped trial states, transitions, the work bound max_steps, rollback.
+ *
+ * Ported from the former kernel (drive_kernel.DriveKernel: attempt, trial, locate, first_event,
+ * advance) with the order of floating-point operations kept: rk45 agrees with it to the last bit. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cam_solver.h"
+
+#define EVENT_ITERATIONS 60   /* Illinois iterations at most per located zero */
+
+/* f(x) into d->solver.k1 unless it is valid already. */
+static void ensure_k1(CamDrive *d, double u)
+{
+    if (!d->solver.k1_valid) {
+        cam_rhs(&d->model, &d->mode, d->x, u, d->solver.k1);
+        d->solver.k1_valid = 1;
+    }
+}
+
+/* One step of the method of size h from d->x into it->work (k1 valid). */
+static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
+{
+    memcpy(it->work.k[0], d->solver.k1, sizeof d->solver.k1);
+    it->method->step(it->method, &d->model, &d->mode, d->x, u, h, &it->work);
+}
+
+int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt_out,
+                      CamError *err)
+{
+    const CamModel *m = &d->model;
+    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u, norm, factor, t;
+    if (remaining < dt)
+        dt = remaining;
+    if (m->h_max < dt)
+        dt = m->h_max;
+    ensure_k1(d, u);
+    for (;;) {
+        method_step(d, it, dt, u);
+        norm = cam_error_norm(m, d->x, &it->work);
+        if (norm <= 1.0) {
+            if (norm == 0.0) {
+                factor = 5.0;
+            } else {
+                t = 0.9 * pow(norm, it->method->tableau->error_exponent);
+                factor = t < 5.0 ? t : 5.0;
+            }
+            if (dt < remaining || factor < 1.0) {
+                t = dt * factor;
+                d->solver.h_next = 1e3 < t ? 1e3 : t;
+            } else {
+                t = dt * (1.0 < factor ? 1.0 : factor);
+                d->solver.h_next = t > d->solver.h_next ? t : d->solver.h_next;
+            }
+            memcpy(it->x_end, it->work.x_new, sizeof it->x_end);
+            memcpy(it->f_end, it->work.f_new, sizeof it->f_end);
+            *dt_out = dt;
+            return CAM_OK;
+        }
+        if (!isfinite(norm))
+            norm = 1e10;
+        t = 0.9 * pow(norm, it->method->tableau->error_exponent);
+        dt *= t > 0.1 ? t : 0.1;
+        if (dt < floor_) {
+            char a[32], b[32], c[32], e[32];
+            snprintf(a, sizeof a, "%g", m->rtol);
+            snprintf(b, sizeof b, "%g", m->atol);
+            snprintf(c, sizeof c, "%g", floor_);
+            snprintf(e, sizeof e, "%g", time);
+            *dt_out = dt;
+            return cam_error(err, CAM_ERR_REJECTED,
+                            "solver 'rk45' cannot meet rtol = %s, atol = %s: its step fell below %s s (1e-12 of "
+                            "the communication step) at t = %s s: loosen rtol/atol, or check the inputs and "
+                            "parameters for a near-singular drive", a, b, c, e);
+        }
+    }
+}
+
+/* The state tau [s] into the current step, into it->work.x_new (moving: a step; stuck: exact). */
+static void trial(CamDrive *d, CamIntegrator *it, double tau, double u)
+{
+    if (d->mode.stuck) {
+        it->work.x_new[CAM_THETA] = d->x[CAM_THETA];
+        it->work.x_new[CAM_OMEGA] = 0.0;
+        it->work.x_new[CAM_CURRENT] = cam_current_at_rest(&d->model, d->x[CAM_CURRENT], u, tau);
+    } else {
+        method_step(d, it, tau, u);
+    }
+}
+
+static double zero_value(CamDrive *d, int code, double target, const double x[CAM_NX], double u)
+{
+    if (code < 0)
+        return d->mode.direction * (target - x[CAM_THETA]);
+    return cam_event_value(&d->model, &d->mode, code, x, u);
+}
+
+double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, double g_lo, double g_hi, double dt)
+{
+    double lo = 0.0, hi = dt, tau, g_tau, u = d->u;
+    int side = 0, k;
+    for (k = 0; k < EVENT_ITERATIONS; k++) {
+        if (hi - lo <= 1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15)
+            break;
+        tau = g_hi != g_lo ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
+        if (!(lo < tau && tau < hi))
+            tau = 0.5 * (lo + hi);
+        trial(d, it, tau, u);
+        g_tau = zero_value(d, code, target, it->work.x_new, u);
+        if (g_tau <= 0.0) {
+            hi = tau;
+            g_hi = g_tau;
+            memcpy(it->x_hit, it->work.x_new, sizeof it->x_hit);
+            if (side == -1)
+                g_lo *= 0.5;
+            side = -1;
+        } else {
+            lo = tau;
+            g_lo = g_tau;
+            if (side == 1)
+                g_hi *= 0.5;
+            side = 1;
+        }
+    }
+    return hi;
+}
+
+/* The earliest event in (0, dt] of the step from d->x to it->x_end: its time from the step start [s],
+ * its code in it->hit and the state there in it->x_hit; or -1 (none). A function at or below zero at
+ * the start fires at once if it goes into the event (g1 < 0, or it started below zero). */
+static double first_event(CamDrive *d, CamIntegrator *it, double dt)
+{
+    int n = it->n_events, k;
+    double best = -1.0, tau, b[CAM_NX] = {0.0, 0.0, 0.0}, u = d->u;
+    if (!it->have_before)
+        for (k = 0; k < n; k++)
+            it->before[k] = cam_event_value(&d->model, &d->mode, it->codes[k], d->x, u);
+    it->have_before = 0;
+    if (n == 0)
+        return -1.0;
+    for (k = 0; k < n; k++)
+        it->after[k] = cam_event_value(&d->model, &d->mode, it->codes[k], it->x_end, u);
+    for (k = 0; k < n; k++)
+        if (it->before[k] < 0.0 || (it->before[k] == 0.0 && it->after[k] < 0.0)) {
+            it->hit = it->codes[k];
+            memcpy(it->x_hit, d->x, sizeof it->x_hit);
+            return 0.0;
+        }
+    for (k = 0; k < n; k++)
+        if (it->before[k] > 0.0 && it->after[k] <= 0.0) {
+            memcpy(it->x_hit, it->x_end, sizeof it->x_hit);
+            tau = cam_locate(d, it, it->codes[k], 0.0, it->before[k], it->after[k], dt);
+            if (best < 0.0 || tau < best) {
+                best = tau;
+                it->hit = it->codes[k];
+                memcpy(b, it->x_hit, sizeof b);
+            }
+        }
+    if (best < 0.0) {
+        for (k = 0; k < n; k++)
+            it->before[k] = it->after[k];
+        it->have_before = 1;   /* the next step starts where this one ended */
+        return -1.0;
+    }
+    memcpy(it->x_hit, b, sizeof b);
+    return best;
+}
+
+static int max_steps_error(const CamDrive *d, const CamMethod *method, double time, double h, CamError *err)
+{
+    const CamModel *m = &d->model;
+    char advice[256];
+    if (method->adaptive)
+        snprintf(advice, sizeof advice, "raise max_steps, loosen rtol/atol or shorten the communication step%s",
+                 m->has_current && !method->exact_electrical_pole
+                     ? "; with L > 0 the electrical pole is stiff: use solver 'etdrk4'" : "");
+    else
+        snprintf(advice, sizeof advice, "raise max_steps or h_max (now %g s), or shorten the communication step; "
+                 "'%s' takes steps no longer than its stability limit", m->h_max, method->name);
+    return cam_error(err, CAM_ERR_REJECTED, "solver '%s' needed more than max_steps = %ld internal steps in one "
+                    "communication step of %g s at t = %g s: %s", method->name, m->max_steps, h, time, advice);
+}
+
+/* The loop of one communication step (the state saved by the caller). */
+static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *steps_out, CamError *err)
+{
+    const CamModel *m = &d->model;
+    double t = 0.0, u = d->u, remaining, dt, target, cut, tau;
+    long steps = 0, retries;
+    int was_stuck = d->mode.stuck, next_valid, status;
+    it->have_before = 0;
+    cam_settle(m, &d->mode, d->x, u, 0);
+    if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck))
+        d->solver.k1_valid = 0;
+    it->n_events = cam_event_codes(m, &d->mode, it->codes);
+    while (h - t > 1e-12 * h) {
+        if (d->mode.stuck && !m->has_current)
+            break;   /* nothing evolves until the input changes */
+        steps += 1;
+        if (steps > m->max_steps) {
+            *steps_out = steps;
+            return max_steps_error(d, it->method, time + t, h, err);
+        }
+        remaining = h - t;
+        next_valid = 0;   /* does it->f_end hold f at the step's end? */
+        if (d->mode.stuck) {
+            dt = remaining;
+            it->x_end[CAM_THETA] = d->x[CAM_THETA];
+            it->x_end[CAM_OMEGA] = 0.0;
+            it->x_end[CAM_CURRENT] = cam_current_at_rest(m, d->x[CAM_CURRENT], u, dt);
+        } else {
+            if (it->method->adaptive) {
+                status = cam_step_adaptive(d, it, remaining, time + t, h, &dt, err);
+                next_valid = 1;
+            } else {
+                ensure_k1(d, u);
+                status = cam_step_fixed(d, it, remaining, &dt, &retries, err);
+                steps += retries;
+                next_valid = it->method->tableau != NULL && it->method->tableau->fsal;
+            }
+            if (status != CAM_OK) {
+                *steps_out = steps;
+                return status;
+            }
+            target = cam_profile_first_breakpoint(&m->profile, d->x[CAM_THETA], it->x_end[CAM_THETA]);
+            if (target == target) {   /* the step crosses a breakpoint and ends just past it */
+                memcpy(it->x_hit, it->x_end, sizeof it->x_hit);
+                cut = cam_locate(d, it, -1, target, d->mode.direction * (target - d->x[CAM_THETA]),
+                                 d->mode.direction * (target - it->x_end[CAM_THETA]), dt);
+                if (cut != dt) {   /* its first-same-as-last derivative belonged to the longer step */
+                    dt = cut;
+                    memcpy(it->x_end, it->x_hit, sizeof it->x_end);
+                    next_valid = 0;
+                }
+            }
+        }
+        tau = first_event(d, it, dt);
+        if (tau < 0.0) {
+            memcpy(d->x, it->x_end, sizeof d->x);
+            t += dt;
+            d->solver.k1_valid = next_valid;
+            if (next_valid)
+                memcpy(d->solver.k1, it->f_end, sizeof d->solver.k1);
+            continue;
+        }
+        memcpy(d->x, it->x_hit, sizeof d->x);
+        t += tau;
+        d->solver.k1_valid = 0;
+        cam_apply_event(m, &d->mode, d->x, it->hit, u);
+        it->n_events = cam_event_codes(m, &d->mode, it->codes);
+        it->have_before = 0;
+    }
+    if (d->mode.stuck)
+        d->solver.k1_valid = 0;
+    d->solver.fsal_u = u;
+    *steps_out = steps;
+    return CAM_OK;
+}
+
+int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err)
+{
+    CamIntegrator it;
+    double x[CAM_NX];
+    CamMode mode = d->mode;
+    int status;
+    memset(&it, 0, sizeof it);
+    it.method = cam_method(d->model.solver);
+    if (it.method == NULL)
+        return cam_error(err, CAM_ERR_SIMULATION, "solver choice %d is not available in the engine", d->model.solver);
+    memcpy(x, d->x, sizeof x);
+    status = advance(d, &it, h, time, steps, err);
+    if (status != CAM_OK) {   /* a refused step leaves the state as before it (fmi2Discard) */
+        memcpy(d->x, x, sizeof x);
+        d->mode = mode;
+        d->solver.k1_valid = 0;
+    }
+    return status;
+}

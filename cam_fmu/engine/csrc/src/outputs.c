@@ -1,0 +1,97 @@
+/* Outputs of the consistent formulation and the guards every published state passes: finite, the
+ * follower within the clearance, the energy bound (physics/energy.py; docs/model.md section 9). */
+#include <math.h>
+
+#include "cam_model.h"
+
+void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double omega_dot,
+                 int known, double out[])
+{
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA];
+    double i = m->has_current ? x[CAM_CURRENT] : (u - m->c_e * omega) / m->R;
+    int engaged = mode->contact != 0;
+    CamLoad load;
+    if (mode->stuck) {
+        cam_load(m, theta, 0.0, 0.0, 0.0, engaged, &load);
+        load.M = m->c_m * i;   /* static friction takes whatever the motor applies */
+        load.v = load.a = 0.0;
+    } else {
+        if (!known) {
+            double dx[CAM_NX];
+            cam_rhs(m, mode, x, u, dx);
+            omega_dot = dx[CAM_OMEGA];
+        }
+        cam_load(m, theta, omega, omega_dot, mode->direction, engaged, &load);
+    }
+    out[CAM_O_OMEGA] = omega;
+    out[CAM_O_THETA] = theta;
+    out[CAM_O_S] = engaged ? load.s_cam - m->c * mode->contact : mode->s_free;
+    out[CAM_O_I] = i;
+    out[CAM_O_M] = load.M;
+    out[CAM_O_J] = load.J;
+    out[CAM_O_V] = load.v;
+    out[CAM_O_A] = load.a;
+    out[CAM_O_ALPHA] = load.alpha;
+    out[CAM_O_S_CAM] = load.s_cam;
+    out[CAM_O_VOLTAGE] = u;
+}
+
+static double mechanical(const CamEnergy *e, double omega, double s, double J)
+{
+    return 0.5 * J * omega * omega - e->F_gx * s;
+}
+
+void cam_energy_init(CamEnergy *e, const CamModel *m, double theta, double omega, double i, double s, double J)
+{
+    e->c_e = m->c_e;
+    e->L = m->L;
+    e->R = m->R;
+    e->F_gx = m->F_gx;
+    e->ratio = m->c_m / m->c_e;
+    e->work_in = 0.0;
+    e->work_abs = 0.0;
+    e->theta = theta;
+    e->i = i;
+    e->e_mech0 = mechanical(e, omega, s, J);
+    e->e_mag0 = 0.5 * e->L * i * i;
+}
+
+void cam_energy_step(CamEnergy *e, double u, double h, double theta, double i)
+{
+    double w = u * (u * h - e->c_e * (theta - e->theta) - e->L * (i - e->i)) / e->R;
+    e->work_in += w;
+    e->work_abs += fabs(w);
+    e->theta = theta;
+    e->i = i;
+}
+
+void cam_energy_excess(const CamEnergy *e, double omega, double s, double J, double i, double *excess,
+                       double *tolerance)
+{
+    double e_mech = mechanical(e, omega, s, J);
+    double e_mag = 0.5 * e->L * i * i;
+    double lhs = (e_mech - e->e_mech0) + e->ratio * (e_mag - e->e_mag0);
+    double rhs = e->ratio * e->work_in;
+    double scale = fabs(e->e_mech0) + fabs(e_mech) + e->ratio * (e->work_abs + e->e_mag0 + e_mag) + 1e-12;
+    *excess = lhs - rhs;
+    *tolerance = CAM_ENERGY_SLACK * scale;
+}
+
+int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, double u, double h)
+{
+    double total = 0.0, excess, tolerance;
+    int k;
+    for (k = 0; k < CAM_N_OUTPUTS; k++)
+        total += out[k];
+    if (!isfinite(total))
+        return CAM_PUBLISH_NOT_FINITE;
+    if (fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) > m->c * (1.0 + 1e-9) + 1e-12)
+        return CAM_PUBLISH_CLEARANCE;
+    if (budget != NULL) {
+        cam_energy_step(budget, u, h, out[CAM_O_THETA], out[CAM_O_I]);
+        cam_energy_excess(budget, out[CAM_O_OMEGA], out[CAM_O_S], out[CAM_O_J], out[CAM_O_I], &excess, &tolerance);
+        if (excess - tolerance > 0.0)
+            return CAM_PUBLISH_ENERGY;
+    }
+    return CAM_PUBLISH_OK;
+}

@@ -1,0 +1,92 @@
+/* Explicit Runge-Kutta methods as data over one generic step, and the error norm of embedded pairs.
+ *
+ * The stage increments are summed left to right over the nonzero coefficients only; a row with a
+ * single nonzero coefficient a is applied as x + (h a) k. That is the order of the former kernel's
+ * Dormand-Prince step, so rk45 agrees with it to the last bit. */
+#include <math.h>
+
+#include "cam_solver.h"
+
+#define TWO_PI (2.0 * 3.141592653589793)
+
+/* Dormand-Prince 5(4) (Hairer, Norsett, Wanner, Solving ODE I, table 5.2); e = b5 - b4. */
+const CamTableau cam_dopri5 = {
+    6,
+    {{0.0},
+     {1.0 / 5.0},
+     {3.0 / 40.0, 9.0 / 40.0},
+     {44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0},
+     {19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0},
+     {9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0}},
+    {35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0},
+    {0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0},
+    1,
+    {71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0},
+    -0.2,
+};
+
+/* h * sum_j coef[j] k[j] + x for slot i over the nonzero coefficients (see the file's comment). */
+static double increment(const double *coef, int n, double (*k)[CAM_NX], int slot, double x, double h)
+{
+    double sum = 0.0;
+    int j, terms = 0, only = -1;
+    for (j = 0; j < n; j++)
+        if (coef[j] != 0.0) {
+            terms++;
+            only = j;
+        }
+    if (terms == 0)
+        return x;
+    if (terms == 1)
+        return x + h * coef[only] * k[only][slot];
+    terms = 0;
+    for (j = 0; j < n; j++) {
+        if (coef[j] == 0.0)
+            continue;
+        if (terms++ == 0)
+            sum = coef[j] * k[j][slot];
+        else
+            sum += coef[j] * k[j][slot];
+    }
+    return x + h * sum;
+}
+
+void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u,
+                 double h, CamStepWork *w)
+{
+    const CamTableau *t = method->tableau;
+    double arg[CAM_NX];
+    int i, slot, s = t->stages;
+    for (i = 1; i < s; i++) {
+        for (slot = 0; slot < CAM_NX; slot++)
+            arg[slot] = increment(t->a[i], i, w->k, slot, x[slot], h);
+        cam_rhs(m, mode, arg, u, w->k[i]);
+    }
+    for (slot = 0; slot < CAM_NX; slot++)
+        w->x_new[slot] = increment(t->b, s, w->k, slot, x[slot], h);
+    if (t->fsal) {
+        cam_rhs(m, mode, w->x_new, u, w->k[s]);
+        for (slot = 0; slot < CAM_NX; slot++)
+            w->f_new[slot] = w->k[s][slot];
+    }
+    if (method->adaptive) {   /* the error h * sum e_j k_j, the FSAL stage included */
+        for (slot = 0; slot < CAM_NX; slot++)
+            w->error[slot] = increment(t->e, s + (t->fsal ? 1 : 0), w->k, slot, 0.0, h);
+    }
+}
+
+double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w)
+{
+    double total = 0.0, scale, atol = m->atol, rtol = m->rtol;
+    int slot;
+    for (slot = 0; slot < m->nx; slot++) {
+        scale = fabs(w->x_new[slot]) > fabs(x[slot]) ? fabs(w->x_new[slot]) : fabs(x[slot]);
+        if (slot == CAM_THETA && TWO_PI < scale)   /* theta enters the physics mod 2 pi */
+            scale = TWO_PI;
+        if (slot == 0)
+            total = pow(w->error[slot] / (atol + rtol * scale), 2.0);
+        else
+            total += pow(w->error[slot] / (atol + rtol * scale), 2.0);
+    }
+    return sqrt(total / m->nx);
+}

@@ -1,0 +1,165 @@
+/* The consistent formulation's discrete side: event indicators and the transitions at events and at
+ * rest (physics/formulations/consistent.py: HybridDrive; docs/model.md sections 5-6), ported with the
+ * order of floating-point operations kept. */
+#include <math.h>
+
+#include "cam_model.h"
+
+int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENTS])
+{
+    int n = 0;
+    if (mode->stuck) {
+        if (m->has_current)
+            codes[n++] = CAM_EV_BREAK_AWAY;
+    } else if (m->backlash && mode->contact == 0) {
+        codes[n++] = CAM_EV_STOP;
+        codes[n++] = CAM_EV_ENGAGE_UP;
+        codes[n++] = CAM_EV_ENGAGE_DOWN;
+    } else {
+        codes[n++] = CAM_EV_STOP;
+        if (m->backlash)
+            codes[n++] = CAM_EV_CONTACT;
+        if (m->guide_side)
+            codes[n++] = CAM_EV_SIDE;
+    }
+    return n;
+}
+
+double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double i, double u)
+{
+    double torque = cam_torque(m, 0.0, i, u);
+    int engaged = mode->contact != 0;
+    double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged, 0.0);
+    double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged, 0.0);
+    return backward > forward ? backward : forward;
+}
+
+double cam_event_value(const CamModel *m, const CamMode *mode, int code, const double x[CAM_NX], double u)
+{
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], d[4];
+    if (code == CAM_EV_STOP)
+        return omega * mode->direction;
+    if (code == CAM_EV_SIDE)
+        return mode->side * cam_side_force(m, theta, omega, cam_torque(m, omega, i, u), mode->direction, mode->side)
+               + CAM_SIDE_HYSTERESIS;
+    if (code == CAM_EV_BREAK_AWAY)
+        return -cam_breakaway_margin(m, mode, theta, i, u);
+    cam_profile_eval(&m->profile, theta, d);
+    if (code == CAM_EV_ENGAGE_UP)
+        return mode->s_free - (d[0] - m->c);
+    if (code == CAM_EV_ENGAGE_DOWN)
+        return (d[0] + m->c) - mode->s_free;
+    /* CONTACT: s' times the direction held between events, not times omega: at a stop omega = 0
+     * would zero both functions at once; the stop decides there. */
+    return mode->contact * d[1] * mode->direction;
+}
+
+void cam_initial(const CamModel *m, double theta0, double omega0, double i0, double x[CAM_NX], CamMode *mode)
+{
+    x[CAM_THETA] = theta0;
+    x[CAM_OMEGA] = omega0;
+    x[CAM_CURRENT] = m->has_current ? i0 : 0.0;
+    mode->stuck = omega0 == 0.0;
+    mode->direction = omega0 >= 0.0 ? 1.0 : -1.0;
+    mode->contact = 1;
+    mode->s_free = 0.0;
+    mode->side = 1.0;
+    if (m->backlash) {   /* the paper's step 1: the follower starts where the cam is, centred in the gap */
+        double d[4];
+        cam_profile_eval(&m->profile, theta0, d);
+        mode->contact = 0;
+        mode->s_free = d[0];
+    }
+}
+
+void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], double u)
+{
+    if (m->guide_side && mode->contact != 0 && !mode->stuck) {
+        double n_r = cam_side_force(m, x[CAM_THETA], x[CAM_OMEGA], cam_torque(m, x[CAM_OMEGA], x[CAM_CURRENT], u),
+                                    mode->direction, 0.0);
+        if (fabs(n_r) > CAM_SIDE_HYSTERESIS)
+            mode->side = n_r < 0.0 ? -1.0 : 1.0;
+    }
+}
+
+/* At rest: stay stuck or start in the direction the torques allow (HybridDrive._settle_motion).
+ * at_threshold: at a located break-away, where the margin is zero to rounding; the shaft then starts
+ * toward the larger acceleration instead of waiting for the next communication step. */
+static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], double u, int at_threshold)
+{
+    double theta = x[CAM_THETA], torque = cam_torque(m, x[CAM_OMEGA], x[CAM_CURRENT], u), direction, d[4];
+    int engaged = mode->contact != 0, leaves = 0;
+    if (!mode->stuck) {
+        if (x[CAM_OMEGA] != 0.0)
+            return;
+        /* at rest but marked as moving: it goes on unless it now accelerates backwards */
+        if (mode->direction * cam_omega_dot(m, theta, 0.0, torque, mode->direction, engaged, 0.0) >= 0.0)
+            return;
+        mode->stuck = 1;
+    }
+    direction = cam_breakaway_direction(m, theta, torque, engaged);
+    if (direction == 0.0 && at_threshold) {
+        double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged, 0.0);
+        double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged, 0.0);
+        if (forward == backward && m->has_current) {
+            /* a tie (no shaft friction, zero torque as the current passes through 0): the shaft goes
+             * where the current is heading */
+            double rate = (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
+            direction = rate > 0.0 ? 1.0 : (rate < 0.0 ? -1.0 : 0.0);
+        } else {
+            direction = forward >= backward ? 1.0 : -1.0;
+        }
+    }
+    if (direction == 0.0)
+        return;
+    if (m->backlash && mode->contact != 0) {
+        cam_profile_eval(&m->profile, theta, d);
+        leaves = mode->contact * d[1] * direction < 0.0;   /* the cam would leave the follower */
+        /* starting that way is consistent only if the shaft, rid of the follower, still accelerates
+         * that way; else it stays at rest instead of chattering */
+        if (leaves && direction * cam_omega_dot(m, theta, 0.0, torque, direction, 0, 0.0) <= 0.0)
+            return;
+    }
+    mode->stuck = 0;
+    mode->direction = direction;
+    if (leaves) {
+        mode->s_free = d[0] - m->c * mode->contact;
+        mode->contact = 0;
+    }
+}
+
+void cam_settle(const CamModel *m, CamMode *mode, double x[CAM_NX], double u, int at_threshold)
+{
+    settle_motion(m, mode, x, u, at_threshold);
+    cam_choose_side(m, mode, x, u);
+}
+
+void cam_apply_event(const CamModel *m, CamMode *mode, double x[CAM_NX], int code, double u)
+{
+    double d[4];
+    switch (code) {
+    case CAM_EV_STOP:
+        x[CAM_OMEGA] = 0.0;
+        mode->stuck = 1;
+        cam_settle(m, mode, x, u, 0);
+        break;
+    case CAM_EV_BREAK_AWAY:
+        /* the located zero of the margin: the torque is at the threshold, so the shaft starts now */
+        cam_settle(m, mode, x, u, 1);
+        break;
+    case CAM_EV_SIDE:
+        mode->side = -mode->side;   /* N_r passed through zero: the other friction branch */
+        break;
+    case CAM_EV_CONTACT:
+        cam_profile_eval(&m->profile, x[CAM_THETA], d);
+        mode->s_free = d[0] - m->c * mode->contact;
+        mode->contact = 0;
+        break;
+    default:   /* ENGAGE_UP, ENGAGE_DOWN: a plastic impact keeps the generalised momentum J_m omega */
+        mode->contact = code == CAM_EV_ENGAGE_UP ? 1 : -1;
+        cam_profile_eval(&m->profile, x[CAM_THETA], d);
+        x[CAM_OMEGA] = m->J_m * x[CAM_OMEGA] / (m->J_m + m->m * d[1] * d[1]);
+        cam_choose_side(m, mode, x, u);
+        break;
+    }
+}

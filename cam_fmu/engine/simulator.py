@@ -1,0 +1,250 @@
+"""The C engine's drive from Python: ``EngineSimulator`` (DriveSimulator's public API) and ``run_scene``.
+
+The engine (``csrc/``) owns the state, the formulation, the solver and every
+check; this module converts parameters and states between Python values and
+the engine's, and turns the engine's errors into the exceptions of
+``cam_fmu.errors`` (and ``physics.parameters.ParameterError``) with the
+engine's message. Times in s, SI units throughout.
+"""
+from __future__ import annotations
+
+import ctypes
+import math
+from array import array
+from typing import Any, Mapping, Sequence
+
+from ..errors import SimulationError, StepRejected
+from ..physics.parameters import BY_NAME, ParameterError
+from ..physics.variables import INPUT_STARTS, OUTPUT_NAMES
+from .library import load
+
+__all__ = ["EngineSimulator", "run_scene"]
+
+N_OUTPUTS = len(OUTPUT_NAMES)
+MESSAGE_LEN = 1024
+STATE_LEN = 48
+# Slots of the engine's state array (cam_model.h, CAM_S_*).
+(S_VERSION, S_FORMULATION, S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF, S_H_NEXT, S_STEPS_TAKEN, S_X) = range(9)
+S_STUCK = S_X + 3
+S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE, S_FORM_U, S_HAVE_BUDGET = range(S_STUCK + 1, S_STUCK + 7)
+S_BUDGET = S_HAVE_BUDGET + 1  # work_in, work_abs, theta, i, e_mech0, e_mag0
+BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
+STATE_VERSION = 1.0
+
+
+class CamError(ctypes.Structure):
+    """The engine's error: its status (0 ok, 1 parameter, 2 simulation, 3 step rejected, 4 memory) and message."""
+
+    _fields_ = [("status", ctypes.c_int), ("message", ctypes.c_char * MESSAGE_LEN)]
+
+
+_P = ctypes.c_void_p
+_D = ctypes.POINTER(ctypes.c_double)
+_SIGNATURES = {
+    "cam_params_sizeof": (ctypes.c_size_t, []),
+    "cam_drive_sizeof": (ctypes.c_size_t, []),
+    "cam_params_defaults": (None, [_P]),
+    "cam_params_free": (None, [_P]),
+    "cam_param_index": (ctypes.c_int, [ctypes.c_char_p]),
+    "cam_params_unknown": (ctypes.c_int, [ctypes.c_char_p, _P]),
+    "cam_params_set_real": (ctypes.c_int, [_P, ctypes.c_int, ctypes.c_double, _P]),
+    "cam_params_set_string": (ctypes.c_int, [_P, ctypes.c_int, ctypes.c_char_p, ctypes.c_size_t, _P]),
+    "cam_drive_init": (ctypes.c_int, [_P, _P, _P]),
+    "cam_drive_free": (None, [_P]),
+    "cam_drive_set_inputs": (ctypes.c_int, [_P, ctypes.c_double, ctypes.c_double, ctypes.c_double, _P]),
+    "cam_drive_do_step": (ctypes.c_int, [_P, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
+                                         ctypes.c_double, _P]),
+    "cam_drive_outputs": (_D, [_P]),
+    "cam_drive_values": (_D, [_P]),
+    "cam_drive_get_state": (None, [_P, _D]),
+    "cam_drive_set_state": (ctypes.c_int, [_P, _D, _P]),
+    "cam_drive_run": (ctypes.c_int, [_P, ctypes.c_long, _D, _D, ctypes.POINTER(ctypes.c_long), _P]),
+    "cam_drive_time": (ctypes.c_double, [_P]),
+    "cam_drive_steps_taken": (ctypes.c_long, [_P]),
+    "cam_drive_last_steps": (ctypes.c_long, [_P]),
+    "cam_drive_nx": (ctypes.c_int, [_P]),
+}
+
+
+def engine() -> ctypes.CDLL:
+    """The engine library with the signatures of the functions this binding calls."""
+    lib = load()
+    if not getattr(lib, "_cam_signatures", False):
+        for name, (restype, argtypes) in _SIGNATURES.items():
+            function = getattr(lib, name)
+            function.restype, function.argtypes = restype, argtypes
+        lib._cam_signatures = True
+    return lib
+
+
+def raise_for(error: CamError) -> None:
+    """The exception of the engine's error status, with its message."""
+    message = error.message.decode("utf-8", "replace")
+    if error.status == 1:
+        raise ParameterError(message)
+    if error.status == 3:
+        raise StepRejected(message)
+    if error.status == 4:
+        raise MemoryError(message)
+    raise SimulationError(message)
+
+
+def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any, err: CamError) -> None:
+    index = lib.cam_param_index(name.encode())
+    if index < 0:
+        lib.cam_params_unknown(name.encode(), ctypes.byref(err))
+        raise_for(err)
+    kind = BY_NAME[name].kind
+    if kind == "string" and not isinstance(value, str):
+        value = BY_NAME[name].check(value)  # its message shows the value as given (3, not '3')
+    if kind == "string" or isinstance(value, str):
+        data = str(value).encode("utf-8")
+        status = lib.cam_params_set_string(params, index, data, len(data), ctypes.byref(err))
+    elif kind == "boolean":
+        status = lib.cam_params_set_real(params, index, 1.0 if bool(value) else 0.0, ctypes.byref(err))
+    else:
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"parameter {name!r} = {value!r} is not a number: "
+                                 f"allowed {BY_NAME[name].allowed()}") from None
+        status = lib.cam_params_set_real(params, index, number, ctypes.byref(err))
+    if status:
+        raise_for(err)
+
+
+class EngineSimulator:
+    """One cam drive in the C engine, advanced by ``do_step`` (DriveSimulator's API)."""
+
+    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+        self._lib = lib = engine()
+        self._err = CamError()
+        self._params = dict(params or {})
+        self._drive = None
+        raw = ctypes.create_string_buffer(lib.cam_params_sizeof())
+        lib.cam_params_defaults(raw)
+        try:
+            for name, value in self._params.items():
+                _set_parameter(lib, raw, name, value, self._err)
+            drive = ctypes.create_string_buffer(lib.cam_drive_sizeof())
+            if lib.cam_drive_init(drive, raw, ctypes.byref(self._err)):
+                raise_for(self._err)
+        finally:
+            lib.cam_params_free(raw)
+        self._drive = drive
+        self.values = (ctypes.c_double * N_OUTPUTS).from_address(
+            ctypes.addressof(lib.cam_drive_values(drive).contents))
+
+    def __del__(self) -> None:
+        if getattr(self, "_drive", None) is not None:
+            self._lib.cam_drive_free(self._drive)
+            self._drive = None
+
+    # ------------------------------------------------------------ public
+    @property
+    def time(self) -> float:
+        """s: the time reached."""
+        return self._lib.cam_drive_time(self._drive)
+
+    @property
+    def steps_taken(self) -> int:
+        """Internal steps taken so far (benchmarks)."""
+        return self._lib.cam_drive_steps_taken(self._drive)
+
+    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float = 0.0) -> None:
+        """Inputs used by ``outputs`` before the first step [V, rad/s, rad/s2]."""
+        if self._lib.cam_drive_set_inputs(self._drive, u, omega_ref, omega_dot_ref, ctypes.byref(self._err)):
+            raise_for(self._err)
+
+    def do_step(self, t: float, h: float, u: float = INPUT_STARTS["u"],
+                omega_ref: float = INPUT_STARTS["omega_ref"], omega_dot_ref: float = 0.0) -> None:
+        """Advance from t to t + h [s] with the inputs held over the step (FMI co-simulation)."""
+        if self._lib.cam_drive_do_step(self._drive, t, h, u, omega_ref, omega_dot_ref, ctypes.byref(self._err)):
+            raise_for(self._err)
+
+    def outputs(self) -> dict[str, float]:
+        """Current value of every output in OUTPUTS (computed once per state)."""
+        values = self._lib.cam_drive_outputs(self._drive)
+        return dict(zip(OUTPUT_NAMES, values[:N_OUTPUTS]))
+
+    def reset(self) -> None:
+        """Back to the start: a new drive from the same parameters."""
+        self.__del__()
+        self.__init__(self._params)
+
+    def state_array(self) -> array:
+        """The engine's whole state as its flat array of doubles (cam_model.h, CAM_S_*)."""
+        raw = (ctypes.c_double * STATE_LEN)()
+        self._lib.cam_drive_get_state(self._drive, raw)
+        return array("d", raw)
+
+    def set_state_array(self, state: Sequence[float]) -> None:
+        """Restore a state_array(); the engine checks every entry first (SimulationError naming it)."""
+        if len(state) != STATE_LEN:
+            raise SimulationError(f"engine state has {len(state)} entries, expected {STATE_LEN}")
+        raw = (ctypes.c_double * STATE_LEN)(*state)
+        if self._lib.cam_drive_set_state(self._drive, raw, ctypes.byref(self._err)):
+            raise_for(self._err)
+
+    def get_state(self) -> dict[str, Any]:
+        """Complete internal state, JSON-serialisable (DriveSimulator's keys for the consistent formulation)."""
+        s = self.state_array()
+        nx = self._lib.cam_drive_nx(self._drive)
+        state: dict[str, Any] = {
+            "time": s[S_TIME], "u": s[S_U], "omega_ref": s[S_OMEGA_REF], "omega_dot_ref": s[S_OMEGA_DOT_REF],
+            "h_next": s[S_H_NEXT], "steps_taken": int(s[S_STEPS_TAKEN]),
+            "y": list(s[S_X:S_X + nx]),
+            "mode": {"stuck": bool(s[S_STUCK]), "direction": s[S_DIRECTION], "contact": int(s[S_CONTACT]),
+                     "s_free": s[S_S_FREE], "side": s[S_SIDE]},
+            "engine": list(s),
+        }
+        state["energy"] = dict(zip(BUDGET_KEYS, s[S_BUDGET:S_BUDGET + 6])) if s[S_HAVE_BUDGET] else None
+        return state
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Restore a state from get_state; SimulationError names what is wrong (checked before use)."""
+        for key in ("time", "u", "omega_ref", "omega_dot_ref", "h_next"):
+            if not math.isfinite(float(state[key])):
+                raise SimulationError(f"state entry {key!r} = {state[key]!r} is not finite")
+        s = self.state_array()
+        nx = self._lib.cam_drive_nx(self._drive)
+        y = [float(v) for v in state["y"]]
+        if len(y) != nx:
+            raise SimulationError(f"state 'y' has length {len(y)}, this drive's state has {nx} "
+                                  "(theta, omega" + (", i)" if nx == 3 else ")"))
+        mode = state["mode"]
+        s[S_TIME], s[S_U], s[S_OMEGA_REF] = float(state["time"]), float(state["u"]), float(state["omega_ref"])
+        s[S_OMEGA_DOT_REF], s[S_H_NEXT] = float(state["omega_dot_ref"]), float(state["h_next"])
+        s[S_STEPS_TAKEN] = float(int(state["steps_taken"]))
+        s[S_X:S_X + 3] = array("d", y + [0.0] * (3 - nx))
+        s[S_STUCK] = 1.0 if mode["stuck"] else 0.0
+        s[S_DIRECTION], s[S_CONTACT] = float(mode["direction"]), float(mode["contact"])
+        s[S_S_FREE], s[S_SIDE], s[S_FORM_U] = float(mode["s_free"]), float(mode["side"]), float(state["u"])
+        energy = state.get("energy")
+        s[S_HAVE_BUDGET] = 0.0 if energy is None else 1.0
+        if energy is not None:
+            s[S_BUDGET:S_BUDGET + 6] = array("d", [float(energy[key]) for key in BUDGET_KEYS])
+        self.set_state_array(s)
+
+    def run(self, table: Sequence[Sequence[float]]) -> list[array]:
+        """Many communication steps in one engine call: rows (t, h, u, omega_ref, omega_dot_ref);
+        returns the outputs after each step (OUTPUTS order). On an error the exception names it;
+        the steps before it are done (their outputs are lost with the exception)."""
+        n = len(table)
+        flat = array("d", (float(v) for row in table for v in row))
+        if len(flat) != 5 * n:
+            raise ValueError("every row of the input table has 5 entries: t, h, u, omega_ref, omega_dot_ref")
+        out = array("d", bytes(8 * N_OUTPUTS * n))
+        done = ctypes.c_long(0)
+        status = self._lib.cam_drive_run(self._drive, n, (ctypes.c_double * len(flat)).from_buffer(flat),
+                                         (ctypes.c_double * len(out)).from_buffer(out), ctypes.byref(done),
+                                         ctypes.byref(self._err))
+        if status:
+            raise_for(self._err)
+        return [out[k * N_OUTPUTS:(k + 1) * N_OUTPUTS] for k in range(n)]
+
+
+def run_scene(params: Mapping[str, Any] | None, table: Sequence[Sequence[float]]) -> list[array]:
+    """A whole scene in one engine call: a new drive from params, then the rows (t, h, u, omega_ref,
+    omega_dot_ref) of ``table``; the outputs after each step."""
+    return EngineSimulator(params).run(table)
