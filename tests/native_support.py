@@ -57,14 +57,11 @@ def value_references(fmu_dir: Path) -> Dict[str, int]:
 
 
 def compile_host(dest: Path) -> Path:
-    gcc = require("gcc")
-    from cam_fmu.engine.build import fmi_headers
+    """tests/native_host/host.c compiled (gcc is required: its absence fails the test)."""
+    from cam_fmu.fmu.native import soak
 
-    proc = subprocess.run([gcc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra", "-Werror",
-                           f"-I{fmi_headers()}", "-o", str(dest), str(HOST_C), "-ldl", "-lm"],
-                          capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    return dest
+    require("gcc")
+    return soak.compile_host(dest)
 
 
 VALGRIND_OPTIONS = ["--error-limit=no", "--num-callers=40", "--leak-check=full", "--show-leak-kinds=definite",

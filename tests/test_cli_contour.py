@@ -91,7 +91,8 @@ def test_motion_table_route(tmp_path, capsys):
     assert rc == 0
     d = json.loads(out)
     a, _ = prog.max_pressure_angle(0.06)
-    assert d["max_pressure_angle_deg"] == pytest.approx(math.degrees(a), abs=1e-4)
+    # the table's s' is O(h^2) (the shape-preserving cubic): 5e-4 deg at 0.5 deg spacing
+    assert d["max_pressure_angle_deg"] == pytest.approx(math.degrees(a), abs=1e-3)
     w = 2 * math.pi * 100 / 60
     assert d["speed"]["peak_velocity_m_s"] == pytest.approx(2 * 0.03 / math.radians(100) * w, rel=1e-4)
 

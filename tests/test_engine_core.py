@@ -203,7 +203,8 @@ def _probes():
         elif spec.kind == "boolean":
             values = [True, 0, "yes", "Off", "maybe"]
         elif spec.choices:
-            values = [spec.choices[0], "nope", 3]
+            # the other formulations and solvers are not yet in the C engine: their choices are probed as laws'
+            values = [spec.default, "nope", 3] + ([spec.choices[0]] if spec.name.endswith("_law") else [])
         else:
             continue
         probes += [pytest.param({spec.name: value}, id=f"{spec.name}={value!r}") for value in values]

@@ -226,20 +226,25 @@ class EngineSimulator:
             s[S_BUDGET:S_BUDGET + 6] = array("d", [float(energy[key]) for key in BUDGET_KEYS])
         self.set_state_array(s)
 
-    def run(self, table: Sequence[Sequence[float]]) -> list[list[float]]:
+    def run(self, table: Sequence[Sequence[float]]) -> list[array]:
         """Many communication steps in one engine call: rows (t, h, u, omega_ref, omega_dot_ref);
         returns the outputs after each step (OUTPUTS order). On an error the exception names it;
         the steps before it are done (their outputs are lost with the exception)."""
         n = len(table)
-        flat = (ctypes.c_double * (5 * n))(*(float(v) for row in table for v in row))
-        out = (ctypes.c_double * (N_OUTPUTS * n))()
+        flat = array("d", (float(v) for row in table for v in row))
+        if len(flat) != 5 * n:
+            raise ValueError("every row of the input table has 5 entries: t, h, u, omega_ref, omega_dot_ref")
+        out = array("d", bytes(8 * N_OUTPUTS * n))
         done = ctypes.c_long(0)
-        if self._lib.cam_drive_run(self._drive, n, flat, out, ctypes.byref(done), ctypes.byref(self._err)):
+        status = self._lib.cam_drive_run(self._drive, n, (ctypes.c_double * len(flat)).from_buffer(flat),
+                                         (ctypes.c_double * len(out)).from_buffer(out), ctypes.byref(done),
+                                         ctypes.byref(self._err))
+        if status:
             raise_for(self._err)
-        return [list(out[k * N_OUTPUTS:(k + 1) * N_OUTPUTS]) for k in range(n)]
+        return [out[k * N_OUTPUTS:(k + 1) * N_OUTPUTS] for k in range(n)]
 
 
-def run_scene(params: Mapping[str, Any] | None, table: Sequence[Sequence[float]]) -> list[list[float]]:
+def run_scene(params: Mapping[str, Any] | None, table: Sequence[Sequence[float]]) -> list[array]:
     """A whole scene in one engine call: a new drive from params, then the rows (t, h, u, omega_ref,
     omega_dot_ref) of ``table``; the outputs after each step."""
     return EngineSimulator(params).run(table)

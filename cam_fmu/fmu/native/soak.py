@@ -59,7 +59,10 @@ def compile_host(dest: Path) -> Path:
     cc = shutil.which(os.environ.get("CC", "")) or shutil.which("cc") or shutil.which("gcc")
     if not cc:
         raise RuntimeError("no C compiler for the test host")
-    subprocess.run([cc, "-O1", "-g", "-o", str(dest), str(HOST_C), "-ldl", "-lm"], check=True)
+    from ...engine.build import fmi_headers
+
+    subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra", "-Werror",
+                    f"-I{fmi_headers()}", "-o", str(dest), str(HOST_C), "-ldl", "-lm"], check=True)
     return dest
 
 

@@ -108,6 +108,14 @@ int main(void)
         bad[CAM_S_DIRECTION] = 0.5;
         status = cam_drive_set_state(&d, bad, &err);
         printf("bad-state %d %s\n", status, err.message);
+        bad[CAM_S_DIRECTION] = 1.0;
+        bad[CAM_S_CONTACT] = 1e300;   /* no conversion of an out-of-range double to int (UB) */
+        status = cam_drive_set_state(&d, bad, &err);
+        printf("bad-contact %d %s\n", status, err.message);
+        bad[CAM_S_CONTACT] = 1.0;
+        bad[CAM_S_X + 1] = 0.0 / 0.0 + bad[CAM_S_X + 1];
+        status = cam_drive_set_state(&d, bad, &err);
+        printf("bad-nan %d %s\n", status, err.message);
         cam_drive_free(&d);
     }
     cam_params_free(&p);

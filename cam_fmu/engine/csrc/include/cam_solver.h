@@ -63,13 +63,11 @@ typedef struct CamMethod {
     int exact_electrical_pole;        /* the pole -R/L needs no stability cut */
 } CamMethod;
 
-/* The method the parameter ``solver`` names (CAM_CHOICE_SOLVER_*), or NULL. */
+/* The method the parameter ``solver`` names (CAM_CHOICE_SOLVER_*), or NULL (methods.c). */
 const CamMethod *cam_method(int solver_choice);
 
-/* The tableaus (const data, defined in rk_tableaus.c). */
-const CamTableau *cam_tableau_euler(void);
-const CamTableau *cam_tableau_rk4(void);
-const CamTableau *cam_tableau_dopri5(void);
+/* The tableaus: const data (no mutable state), Dormand-Prince 5(4) in rk.c. */
+extern const CamTableau cam_dopri5;
 
 /* The generic explicit Runge-Kutta step over method->tableau. */
 void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX],

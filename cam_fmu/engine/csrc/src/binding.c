@@ -11,6 +11,11 @@ size_t cam_drive_sizeof(void)
     return sizeof(CamDrive);
 }
 
+size_t cam_model_sizeof(void)
+{
+    return sizeof(CamModel);
+}
+
 double cam_drive_time(const CamDrive *d)
 {
     return d->time;

@@ -43,17 +43,7 @@ static void consistent_advice(const CamDrive *d, char *buf, size_t len)
              solver->choices[d->model.solver], d->model.h_max);
 }
 
-static const CamFormulation CONSISTENT = {
+const CamFormulation cam_consistent = {
     "consistent", 1, consistent_init, consistent_set_inputs, consistent_advance, consistent_outputs,
     consistent_advice,
 };
-
-const CamFormulation *cam_formulation(CamFormulationId id)
-{
-    switch (id) {
-    case CAM_FORM_CONSISTENT:
-        return &CONSISTENT;
-    default:
-        return NULL;   /* paper, speed: not yet ported */
-    }
-}

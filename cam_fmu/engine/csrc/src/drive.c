@@ -13,10 +13,13 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
         return status;
     d->form = cam_formulation(d->model.formulation);
-    if (d->form == NULL) {
+    if (d->form == NULL || (d->model.formulation == CAM_FORM_CONSISTENT && cam_method(d->model.solver) == NULL)) {
+        const char *what = d->form == NULL ? (d->model.formulation == CAM_FORM_SPEED ? "the speed drive"
+                                              : "formulation 'paper'") : "this solver";
+        status = cam_error(err, CAM_ERR_PARAMETER, "%s is not yet available in the C engine (solver '%s')", what,
+                           cam_param_spec(CAM_P_SOLVER)->choices[d->model.solver]);
         cam_model_free(&d->model);
-        return cam_error(err, CAM_ERR_PARAMETER, "formulation %d is not yet available in the C engine",
-                        (int)d->model.formulation);
+        return status;
     }
     d->time = 0.0;
     d->u = cam_input_spec(CAM_I_U)->start;
@@ -69,8 +72,10 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
     if (verdict == CAM_PUBLISH_NOT_FINITE) {
         for (k = 0; k < CAM_N_OUTPUTS && isfinite(out[k]); k++)
             ;
-        if (k == CAM_N_OUTPUTS)   /* the sum overflowed, every output finite */
-            k = 0;
+        if (k == CAM_N_OUTPUTS)   /* every output finite, their sum overflowed (DriveSimulator had no message) */
+            return cam_error(err, CAM_ERR_SIMULATION, "the outputs at t = %g s are too large to check (their sum "
+                             "is not finite) with solver '%s', h_max = %g s: reduce h_max or use 'rk45'/'etdrk4'",
+                             d->time, solver->choices[d->model.solver], d->model.h_max);
         return cam_error(err, CAM_ERR_SIMULATION, "output '%s' became %s at t = %g s with solver '%s', h_max = %g s: "
                         "reduce h_max or use 'rk45'/'etdrk4'", cam_output_spec(k)->name,
                         cam_num(out[k], shown), d->time, solver->choices[d->model.solver],

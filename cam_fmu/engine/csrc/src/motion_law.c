@@ -187,8 +187,8 @@ int cam_law_init(CamLaw *law, const double T[6], const char *name, char *err, si
         }
         snprintf(list + pos, sizeof list - pos, ")");
         if (name != NULL && name[0] != '\0') {
-            return cam_fail(err, err_len, "%.20s law: split points %s are too close to make a finite curve "
-                            "(acceleration or deceleration phase of length ~0)", name, list);
+            return cam_fail(err, err_len, "%.20s law: split points %.20s_T1..%.20s_T6 = %s are too close to make a "
+                            "finite curve (acceleration or deceleration phase of length ~0)", name, name, name, list);
         }
         return cam_fail(err, err_len, "split points %s are too close to make a finite curve "
                         "(acceleration or deceleration phase of length ~0)", list);

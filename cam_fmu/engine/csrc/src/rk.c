@@ -10,7 +10,7 @@
 #define TWO_PI (2.0 * 3.141592653589793)
 
 /* Dormand-Prince 5(4) (Hairer, Norsett, Wanner, Solving ODE I, table 5.2); e = b5 - b4. */
-static const CamTableau DOPRI5 = {
+const CamTableau cam_dopri5 = {
     6,
     {{0.0},
      {1.0 / 5.0},
@@ -24,11 +24,6 @@ static const CamTableau DOPRI5 = {
     {71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0},
     -0.2,
 };
-
-const CamTableau *cam_tableau_dopri5(void)
-{
-    return &DOPRI5;
-}
 
 /* h * sum_j coef[j] k[j] + x for slot i over the nonzero coefficients (see the file's comment). */
 static double increment(const double *coef, int n, double (*k)[CAM_NX], int slot, double x, double h)
@@ -94,18 +89,4 @@ double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWo
             total += pow(w->error[slot] / (atol + rtol * scale), 2.0);
     }
     return sqrt(total / m->nx);
-}
-
-/* Adaptive Dormand-Prince 5(4) with error control (rtol, atol); h_max caps its step. The smallest
- * step is 1e-12 of the communication step; theta's error is scaled by at most 2 pi. */
-static const CamMethod RK45 = {"rk45", &DOPRI5, cam_rk_step, 1, HUGE_VAL, HUGE_VAL, HUGE_VAL, 0};
-
-const CamMethod *cam_method(int solver_choice)
-{
-    switch (solver_choice) {
-    case CAM_CHOICE_SOLVER_RK45:
-        return &RK45;
-    default:
-        return NULL;   /* euler, rk4, etdrk4: not yet ported */
-    }
 }

@@ -75,12 +75,12 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
                             cam_num(s[k], shown));
     mode.stuck = s[CAM_S_STUCK] != 0.0;
     mode.direction = s[CAM_S_DIRECTION];
-    mode.contact = (int)s[CAM_S_CONTACT];
+    mode.contact = s[CAM_S_CONTACT] == 1.0 ? 1 : (s[CAM_S_CONTACT] == -1.0 ? -1 : 0);   /* checked below */
     mode.s_free = s[CAM_S_S_FREE];
     mode.side = s[CAM_S_SIDE];
     if ((s[CAM_S_STUCK] != 0.0 && s[CAM_S_STUCK] != 1.0) || (mode.direction != 1.0 && mode.direction != -1.0)
         || (mode.side != 1.0 && mode.side != -1.0) || (double)mode.contact != s[CAM_S_CONTACT]
-        || mode.contact < -1 || mode.contact > 1 || (s[CAM_S_HAVE_BUDGET] != 0.0 && s[CAM_S_HAVE_BUDGET] != 1.0))
+        || (s[CAM_S_HAVE_BUDGET] != 0.0 && s[CAM_S_HAVE_BUDGET] != 1.0))
         return cam_error(err, CAM_ERR_SIMULATION, "state mode (stuck %g, direction %g, contact %g, side %g) is not a "
                         "valid mode", s[CAM_S_STUCK], s[CAM_S_DIRECTION], s[CAM_S_CONTACT], s[CAM_S_SIDE]);
     d->stale = 1;

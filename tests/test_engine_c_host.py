@@ -48,9 +48,10 @@ def _check(lines: dict[str, list[str]]) -> None:
     assert lines["fig6"] == _python_line({}, 2000)
     assert lines["backlash"] == _python_line({"c": 5e-4}, 2000)
     expected = {"bad-table": "1", "bad-R": "1", "unknown": "1", "bad-solver": "1", "max-steps": "3",
-                "bad-step": "2", "bad-input": "2", "bad-state": "2"}
+                "bad-step": "2", "bad-input": "2", "bad-state": "2", "bad-contact": "2", "bad-nan": "2"}
     assert {name: lines[name][0] for name in expected} == expected
     assert " ".join(lines["bad-R"][1:]) == "parameter 'R' = 0.0 [Ohm] is outside the allowed range [0.001, 10000] Ohm"
+    assert " ".join(lines["bad-nan"][1:]) == "state entry 9 = nan is not finite"
 
 
 def test_address_and_undefined_behaviour_sanitizers_are_clean(tmp_path):

@@ -1,0 +1,44 @@
+/* The rates that bound an explicit method's step (physics/formulations/consistent.py: stiffness_rate,
+ * profile_rate, torque_gain; physics/motor.py: electrical_rate), with the order of operations kept. */
+#include <math.h>
+
+#include "cam_model.h"
+
+/* Largest rate [1/s] of the motor's own dynamics with inertia J [kg m2]: L > 0, the pole R/L plus the
+ * electromechanical coupling sqrt(c_e c_m / (J L)); L = 0, the back-EMF damping c_e c_m / (R J). */
+static double electrical_rate(const CamModel *m, double J)
+{
+    if (m->L > 0.0)
+        return m->R / m->L + sqrt(m->c_e * m->c_m / (J * m->L));
+    return m->c_e * m->c_m / (m->R * J);
+}
+
+double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x[CAM_NX], int electrical)
+{
+    double d[4], J, omega = x[CAM_OMEGA], rate = 0.0;
+    int engaged = mode->contact != 0;
+    cam_profile_eval(&m->profile, x[CAM_THETA], d);
+    J = m->J_m + (engaged ? m->m * d[1] * d[1] : 0.0);
+    if (engaged)
+        rate = (2.0 * m->m * fabs(d[1] * d[2] * omega) + fabs(omega) * sqrt(m->m * J * (d[2] * d[2] + fabs(d[1] * d[3]))))
+               / J;
+    if (m->L > 0.0) {
+        if (electrical)
+            rate += electrical_rate(m, J);
+    } else {
+        rate += electrical_rate(m, J);
+    }
+    return rate;
+}
+
+double cam_profile_rate(const CamModel *m, const double x[CAM_NX])
+{
+    return fabs(x[CAM_OMEGA]) / m->feature_angle;
+}
+
+double cam_torque_gain(const CamModel *m, const CamMode *mode, const double x[CAM_NX])
+{
+    double d[4];
+    cam_profile_eval(&m->profile, x[CAM_THETA], d);
+    return m->c_m / (m->J_m + (mode->contact != 0 ? m->m * d[1] * d[1] : 0.0));
+}
