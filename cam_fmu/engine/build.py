@@ -120,13 +120,20 @@ def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str |
     return dest
 
 
-def build(extra_flags: Sequence[str] = ()) -> Path:
-    """The current engine library (compiled now unless a build of these sources exists)."""
+def library_name(extra_flags: Sequence[str] = ()) -> str:
+    """The file name of the library these sources and flags make."""
     suffix = ".dll" if sys.platform == "win32" else ".so"
-    dest = library_dir() / f"{LIBRARY_STEM}-{digest(extra_flags)}{suffix}"
-    if dest.is_file():
-        return dest
-    return compile_library(dest, extra_flags)
+    return f"{LIBRARY_STEM}-{digest(extra_flags)}{suffix}"
+
+
+def build(extra_flags: Sequence[str] = ()) -> Path:
+    """The current engine library: the one ``pip install`` put into the package, else one built
+    earlier into the package's or the user's cache folder, else compiled now."""
+    name = library_name(extra_flags)
+    for folder in (HERE / "_lib", Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"):
+        if (folder / name).is_file():
+            return folder / name
+    return compile_library(library_dir() / name, extra_flags)
 
 
 def main() -> int:
