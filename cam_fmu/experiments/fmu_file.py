@@ -89,7 +89,7 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
 
 def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
     """The speed-loop SSP: ``path`` as given (it must exist), or models/speed_loop.ssp, rebuilt when
-    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale)."""
+    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale) or than ssp.py (its writer)."""
     if path is not None:
         path = Path(path)
         if not path.is_file():
@@ -99,7 +99,10 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
 
     fmus = {name: ensure_fmu(None, log, name) for name in MODELS}
     path = default_model_path(SSP_NAME, ".ssp")
-    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in fmus.values()):
+    from . import ssp as writer
+
+    inputs = [*fmus.values(), Path(writer.__file__)]
+    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in inputs):
         return path
     if log is not None:
         log(f"# writing {path}")
