@@ -11,7 +11,10 @@
  *   init                 fmi2SetupExperiment(0) + Enter/ExitInitializationMode
  *   setr VR VALUE        fmi2SetReal of one variable (VALUE may be nan)
  *   sets VR TEXT         fmi2SetString of one variable
- *   getr VR,VR,...       one fmi2GetReal of all listed variables
+ *   getr VR,VR,...       one fmi2GetReal of all listed variables (the array is filled with -1.5 first)
+ *   gets VR,VR,...       one fmi2GetString of all listed variables (the array is filled with "junk" first)
+ *   nullcalls            every getter with a NULL and with a bogus component, outputs filled with junk
+ *                        first; prints each status and what the outputs hold afterwards (no instance needed)
  *   step N H             N x fmi2DoStep of size H (stops at the first non-OK status)
  *   save / restore       fmi2GetFMUstate / fmi2SetFMUstate (one slot)
  *   serial               serialise the saved state, deserialise it, and make that the saved state
@@ -100,6 +103,27 @@ typedef fmi2Status (*fmi2SerializeFMUstate_t)(fmi2Component, fmi2FMUstate, char 
 typedef fmi2Status (*fmi2DeSerializeFMUstate_t)(fmi2Component, const char *, size_t, fmi2FMUstate *);
 typedef fmi2Status (*fmi2GetBooleanStatus_t)(fmi2Component, int, int *);
 typedef fmi2Status (*fmi2GetRealStatus_t)(fmi2Component, int, double *);
+typedef fmi2Status (*fmi2GetInteger_t)(fmi2Component, const fmi2ValueReference *, size_t, int *);
+typedef fmi2Status (*fmi2GetBoolean_t)(fmi2Component, const fmi2ValueReference *, size_t, int *);
+typedef fmi2Status (*fmi2GetString_t)(fmi2Component, const fmi2ValueReference *, size_t, const char **);
+typedef fmi2Status (*fmi2GetStatus_t)(fmi2Component, int, fmi2Status *);
+typedef fmi2Status (*fmi2GetIntegerStatus_t)(fmi2Component, int, int *);
+typedef fmi2Status (*fmi2GetStringStatus_t)(fmi2Component, int, const char **);
+typedef fmi2Status (*fmi2GetDirectionalDerivative_t)(fmi2Component, const fmi2ValueReference *, size_t,
+                                                     const fmi2ValueReference *, size_t, const double *, double *);
+typedef fmi2Status (*fmi2GetRealOutputDerivatives_t)(fmi2Component, const fmi2ValueReference *, size_t,
+                                                     const int *, double *);
+
+static void json_strings(const char *const *s, size_t n)
+{
+    putchar('[');
+    for (size_t i = 0; i < n; i++) {
+        if (i) printf(", ");
+        if (s[i]) json_string(s[i]);
+        else printf("null");
+    }
+    putchar(']');
+}
 
 int main(int argc, char **argv)
 {
@@ -125,6 +149,8 @@ int main(int argc, char **argv)
     SYM(fmi2SetString); SYM(fmi2DoStep); SYM(fmi2GetFMUstate); SYM(fmi2SetFMUstate); SYM(fmi2FreeFMUstate);
     SYM(fmi2SerializedFMUstateSize); SYM(fmi2SerializeFMUstate); SYM(fmi2DeSerializeFMUstate);
     SYM(fmi2GetBooleanStatus); SYM(fmi2GetRealStatus);
+    SYM(fmi2GetInteger); SYM(fmi2GetBoolean); SYM(fmi2GetString); SYM(fmi2GetStatus); SYM(fmi2GetIntegerStatus);
+    SYM(fmi2GetStringStatus); SYM(fmi2GetDirectionalDerivative); SYM(fmi2GetRealOutputDerivatives);
     if (!fmi2Instantiate || !fmi2DoStep || !fmi2GetBooleanStatus || !fmi2DeSerializeFMUstate) {
         printf("{\"dlsym\": \"missing FMI functions\"}\n");
         return 3;
@@ -156,6 +182,40 @@ int main(int argc, char **argv)
             fmi2FreeInstance(c);   /* also after fmi2Error/fmi2Fatal, and with NULL */
             c = NULL;
             saved = NULL;
+        } else if (!strcmp(cmd, "nullcalls")) {
+            int bogus[64] = {0};   /* memory that is not an instance: the wrapper must recognise it */
+            fmi2Component comps[2] = {NULL, bogus};
+            for (int which = 0; which < 2; which++) {
+                fmi2Component x = comps[which];
+                fmi2ValueReference vrs[3] = {0, 1, 2}, z[2] = {0, 1};
+                double r[3] = {-1.5, -1.5, -1.5}, rs = -1.5, dz[2] = {-1.5, -1.5}, od[2] = {-1.5, -1.5}, dv[1] = {1};
+                int iv[3] = {-7, -7, -7}, bv[3] = {-7, -7, -7}, is = -7, bs = -7, order[2] = {1, 1};
+                const char *sv[3] = {"junk", "junk", "junk"}, *ss = "junk";
+                fmi2Status st = fmi2Pending;
+                int statuses[11];
+                statuses[0] = fmi2GetReal(x, vrs, 3, r);
+                statuses[1] = fmi2GetInteger(x, vrs, 3, iv);
+                statuses[2] = fmi2GetBoolean(x, vrs, 3, bv);
+                statuses[3] = fmi2GetString(x, vrs, 3, sv);
+                statuses[4] = fmi2GetStatus(x, 0, &st);
+                statuses[5] = fmi2GetRealStatus(x, 2, &rs);
+                statuses[6] = fmi2GetIntegerStatus(x, 0, &is);
+                statuses[7] = fmi2GetBooleanStatus(x, 3, &bs);
+                statuses[8] = fmi2GetStringStatus(x, 0, &ss);
+                statuses[9] = fmi2GetDirectionalDerivative(x, vrs, 1, z, 2, dv, dz);
+                statuses[10] = fmi2GetRealOutputDerivatives(x, z, 2, order, od);
+                printf("{\"cmd\": \"nullcalls\", \"component\": \"%s\", \"statuses\": [", which ? "bogus" : "null");
+                for (int i = 0; i < 11; i++) printf(i ? ", %d" : "%d", statuses[i]);
+                printf("], \"real\": [%g, %g, %g], \"integer\": [%d, %d, %d], \"boolean\": [%d, %d, %d], \"string\": ",
+                       r[0], r[1], r[2], iv[0], iv[1], iv[2], bv[0], bv[1], bv[2]);
+                json_strings(sv, 3);
+                printf(", \"status\": %d, \"real_status\": %g, \"integer_status\": %d, \"boolean_status\": %d, "
+                       "\"string_status\": ", (int)st, rs, is, bs);
+                json_strings(&ss, 1);
+                printf(", \"directional\": [%g, %g], \"output_derivatives\": [%g, %g]}\n", dz[0], dz[1], od[0], od[1]);
+                fflush(stdout);
+            }
+            continue;
         } else if (!c) {
             printf("{\"cmd\": \"%s\", \"error\": \"no instance\"}\n", cmd);
             continue;
@@ -177,12 +237,27 @@ int main(int argc, char **argv)
             double values[64];
             size_t n = 0;
             char *list = strdup(argv[++k]);
+            for (int i = 0; i < 64; i++) values[i] = -1.5;
             for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
             free(list);
             s = fmi2GetReal(c, vrs, n, values);
             printf("{\"cmd\": \"getr\", \"status\": %d, \"values\": [", (int)s);
             for (size_t i = 0; i < n; i++) printf(i ? ", %.17g" : "%.17g", isfinite(values[i]) ? values[i] : 1e308);
             printf("]}\n");
+            fflush(stdout);
+            continue;
+        } else if (!strcmp(cmd, "gets")) {
+            fmi2ValueReference vrs[64];
+            const char *values[64];
+            size_t n = 0;
+            char *list = strdup(argv[++k]);
+            for (int i = 0; i < 64; i++) values[i] = "junk";
+            for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
+            free(list);
+            s = fmi2GetString(c, vrs, n, values);
+            printf("{\"cmd\": \"gets\", \"status\": %d, \"values\": ", (int)s);
+            json_strings(values, n);
+            printf("}\n");
             fflush(stdout);
             continue;
         } else if (!strcmp(cmd, "step")) {
