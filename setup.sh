@@ -19,6 +19,7 @@ if [ "${#missing[@]}" -gt 0 ]; then
     apt-get install -y "${missing[@]}"
 fi
 
-python -m pip install -e ".[test]"
+# the test environment pinned (constraints/test.txt; refresh: bash constraints/refresh.sh), the package keeps ranges
+python -m pip install -c constraints/test.txt -e ".[test]"
 # the drive kernel's extension beside its .py (Cython + gcc; skipped while current), so the tests use it
 python -m cam_fmu.kernel.compile

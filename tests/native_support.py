@@ -93,8 +93,12 @@ def valgrind_summary(log: Path) -> dict:
 
 def run_host(host: Path, fmu_dir: Path, *commands: str, env: Optional[dict] = None,
              prefix: Sequence[str] = (), timeout: float = 900) -> dict:
-    """Run the C host; return its exit code, the JSON lines (commands, log messages) and stderr."""
-    proc = subprocess.run([*prefix, str(host), str(fmu_dir / "binaries" / "linux64" / "cam.so"),
+    """Run the C host on the FMU's linux64 binary (cam.so, pi_speed.so, ...); return its exit code, the JSON
+    lines (commands, log messages) and stderr."""
+    binary = fmu_dir / "binaries" / "linux64" / "cam.so"
+    if not binary.is_file():
+        binary = next((fmu_dir / "binaries" / "linux64").glob("*.so"))
+    proc = subprocess.run([*prefix, str(host), str(binary),
                            str(fmu_dir / "resources"), *commands],
                           capture_output=True, text=True, env=EMPTY_ENV if env is None else env, timeout=timeout)
     lines = [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]

@@ -30,8 +30,10 @@ def test_host_env_line():
     assert Path(env["LD_PRELOAD"]).is_file() and "libpython3" in Path(env["LD_PRELOAD"]).name
     assert Path(env["PYTHONHOME"], "lib").is_dir()
     assert any(Path(p, "numpy").is_dir() for p in env["PYTHONPATH"].split(os.pathsep))
-    exe = shutil.which("cam-fmu")
-    cmd = [exe] if exe else [sys.executable, "-m", "cam_fmu.cli"]
+    # the console script of this interpreter's environment (a venv run without activating it has another
+    # cam-fmu first on PATH), else the module
+    exe = Path(sys.executable).parent / "cam-fmu"
+    cmd = [str(exe)] if exe.is_file() else [sys.executable, "-m", "cam_fmu.cli"]
     proc = subprocess.run([*cmd, "host-env"], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     line = proc.stdout.strip()

@@ -270,3 +270,16 @@ def test_docs_parameter_table_is_the_generated_one():
     """docs/scenes.md's parameter table is physics.parameters.markdown_table(): it cannot drift from the table."""
     from cam_fmu.physics.parameters import markdown_table
     assert markdown_table() in (ROOT / "docs" / "scenes.md").read_text(encoding="utf-8")
+
+
+def test_every_parameter_states_what_it_allows():
+    """No 'one of ' with nothing after it (motion_table, a free string, once said that in both tables)."""
+    from cam_fmu.physics.parameters import PARAMETERS
+
+    for p in PARAMETERS:
+        text = p.allowed()
+        assert text.strip() and not text.rstrip().endswith("one of"), (p.name, text)
+        if p.kind == "string" and not p.choices:
+            assert text.startswith("any text") and p.check("angle_deg,lift_mm\n0,0\n") == "angle_deg,lift_mm\n0,0\n"
+    for doc in ("scenes.md", "fmu.md"):
+        assert "| one of  |" not in (ROOT / "docs" / doc).read_text(encoding="utf-8"), doc

@@ -5,6 +5,7 @@ must be installed (the CI installs it): a missing dask fails these tests.
 """
 from __future__ import annotations
 
+import csv
 import json
 import os
 import subprocess
@@ -54,13 +55,54 @@ def serial(cam_fmu_path, tmp_path_factory) -> str:
 
 def test_serial_table(serial):
     lines = serial.strip().splitlines()
-    assert lines[0] == "m [kg],rise_law,peak_i [A],peak_M [N.m],ripple [rad/s],final_omega [rad/s]"
+    assert lines[0] == "m [kg],rise_law,peak_i [A],peak_M [N.m],ripple [rad/s],final_omega [rad/s],status,message"
     assert len(lines) == 1 + 6
     rows = [line.split(",") for line in lines[1:]]
     # a heavier follower slows the spin-up: final omega falls with m for each law
     for law in ("paper", "cycloidal"):
         finals = [float(r[5]) for r in rows if r[1] == law]
         assert finals == sorted(finals, reverse=True) and finals[0] > finals[-1]
+    assert all(r[6:] == ["ok", ""] for r in rows)
+
+
+FAILING = ["sweep", "paper_fig6", "--vary", "max_steps=10000,1,5000", "--metric", "final_omega",
+           "--stop-time", "0.05", "--no-plot"]
+
+
+@pytest.mark.parametrize("where", [["--serial"], ["--workers", "2"]], ids=["serial", "workers"])
+def test_a_failing_case_keeps_every_row_and_is_named(cam_fmu_path, tmp_path, where):
+    """max_steps = 1 cannot complete a step: that case fails, the other two run; exit 1 at the end."""
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(cam_fmu_path),
+                           "--out", str(out), *where], capture_output=True, text=True, env=_env(),
+                          cwd=tmp_path, timeout=600)
+    assert proc.returncode == 1, proc.stderr[-3000:]
+    with open(out / "paper_fig6_sweep.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["max_steps [1]", "final_omega [rad/s]", "status", "message"]
+    assert [float(r[0]) for r in rows[1:]] == [10000, 1, 5000]
+    assert [r[2] for r in rows[1:]] == ["ok", "failed", "ok"]
+    assert "max_steps = 1 internal steps" in rows[2][3] and rows[2][1] == "nan"
+    assert float(rows[1][1]) > 0 and rows[1][1] == rows[3][1]  # both complete the same steps
+    lines = proc.stderr.strip().splitlines()
+    assert lines[-2].startswith("# case 2 (max_steps=1.0) failed: ") and "max_steps = 1" in lines[-2]
+    assert lines[-1] == "cam-fmu sweep: 1 of 3 cases failed (rows kept, status 'failed')"
+    assert "Traceback" not in proc.stderr and "distributed" not in proc.stderr, proc.stderr
+
+
+def test_vary_drive_is_checked_as_simulate_checks_it(tmp_path):
+    """--vary drive=speed on a voltage scene: refused up front, with simulate's own message."""
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "sweep", "paper_fig6", "--vary",
+                           "drive=voltage,speed", "--serial", "--out", str(tmp_path / "out")],
+                          capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=300)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "drive = 'speed' needs the input signal 'omega_ref'" in proc.stderr
+    # the same sentence simulate gives for a speed scene without omega_ref
+    scene = tmp_path / "speed.toml"
+    scene.write_text('drive = "speed"\nu = 1.0\nstop_time = 0.1\noutput_interval = 1e-3\n')
+    sim = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "simulate", str(scene), "--no-plot"],
+                         capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=300)
+    assert sim.returncode == 2 and "drive = 'speed' needs the input signal 'omega_ref'" in sim.stderr
 
 
 def test_local_cluster_equals_serial_bit_for_bit(cam_fmu_path, serial, tmp_path):

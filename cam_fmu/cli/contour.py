@@ -56,6 +56,7 @@ def _error(msg: str) -> int:
 def _build(args):
     from ..kinematics.design_checks import Limits
     from ..kinematics.disc_cam import DiscCam
+    from ..kinematics.physical import MAX_RPM
 
     if args.table is not None:
         from ..kinematics.motion_table import program_from_table_text
@@ -77,8 +78,8 @@ def _build(args):
         raise ValueError(f"--roller-radius-mm {args.roller_radius_mm:g} must be < --base-radius-mm "
                          f"{args.base_radius_mm:g} (r_b is the prime-circle radius, to the roller centre; "
                          f"the cam's base circle r_b - r_r would vanish)")
-    if args.rpm is not None and not (math.isfinite(args.rpm) and args.rpm > 0.0):
-        raise ValueError(f"--rpm must be a number > 0, got {args.rpm:g}")
+    if args.rpm is not None and not (math.isfinite(args.rpm) and 0.0 < args.rpm <= MAX_RPM):
+        raise ValueError(f"--rpm must be a number > 0 and <= {MAX_RPM:g}, got {args.rpm:g}")
     if not (0.0 < args.max_pressure_angle_deg < 90.0):
         raise ValueError(f"--max-pressure-angle-deg must lie in (0, 90), got {args.max_pressure_angle_deg:g}")
     if args.min_radius_mm is not None and not (math.isfinite(args.min_radius_mm) and args.min_radius_mm >= 0.0):

@@ -1,4 +1,5 @@
-"""`cam-fmu host-env`: the environment line a native FMU host needs (a diagnostic)."""
+"""`cam-fmu host-env`: a diagnostic: the environment line of this machine's Python (LD_PRELOAD, PYTHONHOME,
+PYTHONPATH). No host needs it for cam.fmu or pi_speed.fmu, which carry their own linux64 binary (docs/fmu.md)."""
 from __future__ import annotations
 
 import argparse
@@ -8,7 +9,7 @@ import sys
 def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser(
         "host-env",
-        help="print the environment a non-Python FMU host (ecos, C/C++ tools) needs for cam.fmu",
+        help="a diagnostic: print this machine's Python environment line (no FMU host needs it)",
         description="Print LD_PRELOAD=... PYTHONHOME=... PYTHONPATH=... for this machine's Python: "
                     "prefix a native co-simulation host with it, e.g. "
                     "`env $(cam-fmu host-env) ecos simulate --path models/cam.fmu --stopTime 2 --stepSize 1e-3`.")

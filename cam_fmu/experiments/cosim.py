@@ -37,6 +37,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
+from .limits import check_steps
 from .ssp import System, SspError, extract_ssp, read_ssp
 
 Progress = Callable[[int, int], None]
@@ -51,6 +52,7 @@ def _n_steps(start: float, stop: float, h: float) -> int:
         raise CosimError(f"step size = {h!r} s: allowed (0, inf)")
     if not stop > start:
         raise CosimError(f"stop time = {stop!r} s must exceed the start time {start!r} s")
+    check_steps(stop - start, h, "stop time - start time / step size", CosimError)
     n = round((stop - start) / h)
     if abs(n * h - (stop - start)) > 1e-9 * max(1.0, stop - start):
         raise CosimError(f"stop time - start time = {stop - start!r} s is not a whole number of steps h = {h!r} s")

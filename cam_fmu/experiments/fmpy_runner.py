@@ -4,6 +4,11 @@ Used by the scene runner and the bench. fmpy's default path instantiates and
 frees an instance per run; this one keeps the library loaded and the
 instance alive. An instance that failed is abandoned, never freed: freeing a
 pythonfmu 0.7.0 instance after an error crashes the host at exit.
+
+Every instance gets this runner's own logger: the FMU's error and discard
+messages are kept (``messages``), never printed (fmpy's default logger prints
+``[ERROR] ...`` lines on stdout), and a failed run raises FmuRunError whose text
+is the FMU's own message (the cause), followed by fmpy's status line.
 """
 from __future__ import annotations
 
@@ -34,7 +39,13 @@ class FmuRunner:
         self.count = 0
         self.fmu = None
         self.abandoned: list = []
-        self._new_instance()
+        self.messages: list[str] = []  # the FMU's messages of status fmi2Discard and worse, this run
+        self._new_instance(logger=self._collect)
+
+    def _collect(self, _env: Any, _name: Any, status: int, _category: Any, message: Any) -> None:
+        if status >= 2:  # fmi2Discard, fmi2Error, fmi2Fatal
+            text = message.decode("utf-8", "replace") if isinstance(message, bytes) else str(message)
+            self.messages.append(" ".join(text.split()))
 
     def _new_instance(self, logging: bool = False, logger: Callable | None = None) -> None:
         from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
@@ -73,6 +84,7 @@ class FmuRunner:
         if not self.fresh:
             self.fmu.reset()
         self.fresh = False
+        self.messages.clear()
         reached = [0.0]
 
         def step_finished(time: float, _recorder: Any) -> bool:
@@ -81,14 +93,24 @@ class FmuRunner:
                 on_step(time)
             return True
 
-        result = simulate_fmu(self.unzipdir, model_description=self.md, fmu_instance=self.fmu,
-                              start_values=start_values, start_time=0.0, stop_time=stop_time,
-                              output_interval=output_interval, input=inputs,
-                              output=list(outputs) if outputs is not None else None,
-                              step_finished=step_finished if check_end or on_step is not None else None)
+        try:
+            result = simulate_fmu(self.unzipdir, model_description=self.md, fmu_instance=self.fmu,
+                                  start_values=start_values, start_time=0.0, stop_time=stop_time,
+                                  output_interval=output_interval, input=inputs,
+                                  output=list(outputs) if outputs is not None else None,
+                                  step_finished=step_finished if check_end or on_step is not None else None)
+        except Exception as exc:  # noqa: BLE001 - fmpy's FMICallException and friends: the FMU's cause first
+            self._new_instance(logger=self._collect)  # the failed instance is abandoned (module docstring)
+            raise FmuRunError(self._cause(str(exc))) from exc
         if check_end and not math.isclose(reached[0], stop_time, rel_tol=1e-9, abs_tol=1e-12):
-            raise FmuRunError(f"the FMU stopped at t = {reached[0]:g} s before stop_time = {stop_time:g} s")
+            raise FmuRunError(self._cause(f"the FMU stopped at t = {reached[0]:g} s before stop_time = "
+                                          f"{stop_time:g} s"))
         return result
+
+    def _cause(self, what: str) -> str:
+        """The FMU's own messages of this run (the cause), then ``what`` happened, on one line."""
+        own = [m for m in dict.fromkeys(self.messages) if "PyObject_CallMethod" not in m]
+        return "; ".join(own + [what]) if own else what
 
     def error_text(self, exc: BaseException, *args: Any, **kwargs: Any) -> str:
         """Re-run with logging on to capture the FMU's own message; leave a fresh instance behind."""
@@ -104,6 +126,6 @@ class FmuRunner:
             self.simulate(*args, **kwargs)
         except Exception:  # noqa: BLE001
             pass
-        self._new_instance()
+        self._new_instance(logger=self._collect)
         own = [m for m in messages if "PyObject_CallMethod" not in m and "Fatal py exception" not in m]
         return (own[0] if own else f"{type(exc).__name__}: {exc}").replace("\n", " ")

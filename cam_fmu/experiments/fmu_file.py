@@ -89,7 +89,7 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
 
 def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
     """The speed-loop SSP: ``path`` as given (it must exist), or models/speed_loop.ssp, rebuilt when
-    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale)."""
+    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale) or than ssp.py (its writer)."""
     if path is not None:
         path = Path(path)
         if not path.is_file():
@@ -99,8 +99,30 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
 
     fmus = {name: ensure_fmu(None, log, name) for name in MODELS}
     path = default_model_path(SSP_NAME, ".ssp")
-    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in fmus.values()):
+    from . import ssp as writer
+
+    inputs = [*fmus.values(), Path(writer.__file__)]
+    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in inputs):
         return path
     if log is not None:
         log(f"# writing {path}")
     return build_ssp(path, fmus["cam"], fmus["pi_speed"])
+
+
+def check_cam_variables(path: str | Path, option: str = "--fmu") -> Path:
+    """``path`` if it is an FMU with cam.fmu's inputs, outputs and parameters, else FmuFileError naming what
+    it lacks: checked before a run that reads them (the bench), not after minutes of work."""
+    from fmpy import read_model_description
+
+    from ..physics.parameters import BY_NAME
+    from ..physics.variables import INPUT_NAMES, OUTPUT_NAMES
+
+    try:
+        names = {v.name for v in read_model_description(str(path)).modelVariables}
+    except Exception as exc:  # noqa: BLE001 - fmpy raises several kinds for a file that is not an FMU
+        raise FmuFileError(f"{option} {str(path)!r} is not an FMU: {' '.join(str(exc).split())}") from None
+    missing = [n for n in (*INPUT_NAMES, *OUTPUT_NAMES, *BY_NAME) if n not in names]
+    if missing:
+        raise FmuFileError(f"{option} {str(path)!r} is not a cam.fmu: it lacks {len(missing)} of cam.fmu's "
+                           f"variables ({', '.join(missing[:6])}{', ...' if len(missing) > 6 else ''})")
+    return Path(path)

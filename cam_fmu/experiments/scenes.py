@@ -38,6 +38,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..physics import parameters as _parameters
+from ..physics.variables import INPUT_RANGES, UNITS
+from .limits import check_steps
 from .signals import OPTIONAL_KEYS, SIGNAL_KEYS, Signal, from_spec
 
 TOP_KEYS = ("description", "drive", "u", "omega_ref", "parameters", "stop_time", "output_interval", "plot", "runs")
@@ -87,7 +89,9 @@ class Scene:
     def with_stop_time(self, stop_time: float) -> "Scene":
         """The same scene over a different duration (e.g. shortened for tests)."""
         from dataclasses import replace
-        return replace(self, stop_time=_positive(stop_time, "stop_time", self._where()))
+        stop_time = _positive(stop_time, "stop_time", self._where())
+        check_steps(stop_time, self.output_interval, f"{self._where()}: stop time / 'output_interval'", SceneError)
+        return replace(self, stop_time=stop_time)
 
     def _where(self) -> str:
         return str(self.path) if self.path else self.name
@@ -135,10 +139,7 @@ def scene_from_dict(data: Mapping[str, Any], name: str, path: Path | None = None
 
     u = _signal(data, "u", where)
     omega_ref = _signal(data, "omega_ref", where)
-    needed = "u" if drive == "voltage" else "omega_ref"
-    if (u if needed == "u" else omega_ref) is None:
-        raise SceneError(f"{where}: drive = {drive!r} needs the input signal {needed!r} "
-                         f"({'V' if needed == 'u' else 'rad/s'}): e.g. {needed} = 1.0")
+    check_drive_inputs(drive, u, omega_ref, where)
 
     if "stop_time" not in data:
         raise SceneError(f"{where}: 'stop_time' [s] is missing")
@@ -148,6 +149,7 @@ def scene_from_dict(data: Mapping[str, Any], name: str, path: Path | None = None
     output_interval = _positive(data["output_interval"], "output_interval", where)
     if output_interval > stop_time:
         raise SceneError(f"{where}: 'output_interval' = {output_interval} s exceeds 'stop_time' = {stop_time} s")
+    check_steps(stop_time, output_interval, f"{where}: 'stop_time' / 'output_interval'", SceneError)
 
     from ..plots.scene import PLOTS  # the figure kinds' one table (matplotlib is imported only to draw)
 
@@ -200,6 +202,26 @@ def _run(label: str, overrides: dict[str, Any], where: str, ctx: str) -> Run:
     return Run(label=label, overrides=dict(overrides), params=resolved)
 
 
+def check_drive_inputs(drive: str, u: Signal | None, omega_ref: Signal | None, where: str) -> None:
+    """SceneError unless the drive has its input signal (voltage: u, speed: omega_ref). `simulate` (through
+    scene files) and `sweep` (for each case that sets 'drive') check a set-up with this one function."""
+    needed = "u" if drive == "voltage" else "omega_ref"
+    if (u if needed == "u" else omega_ref) is None:
+        raise SceneError(f"{where}: drive = {drive!r} needs the input signal {needed!r} "
+                         f"({'V' if needed == 'u' else 'rad/s'}): e.g. {needed} = 1.0")
+
+
+def _in_range(sig: Signal, key: str, name: str, where: str) -> None:
+    """Every value of the signal (piecewise linear or held: its extremes are its table values) lies in
+    the FMU input's allowed range (physics.variables.INPUT_RANGES), checked before anything runs."""
+    low, high = INPUT_RANGES[name]
+    bad = [v for v in sig.values if not (low <= v <= high)]
+    if bad:
+        what = "its slope (omega_dot_ref)" if name != key else "it"
+        raise SceneError(f"{where}: [{key}]: {what} reaches {bad[0]:g} {UNITS[name]}, outside the allowed range "
+                         f"of the input {name!r}: [{low:g}, {high:g}] {UNITS[name]}")
+
+
 def _positive(value: Any, key: str, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
         raise SceneError(f"{where}: {key!r} = {value!r}: must be a number > 0 [s]")
@@ -225,9 +247,13 @@ def _signal(data: Mapping[str, Any], key: str, where: str) -> Signal | None:
         if missing:
             raise SceneError(f"{where}: [{key}] (type {kind!r}): missing key(s) {', '.join(map(repr, missing))}")
     try:
-        return from_spec(spec)
+        sig = from_spec(spec)
     except (ValueError, TypeError, KeyError) as exc:
         raise SceneError(f"{where}: [{key}]: {exc}") from None
+    _in_range(sig, key, key, where)
+    if key == "omega_ref":
+        _in_range(sig.slope_signal(), key, "omega_dot_ref", where)
+    return sig
 
 
 def scene_files(directory: str | Path = SCENE_DIR) -> list[Path]:

@@ -11,7 +11,17 @@ ecos, libcosim (OSP) and fmpy all understand:
 - ``ssd:Connections`` (``startElement.startConnector -> endElement.endConnector``);
 - ``ssd:DefaultExperiment`` (startTime, stopTime) with the OSP annotation
   ``osp:FixedStepAlgorithm baseStepSize`` (the communication step), which
-  libcosim reads; ecos takes the step on its command line.
+  libcosim reads; ecos takes the step on its command line;
+- inside ``ssd:System``, OMSimulator's vendor annotation (``org.openmodelica``:
+  ``oms:FixedStepMaster stepSize`` = the same step): OMSimulator's importer learns
+  the system's type only from it and aborts without it; other engines ignore it,
+  as the standard lets them.
+
+``read_ssp`` checks what the standard requires before anything runs
+(``validate``): every connection names a component and a connector of it
+declared with the right kind (output or input at its start, input at its end),
+no input is fed by two connections, and each component's source is an FMU (a zip
+with a modelDescription.xml); the error names the component or connection.
 
 Standard library only.
 """
@@ -29,8 +39,10 @@ SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
+OMS_TOLERANCE = 1e-4  # OMSimulator's absolute and relative tolerance attributes (unused by a fixed-step master)
 PARAMETER_SET = "initialValues"
-for _prefix, _uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV), ("osp", OSP)):
+for _prefix, _uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV), ("osp", OSP), ("oms", OMS)):
     ET.register_namespace(_prefix, _uri)
 
 
@@ -109,6 +121,11 @@ def system_xml(system: System) -> bytes:
         ET.SubElement(connections, _q(SSD, "Connection"), {
             "startElement": c.start_element, "startConnector": c.start_connector,
             "endElement": c.end_element, "endConnector": c.end_connector})
+    oms = ET.SubElement(ET.SubElement(ET.SubElement(sys_el, _q(SSD, "Annotations")), _q(SSC, "Annotation"),
+                                      {"type": "org.openmodelica"}), _q(OMS, "Annotations"))
+    ET.SubElement(ET.SubElement(oms, _q(OMS, "SimulationInformation")), _q(OMS, "FixedStepMaster"),
+                  {"description": "oms-ma", "stepSize": _fmt(system.step_size),
+                   "absoluteTolerance": _fmt(OMS_TOLERANCE), "relativeTolerance": _fmt(OMS_TOLERANCE)})
     exp = ET.SubElement(root, _q(SSD, "DefaultExperiment"),
                         {"startTime": _fmt(system.start_time), "stopTime": _fmt(system.stop_time)})
     ann = ET.SubElement(ET.SubElement(exp, _q(SSD, "Annotations")), _q(SSC, "Annotation"),
@@ -208,8 +225,50 @@ def read_ssp(path: str | Path) -> System:
     for comp in system.components.values():
         if comp.source not in names:
             raise SspError(f"{path}: component {comp.name!r}: {comp.source!r} is not in the archive")
+    validate(system, where=str(path))
+    _check_fmus(path, system)
     system.path = path
     return system
+
+
+def validate(system: System, where: str = "SystemStructure.ssd") -> None:
+    """Raise SspError unless every connection joins declared connectors and each input has one source."""
+    fed: dict[tuple[str, str], Connection] = {}
+    for c in system.connections:
+        for elem, connector, kinds in ((c.start_element, c.start_connector, ("output", "input")),
+                                       (c.end_element, c.end_connector, ("input",))):
+            comp = system.components.get(elem)
+            if comp is None:
+                raise SspError(f"{where}: connection {c}: no component {elem!r}")
+            declared = {n: "input" for n in comp.inputs} | {n: "output" for n in comp.outputs}
+            if connector not in declared:
+                raise SspError(f"{where}: connection {c}: component {elem!r} has no connector {connector!r}; "
+                               f"it declares: {', '.join(declared) or 'none'}")
+            if declared[connector] not in kinds:
+                raise SspError(f"{where}: connection {c}: {elem}.{connector} is an {declared[connector]}, "
+                               f"a connection {'ends' if kinds == ('input',) else 'starts'} at "
+                               f"{' or '.join(kinds)}s")
+        key = (c.end_element, c.end_connector)
+        if key in fed:
+            raise SspError(f"{where}: input {c.end_element}.{c.end_connector} is fed by two connections "
+                           f"({fed[key]} and {c}); an input takes one")
+        fed[key] = c
+
+
+def _check_fmus(path: Path, system: System) -> None:
+    """Each component's source is a zip archive with a modelDescription.xml (an FMU)."""
+    import io
+
+    with zipfile.ZipFile(path) as z:
+        for comp in system.components.values():
+            try:
+                with zipfile.ZipFile(io.BytesIO(z.read(comp.source))) as fmu:
+                    if "modelDescription.xml" not in fmu.namelist():
+                        raise SspError(f"{path}: component {comp.name!r}: {comp.source} has no modelDescription.xml "
+                                       f"(not an FMU)")
+            except zipfile.BadZipFile:
+                raise SspError(f"{path}: component {comp.name!r}: {comp.source} is not an FMU "
+                               f"(not a zip archive)") from None
 
 
 def extract_ssp(path: str | Path, dest: str | Path) -> Path:

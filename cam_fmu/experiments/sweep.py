@@ -9,9 +9,18 @@ Every process (the serial caller or a dask worker) loads the FMU once
 (``_runner``: a process-local FmuRunner keyed by the FMU's path and mtime) and
 resets the instance between cases, so a case's result does not depend on
 where or after which case it ran: dask results equal serial ones bit for bit.
+
+Before anything runs, every case is checked as `simulate` checks a scene
+(``check_cases``: parameters through parameters.resolve, the drive's input
+signal through scenes.check_drive_inputs), and the sweep has at most
+limits.MAX_CASES cases. A case that then fails while it runs (the FMU refuses
+it, a step cannot be completed) does not stop the sweep: its row keeps the
+varied values, ``status`` = "failed", ``message`` = the FMU's own reason and
+NaN metrics (``status`` = "ok" and an empty message otherwise).
 """
 from __future__ import annotations
 
+import csv
 import itertools
 import math
 import os
@@ -22,6 +31,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..physics import parameters as _parameters
+from .limits import MAX_CASES
 
 
 class SweepError(ValueError):
@@ -72,8 +82,9 @@ def parse_vary(text: str) -> Vary:
         except (ValueError, IndexError):
             raise SweepError(f"--vary {text!r}: expected NAME=START:STOP:N with numbers START, STOP "
                              "and an integer N >= 1") from None
-        if n < 1 or (n == 1 and start != stop):
-            raise SweepError(f"--vary {text!r}: N = {n}: allowed N >= 2 (or N = 1 with START = STOP)")
+        if n < 1 or (n == 1 and start != stop) or n > MAX_CASES:
+            raise SweepError(f"--vary {text!r}: N = {n}: allowed 2 <= N <= {MAX_CASES} "
+                             f"(or N = 1 with START = STOP)")
         raw = [float(v) for v in np.linspace(start, stop, n)]
     else:
         raw = [v.strip() for v in spec.split(",")]
@@ -89,7 +100,26 @@ def cases(varies: Sequence[Vary]) -> list[dict[str, Any]]:
     names = [v.name for v in varies]
     if len(set(names)) != len(names):
         raise SweepError(f"--vary names a parameter twice: {', '.join(names)}")
+    n = math.prod(len(v.values) for v in varies)
+    if n > MAX_CASES:
+        raise SweepError(f"--vary: {' x '.join(str(len(v.values)) for v in varies)} = {n} cases; "
+                         f"at most {MAX_CASES} in one sweep")
     return [dict(zip(names, combo)) for combo in itertools.product(*(v.values for v in varies))]
+
+
+def check_cases(scene: Any, todo: Sequence[Mapping[str, Any]]) -> None:
+    """SweepError for the first case `simulate` would refuse as a scene: a parameter out of range or
+    inconsistent with the others, a drive without its input signal (``--vary drive=speed`` on a voltage
+    scene). ``scene``: the experiments.scenes.Scene swept."""
+    from .scenes import SceneError, check_drive_inputs
+
+    for case in todo:
+        label = ", ".join(f"{k}={v}" for k, v in case.items())
+        try:
+            params = _parameters.resolve({**scene.primary.overrides, **case})
+            check_drive_inputs(params["drive"], scene.u, scene.omega_ref, f"{scene.name}, case {label}")
+        except (_parameters.ParameterError, SceneError) as exc:
+            raise SweepError(f"--vary: {exc}") from None
 
 
 # ------------------------------------------------------------------- one case
@@ -119,12 +149,16 @@ def run_case(scene_ref: str, fmu: str, case: Mapping[str, Any], metrics: Sequenc
     run = scene.primary
     params = _parameters.resolve({**run.overrides, **case})
     start_values = {name: params[name] for name in {**run.overrides, **case}}
-    runner = _runner(fmu)
-    result = runner.simulate(start_values, scene.stop_time, scene.output_interval, input_table(scene),
-                             outputs=OUTPUT_NAMES, check_end=True)
-    r = {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}
     row = dict(case)
-    row.update({m: METRICS[m][2](r) for m in metrics})
+    try:
+        result = _runner(fmu).simulate(start_values, scene.stop_time, scene.output_interval, input_table(scene),
+                                       outputs=OUTPUT_NAMES, check_end=True)
+    except Exception as exc:  # noqa: BLE001 - the case fails, the sweep goes on (module docstring)
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        row.update({m: math.nan for m in metrics}, status="failed", message=text)
+        return row
+    r = {name: np.asarray(result[name], dtype=float) for name in ("time",) + OUTPUT_NAMES}
+    row.update({m: METRICS[m][2](r) for m in metrics}, status="ok", message="")
     return row
 
 
@@ -138,6 +172,10 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
     if bad:
         raise SweepError(f"--metric {', '.join(bad)}: allowed {', '.join(METRICS)}")
     todo = cases(varies)
+    from .scenes import find_scene
+
+    scene = find_scene(scene_ref)
+    check_cases(scene if stop_time is None else scene.with_stop_time(stop_time), todo)
     fmu = str(Path(fmu).resolve())
     rows: list[dict | None] = [None] * len(todo)
     if serial:
@@ -175,16 +213,24 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
 
 def write_table(rows: Sequence[Mapping[str, Any]], varies: Sequence[Vary], metrics: Sequence[str],
                 path: str | Path) -> Path:
-    """CSV: one row per case, headers with units ('m [kg]', 'peak_i [A]'); numbers with 17 digits (exact)."""
+    """CSV: one row per case, headers with units ('m [kg]', 'peak_i [A]'); numbers with 17 digits (exact);
+    then each case's status ('ok', 'failed') and message (the reason of a failed case, quoted)."""
     names = [v.name for v in varies] + list(metrics)
     units = {v.name: _parameters.BY_NAME[v.name].unit for v in varies}
     units.update({m: METRICS[m][0] for m in metrics})
     path = Path(path)
-    with open(path, "w", encoding="utf-8") as fh:
-        fh.write(",".join(f"{n} [{units[n]}]" if units[n] else n for n in names) + "\n")
+    with open(path, "w", encoding="utf-8", newline="") as fh:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow([f"{n} [{units[n]}]" if units[n] else n for n in names] + ["status", "message"])
         for row in rows:
-            fh.write(",".join(repr(row[n]) if isinstance(row[n], float) else str(row[n]) for n in names) + "\n")
+            out.writerow([repr(row[n]) if isinstance(row[n], float) else str(row[n]) for n in names]
+                         + [row.get("status", "ok"), row.get("message", "")])
     return path
+
+
+def failed(rows: Sequence[Mapping[str, Any]]) -> list[tuple[int, Mapping[str, Any]]]:
+    """(case number from 1, row) of every failed case."""
+    return [(k, row) for k, row in enumerate(rows, start=1) if row.get("status") == "failed"]
 
 
 def plot_table(rows: Sequence[Mapping[str, Any]], varies: Sequence[Vary], metrics: Sequence[str],

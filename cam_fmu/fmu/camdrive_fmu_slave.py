@@ -89,6 +89,7 @@ class CamDriveSlave(Fmi2Slave):
     author = "cam_fmu"
     description = DESCRIPTION
     default_experiment = DEFAULT_EXPERIMENT
+    errors_reach_logger = False  # set by the linux64 binary's bridge: no stderr copy of an error (see _fail)
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
@@ -217,10 +218,12 @@ class CamDriveSlave(Fmi2Slave):
         category logStatusError) followed by its own fmi2Fatal line, but only when
         the importer turned logging on (fmpy: ``debug_logging=True``); its fatal
         line does not contain the exception text. stderr is the fallback a user
-        sees when logging is off.
+        sees when logging is off; the project's own linux64 binary, which logs every
+        error even with logging off, sets ``errors_reach_logger`` and has no such line.
         """
         self.log(message, Fmi2Status.error)
-        print(f"[cam.fmu {self.instance_name}] error: {message}", file=sys.stderr, flush=True)
+        if not self.errors_reach_logger:
+            print(f"[cam.fmu {self.instance_name}] error: {message}", file=sys.stderr, flush=True)
         raise error(message)
 
     def _build(self) -> None:

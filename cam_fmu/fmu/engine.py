@@ -3,9 +3,10 @@
 ``DriveSimulator`` joins one formulation (physics.formulations, chosen from
 the parameters ``drive`` and ``formulation``) and one solver (solvers.SOLVERS,
 parameter ``solver``) and owns the time, the inputs and the state; it holds
-no physics. The FMU class only maps FMI variables onto it. numpy is not
-imported on this path: the FMU's run-time path is ``math`` only (scipy in an
-FMU crashes native hosts at teardown).
+no physics. The FMU class only maps FMI variables onto it. numpy is imported
+on this path (through kinematics.cam_program), scipy never (scipy in an FMU
+crashes native hosts at teardown); the per-step arithmetic is ``math`` on floats
+in the drive kernel.
 
 Solvers (consistent formulation, voltage drive):
 - ``euler``, ``rk4``: fixed internal step min(h_max, stability limit): a step

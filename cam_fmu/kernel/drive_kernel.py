@@ -9,7 +9,7 @@ second implementation. It imports the event names and constants from
 ``physics``, never the reverse. ``compile.py`` compiles this file with
 the C types of ``drive_kernel.pxd`` (Cython, pure-Python mode). Compiled and
 pure-Python runs execute the same IEEE operations in the same order: they agree
-to the last bit (tests/test_kernel_paths.py).
+to the last bit (tests/test_kernel_build.py).
 
 Style forced by the compilation, so that no Python object is built per
 evaluation: results are written into attributes (``s, s1, s2, s3`` after
@@ -31,7 +31,7 @@ from ..physics.variables import OUTPUT_NAMES
 
 # Constants spelled out: compiled, ``math`` here is C's libc math (the .pxd), which has no pi, inf or nan.
 TWO_PI = 2.0 * 3.141592653589793  # 2 pi, math.pi being that double
-SHAPE_CONST, SHAPE_SIN, SHAPE_COS = 0, 1, 2  # as kinematics.motion_law (tests/test_kernel_paths.py checks)
+SHAPE_CONST, SHAPE_SIN, SHAPE_COS = 0, 1, 2  # as kinematics.motion_law (tests/test_architecture.py checks)
 INF, NAN = float("inf"), float("nan")
 SEGMENT_FIELDS = 7  # end, start, F, c, kind, V0, S0 per non-empty law segment
 

@@ -91,6 +91,11 @@ class ProgramBase:
         return best, best_t
 
 
+# The shortest rise or return: 0.01 deg. The stroke's derivatives scale with 1/angle^3, which under- and
+# overflows for angles near 0 (1e-300 deg divided by zero); no cam is cut with a shorter stroke.
+MIN_STROKE_ANGLE = math.radians(0.01)
+
+
 class CamProgram(ProgramBase):
     """Rise, upper dwell, return, lower dwell; angles in rad summing to 2 pi, lift in m."""
 
@@ -108,9 +113,10 @@ class CamProgram(ProgramBase):
         bad = [f"{k}={v!r}" for k, v in angles.items() if not (math.isfinite(v) and v >= 0.0)]
         if bad:
             raise ValueError(f"angles must be finite and >= 0 [rad]: {', '.join(bad)}")
-        bad = [f"{k}={angles[k]!r}" for k in ("rise_angle", "return_angle") if angles[k] == 0.0]
+        bad = [f"{k}={angles[k]!r}" for k in ("rise_angle", "return_angle") if angles[k] < MIN_STROKE_ANGLE]
         if bad:
-            raise ValueError(f"rise and return angles must be > 0 [rad]: {', '.join(bad)}")
+            raise ValueError(f"rise and return angles must be >= {MIN_STROKE_ANGLE:.6g} rad (0.01 deg) [rad]: "
+                             f"{', '.join(bad)}")
         total = sum(angles.values())
         if abs(total - TWO_PI) > 1e-9:
             detail = ", ".join(f"{k}={v:.6g}" for k, v in angles.items())

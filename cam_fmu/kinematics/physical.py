@@ -25,11 +25,14 @@ from .motion_table import TableProgram
 __all__ = ["FollowerPeaks", "follower_peaks", "omega_from_rpm"]
 
 
+MAX_RPM = 1e6  # rpm; far above any cam, and low enough that v, a, j = s' w, s'' w^2, s''' w^3 stay finite
+
+
 def omega_from_rpm(rpm: float) -> float:
     """Cam speed [rad/s] from rpm (> 0)."""
     rpm = float(rpm)
-    if not (math.isfinite(rpm) and rpm > 0.0):
-        raise ValueError(f"rpm must be a finite number > 0, got {rpm!r}")
+    if not (math.isfinite(rpm) and 0.0 < rpm <= MAX_RPM):
+        raise ValueError(f"rpm = {rpm!r}: allowed (0, {MAX_RPM:g}] rpm")
     return 2.0 * math.pi * rpm / 60.0
 
 

@@ -40,6 +40,8 @@ class ParameterSpec:
         if self.kind == "boolean":
             return "true or false"
         if self.kind == "string":
+            if not self.choices:  # a free string (motion_table): its content is checked where it is used
+                return "any text (\"\" = not used)" if self.default == "" else "any text"
             return "one of " + ", ".join(repr(c) for c in self.choices)
         left = "(" if self.low_open else "["
         zero = "0 or " if self.zero_ok else ""

@@ -14,8 +14,8 @@
  *   enter / exit         fmi2EnterInitializationMode / fmi2ExitInitializationMode alone
  *   setr VR VALUE        fmi2SetReal of one variable (VALUE may be nan)
  *   sets VR TEXT         fmi2SetString of one variable
- *   getr VR,VR,...       one fmi2GetReal of all listed variables
- *   gets VR,VR,...       one fmi2GetString of all listed variables
+ *   getr VR,VR,...       one fmi2GetReal of all listed variables (the array is filled with -1.5 first)
+ *   gets VR,VR,...       one fmi2GetString of all listed variables (the array is filled with "junk" first)
  *   step N H             N x fmi2DoStep of size H (stops at the first non-OK status)
  *   stepat T H           one fmi2DoStep(T, H), whatever the host's time
  *   save / restore       fmi2GetFMUstate / fmi2SetFMUstate (one slot)
@@ -23,7 +23,8 @@
  *   reset / term / free  fmi2Reset / fmi2Terminate / fmi2FreeInstance
  *   laststatus           fmi2GetBooleanStatus(fmi2Terminated) and fmi2GetRealStatus(fmi2LastSuccessfulTime)
  *   cycles N             N x (fmi2Instantiate + fmi2FreeInstance); prints RSS after 20 and after N (Linux)
- *   nullcalls            every get/set/step call with a NULL instance: must return fmi2Error and zero outputs
+ *   nullcalls            every getter with a NULL and with a bogus component, outputs filled with junk
+ *                        first; prints each status and what the outputs hold afterwards (no instance needed)
  * At the end: fmi2FreeInstance if still instantiated, dlclose, {"exit": 0}, return 0.
  */
 #include <math.h>
@@ -90,6 +91,17 @@ static long rss_kb(void)
 
 #define SYM(name) fmi2##name##TYPE *fmi2##name = (fmi2##name##TYPE *)SYMBOL(lib, "fmi2" #name)
 
+static void json_strings(const char *const *s, size_t n)
+{
+    putchar('[');
+    for (size_t i = 0; i < n; i++) {
+        if (i) printf(", ");
+        if (s[i]) json_string(s[i]);
+        else printf("null");
+    }
+    putchar(']');
+}
+
 int main(int argc, char **argv)
 {
     LIBRARY lib;
@@ -118,7 +130,8 @@ int main(int argc, char **argv)
     SYM(ExitInitializationMode); SYM(Terminate); SYM(Reset); SYM(SetReal); SYM(GetReal); SYM(GetString);
     SYM(SetString); SYM(DoStep); SYM(GetFMUstate); SYM(SetFMUstate); SYM(FreeFMUstate);
     SYM(SerializedFMUstateSize); SYM(SerializeFMUstate); SYM(DeSerializeFMUstate);
-    SYM(GetBooleanStatus); SYM(GetRealStatus);
+    SYM(GetBooleanStatus); SYM(GetRealStatus); SYM(GetInteger); SYM(GetBoolean); SYM(GetStatus);
+    SYM(GetIntegerStatus); SYM(GetStringStatus); SYM(GetDirectionalDerivative); SYM(GetRealOutputDerivatives);
     if (!fmi2Instantiate || !fmi2DoStep || !fmi2GetBooleanStatus || !fmi2DeSerializeFMUstate || !fmi2GetString) {
         printf("{\"dlsym\": \"missing FMI functions\"}\n");
         return 3;
@@ -132,19 +145,38 @@ int main(int argc, char **argv)
             guid = argv[++k];
             continue;
         } else if (!strcmp(cmd, "nullcalls")) {
-            fmi2ValueReference vr[2] = {0, 1};
-            double reals[2] = {7.0, 7.0};
-            fmi2String strings[2] = {"x", "x"};
-            int zeroed;
-            fmi2Status st[4];
-            st[0] = fmi2GetReal(NULL, vr, 2, reals);
-            st[1] = fmi2GetString(NULL, vr, 2, strings);
-            st[2] = fmi2DoStep(NULL, 0.0, 1e-3, fmi2True);
-            st[3] = fmi2SetReal(NULL, vr, 2, reals);
-            zeroed = reals[0] == 0.0 && reals[1] == 0.0 && strings[0] && !strings[0][0] && strings[1] && !strings[1][0];
-            printf("{\"cmd\": \"nullcalls\", \"statuses\": [%d, %d, %d, %d], \"zeroed\": %s}\n", (int)st[0],
-                   (int)st[1], (int)st[2], (int)st[3], zeroed ? "true" : "false");
-            fflush(stdout);
+            int bogus[64] = {0};   /* memory that is not an instance: the wrapper must recognise it */
+            fmi2Component comps[2] = {NULL, bogus};
+            for (int which = 0; which < 2; which++) {
+                fmi2Component x = comps[which];
+                fmi2ValueReference vrs[3] = {0, 1, 2}, z[2] = {0, 1};
+                double r[3] = {-1.5, -1.5, -1.5}, rs = -1.5, dz[2] = {-1.5, -1.5}, od[2] = {-1.5, -1.5}, dv[1] = {1};
+                int iv[3] = {-7, -7, -7}, bv[3] = {-7, -7, -7}, is = -7, bs = -7, order[2] = {1, 1};
+                const char *sv[3] = {"junk", "junk", "junk"}, *ss = "junk";
+                fmi2Status st = fmi2Pending;
+                int statuses[11];
+                statuses[0] = fmi2GetReal(x, vrs, 3, r);
+                statuses[1] = fmi2GetInteger(x, vrs, 3, iv);
+                statuses[2] = fmi2GetBoolean(x, vrs, 3, bv);
+                statuses[3] = fmi2GetString(x, vrs, 3, sv);
+                statuses[4] = fmi2GetStatus(x, 0, &st);
+                statuses[5] = fmi2GetRealStatus(x, 2, &rs);
+                statuses[6] = fmi2GetIntegerStatus(x, 0, &is);
+                statuses[7] = fmi2GetBooleanStatus(x, 3, &bs);
+                statuses[8] = fmi2GetStringStatus(x, 0, &ss);
+                statuses[9] = fmi2GetDirectionalDerivative(x, vrs, 1, z, 2, dv, dz);
+                statuses[10] = fmi2GetRealOutputDerivatives(x, z, 2, order, od);
+                printf("{\"cmd\": \"nullcalls\", \"component\": \"%s\", \"statuses\": [", which ? "bogus" : "null");
+                for (int i = 0; i < 11; i++) printf(i ? ", %d" : "%d", statuses[i]);
+                printf("], \"real\": [%g, %g, %g], \"integer\": [%d, %d, %d], \"boolean\": [%d, %d, %d], \"string\": ",
+                       r[0], r[1], r[2], iv[0], iv[1], iv[2], bv[0], bv[1], bv[2]);
+                json_strings(sv, 3);
+                printf(", \"status\": %d, \"real_status\": %g, \"integer_status\": %d, \"boolean_status\": %d, "
+                       "\"string_status\": ", (int)st, rs, is, bs);
+                json_strings(&ss, 1);
+                printf(", \"directional\": [%g, %g], \"output_derivatives\": [%g, %g]}\n", dz[0], dz[1], od[0], od[1]);
+                fflush(stdout);
+            }
             continue;
         } else if (!strcmp(cmd, "inst")) {
             c = fmi2Instantiate("host", fmi2CoSimulation, guid, uri, &cb, fmi2False, fmi2False);
@@ -187,18 +219,16 @@ int main(int argc, char **argv)
             if (s == fmi2OK) time = t0 + h;
         } else if (!strcmp(cmd, "gets")) {
             fmi2ValueReference vrs[64];
-            fmi2String values[64];
+            const char *values[64];
             size_t n = 0;
             char *list = strdup(argv[++k]);
+            for (int i = 0; i < 64; i++) values[i] = "junk";
             for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
             free(list);
             s = fmi2GetString(c, vrs, n, values);
-            printf("{\"cmd\": \"gets\", \"status\": %d, \"values\": [", (int)s);
-            for (size_t i = 0; i < n; i++) {
-                if (i) printf(", ");
-                json_string(values[i] ? values[i] : "(null)");
-            }
-            printf("]}\n");
+            printf("{\"cmd\": \"gets\", \"status\": %d, \"values\": ", (int)s);
+            json_strings(values, n);
+            printf("}\n");
             fflush(stdout);
             continue;
         } else if (!strcmp(cmd, "setr")) {
@@ -214,6 +244,7 @@ int main(int argc, char **argv)
             double values[64];
             size_t n = 0;
             char *list = strdup(argv[++k]);
+            for (int i = 0; i < 64; i++) values[i] = -1.5;
             for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
             free(list);
             s = fmi2GetReal(c, vrs, n, values);

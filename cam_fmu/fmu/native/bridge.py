@@ -168,6 +168,7 @@ class Instance:
 
     def __init__(self, cls, name: str, resources: str, visible: bool):
         self.cls = cls
+        cls.errors_reach_logger = True  # this binary logs every error through the host's logger (docs/fmu.md)
         self.args = dict(instance_name=name, resources=resources, visible=bool(visible))
         self.slave = None
         self.last_error = ""

@@ -105,6 +105,7 @@ static PyObject *g_bridge = NULL;   /* <package>._fmi_bridge */
 static PyObject *g_class = NULL;    /* the slave class */
 static int g_live = 0;              /* live instances (guarded by the GIL) */
 static int (*p_is_finalizing)(void) = NULL;  /* Py_IsFinalizing (3.13+) or _Py_IsFinalizing, if exported */
+static PyObject *p_none = NULL;     /* Python's None (_Py_NoneStruct): a payload that means "nothing" */
 static char g_package[128];
 static char g_slave[128];
 
@@ -362,6 +363,11 @@ static int load_api(void *handle, char *err, size_t errsize)
     }
     PY_FUNCTIONS(LOAD_PTR)
 #undef LOAD_PTR
+    p_none = (PyObject *)dlsym(handle, "_Py_NoneStruct");
+    if (!p_none) {
+        snprintf(err, errsize, "libpython lacks _Py_NoneStruct");
+        return -1;
+    }
     p_is_finalizing = (int (*)(void))dlsym(handle, "Py_IsFinalizing");
     if (!p_is_finalizing) p_is_finalizing = (int (*)(void))dlsym(handle, "_Py_IsFinalizing");
     return 0;
@@ -376,6 +382,7 @@ static int python_usable(void)
 static void reset_api(void)
 {
     p_is_finalizing = NULL;
+    p_none = NULL;
 #define CLEAR_PTR(name) p_##name = NULL;
     PY_FUNCTIONS(CLEAR_PTR)
 #undef CLEAR_PTR
@@ -760,8 +767,9 @@ static PyObject *packed(const void *data, size_t bytes)
 }
 
 /* ------------------------------------------------------------------ the exchange */
-/* Ask the bridge for the exchange and check its layout (GIL held).  Without one (another slave, or a
- * layout that does not fit) every value call goes to Python, as before. */
+/* Ask the bridge for the exchange and check its layout (GIL held).  Without one (another slave: the
+ * bridge answers None, quietly; or a layout that does not fit: a warning) every value call goes to
+ * Python, as before.  None is checked before PyByteArray_AsString, which is undefined for it. */
 static void share_exchange(Instance *c)
 {
     PyObject *buffer = NULL;
@@ -773,7 +781,7 @@ static void share_exchange(Instance *c)
         c->in_error = c->terminated = 0;
         logf_(c, fmi2Warning, "logStatusWarning", "the exchange could not be set up: every value call goes to Python");
     }
-    if (s != fmi2OK || !buffer) {
+    if (s != fmi2OK || !buffer || buffer == p_none) {
         if (buffer) p_Py_DecRef(buffer);
         return;
     }
@@ -990,6 +998,19 @@ EXPORT fmi2Status fmi2Reset(fmi2Component comp)
 }
 
 /* ---- values */
+/* Every output array gets safe values (0, false, "") before a call is checked, so a host that reads it
+ * after a refused call (an invalid instance, an unknown value reference, fmi2Error) reads no garbage. */
+static void zero_out(void *out, size_t n, size_t item)
+{
+    if (out && n) memset(out, 0, n * item);
+}
+
+static void empty_strings(fmi2String value[], size_t n)
+{
+    if (value)
+        for (size_t i = 0; i < n; i++) value[i] = "";
+}
+
 static fmi2Status get_values(fmi2Component comp, const char *fname, const char *method,
                              const fmi2ValueReference vr[], size_t nvr, void *out, size_t item)
 {
@@ -997,6 +1018,7 @@ static fmi2Status get_values(fmi2Component comp, const char *fname, const char *
     fmi2Status s;
     char *data;
     Py_ssize_t size;
+    zero_out(out, nvr, item);
     ENTER(fname, 1)
     if (nvr == 0) LEAVE(fmi2OK);
     if (!vr || !out) {
@@ -1090,6 +1112,7 @@ EXPORT fmi2Status fmi2GetString(fmi2Component comp, const fmi2ValueReference vr[
 {
     PyObject *vrs, *payload = NULL;
     fmi2Status s;
+    empty_strings(value, nvr);
     ENTER("fmi2GetString", 1)
     if (nvr == 0) LEAVE(fmi2OK);
     if (!vr || !value) {
@@ -1176,6 +1199,7 @@ EXPORT fmi2Status fmi2CancelStep(fmi2Component comp)
 
 EXPORT fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Status *value)
 {
+    if (value) *value = fmi2OK;
     ENTER("fmi2GetStatus", 1)
     if (s == fmi2DoStepStatus && value) {
         *value = c->terminated ? fmi2Discard : fmi2OK;
@@ -1186,6 +1210,7 @@ EXPORT fmi2Status fmi2GetStatus(fmi2Component comp, const fmi2StatusKind s, fmi2
 
 EXPORT fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Real *value)
 {
+    if (value) *value = 0.0;
     ENTER("fmi2GetRealStatus", 1)
     if (s == fmi2LastSuccessfulTime && value) {
         *value = c->time;
@@ -1197,7 +1222,7 @@ EXPORT fmi2Status fmi2GetRealStatus(fmi2Component comp, const fmi2StatusKind s, 
 EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Integer *value)
 {
     (void)s;
-    (void)value;
+    if (value) *value = 0;
     ENTER("fmi2GetIntegerStatus", 1)
     LEAVE(fmi2Discard);
 }
@@ -1205,6 +1230,7 @@ EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component comp, const fmi2StatusKind 
 /* fmi2Terminated is true after a discarded step: fmpy then ends the run at fmi2LastSuccessfulTime. */
 EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind s, fmi2Boolean *value)
 {
+    if (value) *value = fmi2False;
     ENTER("fmi2GetBooleanStatus", 1)
     if (s == fmi2Terminated && value) {
         *value = c->terminated ? fmi2True : fmi2False;
@@ -1216,7 +1242,7 @@ EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component comp, const fmi2StatusKind 
 EXPORT fmi2Status fmi2GetStringStatus(fmi2Component comp, const fmi2StatusKind s, fmi2String *value)
 {
     (void)s;
-    (void)value;
+    if (value) *value = "";
     ENTER("fmi2GetStringStatus", 1)
     LEAVE(fmi2Discard);
 }
@@ -1293,6 +1319,7 @@ EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component comp, fmi2FMUstate FM
     char *data;
     Py_ssize_t n = 0;
     fmi2Status s;
+    if (size) *size = 0;
     ENTER("fmi2SerializedFMUstateSize", 1)
     if (!state || !size) LEAVE(fmi2Error);
     s = serialized(c, state, &bytes);
@@ -1309,6 +1336,7 @@ EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component comp, fmi2FMUstate FMUstat
     char *data;
     Py_ssize_t n = 0;
     fmi2Status s;
+    zero_out(out, size, 1);
     ENTER("fmi2SerializeFMUstate", 1)
     if (!state || !out) LEAVE(fmi2Error);
     s = serialized(c, state, &bytes);
@@ -1357,7 +1385,8 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2Val
                                                const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
                                                fmi2Real dz[])
 {
-    (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
+    (void)u; (void)nu; (void)z; (void)dv;
+    zero_out(dz, nz, sizeof *dz);
     ENTER("fmi2GetDirectionalDerivative", 1)
     logf_(c, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative is not supported");
     LEAVE(fmi2Error);
@@ -1375,7 +1404,8 @@ EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component comp, const fmi2Valu
 EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component comp, const fmi2ValueReference vr[], size_t nvr,
                                                const fmi2Integer order[], fmi2Real value[])
 {
-    (void)vr; (void)nvr; (void)order; (void)value;
+    (void)vr; (void)order;
+    zero_out(value, nvr, sizeof *value);
     ENTER("fmi2GetRealOutputDerivatives", 1)
     logf_(c, fmi2Error, "logStatusError", "fmi2GetRealOutputDerivatives is not supported");
     LEAVE(fmi2Error);

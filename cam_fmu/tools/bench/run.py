@@ -62,7 +62,7 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ...experiments.fmu_file import ensure_fmu
+from ...experiments.fmu_file import check_cam_variables, ensure_fmu
 from .cases import CASES, COMM_STEPS, References, load_cases, settings_grid
 from .floor import build_floor_fmu
 from .perstep import EFFECT_COLUMNS, GOAL_C, GOAL_PY, SCENE_COLUMNS, run_perstep
@@ -80,10 +80,10 @@ def run_bench(out: Path, quick: bool = False, fmu_path: Path | None = None,
         (log or print)(text)
         sys.stdout.flush()
 
+    fmu_path = check_cam_variables(ensure_fmu(fmu_path, log=say))  # another FMU: refused before any run
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    fmu_path = ensure_fmu(fmu_path, log=say)
     comm_steps = (1e-3,) if quick else COMM_STEPS
     cases = load_cases(("fig6",) if quick else CASES)
     repeats, floor_repeats, min_time = 3, 5, 1.0
