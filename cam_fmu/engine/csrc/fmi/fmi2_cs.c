@@ -50,7 +50,10 @@ typedef enum {
 #define ANY_STATE (INSTANTIATED | INITIALIZATION | STEP_COMPLETE | STEP_FAILED | ERROR_STATE | TERMINATED)
 #define GET_STATES (INITIALIZATION | STEP_COMPLETE | STEP_FAILED | ERROR_STATE | TERMINATED)
 
+#define INSTANCE_MAGIC 0x63616d32u   /* 'cam2': a pointer a host passes is checked to be an instance */
+
 typedef struct {
+    unsigned magic;               /* INSTANCE_MAGIC while alive, 0 once freed */
     CamInstance *drive;
     fmi2CallbackLogger logger;
     fmi2ComponentEnvironment environment;
@@ -175,12 +178,20 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     S->environment = probe.environment;
     S->logging_on = loggingOn ? 1 : 0;
     S->state = INSTANTIATED;
+    S->magic = INSTANCE_MAGIC;
     return S;
 }
 
-void fmi2FreeInstance(fmi2Component c) {
+/* The instance behind a component a host passes, or NULL (NULL, freed, or not an instance). */
+static Instance *instance(fmi2Component c) {
     Instance *S = c;
+    return S && S->magic == INSTANCE_MAGIC ? S : NULL;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    Instance *S = instance(c);
     if (!S) return;
+    S->magic = 0;
     cam_instance_free(S->drive);
     free(S->name);
     free(S);
@@ -188,7 +199,7 @@ void fmi2FreeInstance(fmi2Component c) {
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)nCategories;
     (void)categories;
     if (!S) return fmi2Error;
@@ -198,7 +209,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[200];
     (void)toleranceDefined;
     (void)tolerance;
@@ -215,7 +226,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!allowed(S, INSTANTIATED, "fmi2EnterInitializationMode")) return fmi2Error;
     S->state = INITIALIZATION;
@@ -223,7 +234,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     fmi2Status status;
     if (!S) return fmi2Error;
     if (!allowed(S, INITIALIZATION, "fmi2ExitInitializationMode")) return fmi2Error;
@@ -236,7 +247,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!allowed(S, STEP_COMPLETE | STEP_FAILED | ERROR_STATE, "fmi2Terminate")) return fmi2Error;
     S->state = TERMINATED;
@@ -244,7 +255,7 @@ fmi2Status fmi2Terminate(fmi2Component c) {
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     cam_instance_reset(S->drive);
     S->state = INSTANTIATED;
@@ -283,7 +294,7 @@ static int check_references(Instance *S, const fmi2ValueReference vr[], size_t n
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (value) for (k = 0; k < nvr; k++) value[k] = 0.0;
     if (!S) return fmi2Error;
@@ -296,7 +307,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     (void)vr;
     if (value) for (k = 0; k < nvr; k++) value[k] = 0;
@@ -306,7 +317,7 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     int v;
     if (value) for (k = 0; k < nvr; k++) value[k] = fmi2False;
@@ -322,7 +333,7 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (value) for (k = 0; k < nvr; k++) value[k] = "";
     if (!S) return fmi2Error;
@@ -339,7 +350,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 #define SET_STATES (INSTANTIATED | INITIALIZATION | STEP_COMPLETE)
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[MESSAGE_MAX];
     size_t k;
     if (!S) return fmi2Error;
@@ -355,7 +366,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)vr;
     (void)value;
     if (!S) return fmi2Error;
@@ -364,7 +375,7 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetBoolean")) return fmi2Error;
@@ -379,7 +390,7 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetString")) return fmi2Error;
@@ -410,7 +421,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[300];
     double now;
     fmi2Status status;
@@ -434,14 +445,14 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     return fail(S, "fmi2CancelStep", "cam.fmu steps synchronously: there is no step to cancel");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)vr;
     (void)order;
     (void)value;
@@ -452,7 +463,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     (void)vr;
     (void)order;
@@ -463,7 +474,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = fmi2OK;
     if (!S || !value) return fmi2Error;
     if (s == fmi2DoStepStatus) return fmi2OK; /* steps are synchronous: never pending */
@@ -471,7 +482,7 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = 0.0;
     if (!S || !value) return fmi2Error;
     if (s != fmi2LastSuccessfulTime) return fail(S, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is a Real status");
@@ -480,7 +491,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)s;
     if (value) *value = 0;
     if (!S) return fmi2Error;
@@ -488,7 +499,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = fmi2False;
     if (!S || !value) return fmi2Error;
     if (s != fmi2Terminated) return fail(S, "fmi2GetBooleanStatus", "only fmi2Terminated is a Boolean status");
@@ -497,7 +508,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)s;
     if (value) *value = "";
     if (!S) return fmi2Error;
@@ -519,7 +530,7 @@ static SavedState *save_state(Instance *S) {
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     SavedState *saved;
     if (!S || !FMUstate) return fmi2Error;
     saved = save_state(S);
@@ -543,14 +554,14 @@ static fmi2Status restore(Instance *S, const SavedState *saved, const char *call
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!FMUstate) return fail(S, "fmi2SetFMUstate", "FMUstate must not be NULL");
     return restore(S, FMUstate, "fmi2SetFMUstate");
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    if (!c) return fmi2Error;
+    if (!instance(c)) return fmi2Error;
     if (FMUstate) {
         free(*FMUstate);
         *FMUstate = NULL;
@@ -559,7 +570,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (size) *size = 0;
     if (!S || !size) return fmi2Error;
     if (!FMUstate) return fail(S, "fmi2SerializedFMUstateSize", "FMUstate must not be NULL");
@@ -580,7 +591,7 @@ static unsigned long get_u32(const unsigned char *p) {
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
-    Instance *S = c;
+    Instance *S = instance(c);
     const SavedState *saved = FMUstate;
     unsigned char *out = (unsigned char *)serializedState;
     if (!S) return fmi2Error;
@@ -596,7 +607,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     const unsigned char *in = (const unsigned char *)serializedState;
     SavedState *saved;
     size_t payload;
@@ -619,7 +630,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     (void)vUnknown_ref;
     (void)vKnown_ref;
