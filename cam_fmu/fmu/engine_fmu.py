@@ -9,7 +9,8 @@ Build time only. Steps:
 3. The binary: every engine source (``engine/csrc/src/*.c``) and the FMI 2.0
    glue (``engine/csrc/fmi/fmi2_cs.c``) compiled into one shared library with the
    official FMI headers (fmpy's copy), only the FMI functions exported, linked
-   with libc and libm only: ``binaries/linux64/cam.so``.
+   with libc and libm only: ``binaries/linux64/cam.so``; with the MinGW-w64 cross
+   compiler also ``binaries/win64/cam.dll`` (Windows' own KERNEL32 and msvcrt only).
 4. ``modelDescription.xml``: ``model_description.skeleton`` completed by
    ``model_description.postprocess`` (units, ranges, structure, the default
    experiment of the paper's fig. 6 scene).
@@ -36,6 +37,11 @@ FMI = engine_build.CSRC / "fmi"
 GLUE = (FMI / "instance.c", FMI / "fmi2_cs.c")  # the instance layer and the FMI 2.0 glue
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
 BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
+# win64: Debian's MinGW-w64 cross compiler; libgcc linked in, so the DLL needs only Windows' own
+# KERNEL32.dll and msvcrt.dll.
+WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
+WIN64_FLAGS: tuple[str, ...] = ("-static-libgcc",)
+PLATFORMS = ("linux64", "win64")
 
 
 class FmuBuildError(RuntimeError):
@@ -64,16 +70,30 @@ def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_fla
         raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
 
 
-def build(dest: Path) -> Path:
-    """Build cam.fmu at ``dest`` (a path ending in .fmu) and return it."""
+def win64_compiler() -> str | None:
+    """The MinGW-w64 cross compiler on PATH, or None."""
+    return shutil.which(WIN64_COMPILER)
+
+
+def build(dest: Path, win64: bool | None = None) -> Path:
+    """Build cam.fmu at ``dest`` (a path ending in .fmu) and return it.
+
+    ``win64``: True requires the win64 binary (FmuBuildError without the cross compiler), False
+    leaves it out, None (the default) adds it when the cross compiler is installed."""
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
         raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
+    cross = win64_compiler() if win64 is not False else None
+    if win64 and not cross:
+        raise FmuBuildError(f"the win64 binary needs the MinGW-w64 cross compiler {WIN64_COMPILER} "
+                            "(Debian: apt-get install gcc-mingw-w64-x86-64; setup.sh installs it)")
     rows = model_description.variable_rows()
     guid = engine_guid()
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         root = Path(tmp)
         compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid)
+        if cross:
+            compile_binary(root / "fmu" / "binaries" / "win64" / f"{MODEL_IDENTIFIER}.dll", guid, cross, WIN64_FLAGS)
         xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
                                             default_experiment(), DESCRIPTION, rows)
         (root / "fmu" / "modelDescription.xml").write_bytes(xml)
