@@ -7,16 +7,18 @@ cd "$(dirname "$0")"
 # Debian packages, installed only when missing (apt is not touched otherwise):
 # - gcc:      compiles cam.fmu's own linux64 binary (cam_fmu/fmu/native/fmi2_python.c) and the test host;
 # - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
-# - libtbb12: needed by the FMU host `ecos`.
+# - libtbb12: needed by the FMU host `ecos`;
+# - gcc-mingw-w64-x86-64: cross-compiles cam.fmu's win64 binary (cam_fmu/fmu/engine_fmu.py);
+# - wine64:   runs that binary in the win64 test host (tests/test_engine_fmu_win64.py).
 missing=()
-for pkg in gcc valgrind libtbb12; do
+for pkg in gcc valgrind libtbb12 gcc-mingw-w64-x86-64 wine64; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
         missing+=("$pkg")
     fi
 done
 if [ "${#missing[@]}" -gt 0 ]; then
     apt-get update
-    apt-get install -y "${missing[@]}"
+    DEBIAN_FRONTEND=noninteractive apt-get install -y "${missing[@]}"
 fi
 
 # the test environment pinned (constraints/test.txt; refresh: bash constraints/refresh.sh), the package keeps ranges

@@ -42,6 +42,15 @@ def cam_fmu_path(tmp_path_factory) -> Path:
     return _build_fmu(tmp_path_factory.mktemp("cam_fmu_build") / "cam.fmu")
 
 
+@pytest.fixture(scope="session")
+def engine_fmu_path(tmp_path_factory) -> Path:
+    """cam.fmu built from the C engine (cam_fmu.fmu.engine_fmu) once per test session. It hosts no
+    Python: loading it into the pytest process is safe."""
+    from cam_fmu.fmu import engine_fmu
+
+    return engine_fmu.build(tmp_path_factory.mktemp("engine_fmu_build") / "cam.fmu")
+
+
 def run_fmu_script(script: Path, *args: str, cwd: Path | None = None, timeout: float = 300,
                    python_args: tuple[str, ...] = ()) -> dict:
     """Run ``python [python_args] script args...`` and return the JSON object it prints last.

@@ -1,4 +1,5 @@
-"""A non-editable `pip install .` works from any directory: scenes and the FMU build ship with the package."""
+"""A non-editable `pip install .` works from any directory: the engine is compiled at install time, and the
+scenes and the FMU build ship with the package."""
 from __future__ import annotations
 
 import os
@@ -24,6 +25,12 @@ def test_installed_package_simulates_a_shipped_scene_on_the_fmu(tmp_path):
     where = subprocess.run([str(python), "-c", "import cam_fmu; print(cam_fmu.__file__)"], capture_output=True,
                            text=True, env=env, cwd=elsewhere, timeout=120)
     assert where.returncode == 0 and where.stdout.strip().startswith(str(env_dir)), where.stdout + where.stderr
+    # pip built the C engine into the package: loading it compiles nothing and writes no cache
+    lib = subprocess.run([str(python), "-c", "from cam_fmu.engine import build; print(build.build())"],
+                         capture_output=True, text=True, env=env, cwd=elsewhere, timeout=120)
+    assert lib.returncode == 0, lib.stderr
+    assert lib.stdout.strip().startswith(str(env_dir)) and "/engine/_lib/libcamdrive-" in lib.stdout
+    assert not (tmp_path / "cache" / "cam_fmu").exists() or not list((tmp_path / "cache" / "cam_fmu").glob("libcamdrive*"))
     cam_fmu_cli = env_dir / "bin" / "cam-fmu"
     run = subprocess.run([str(cam_fmu_cli), "simulate", "paper_fig6", "--engine", "fmu", "--out", "out",
                           "--stop-time", "0.05", "--no-plot"], capture_output=True, text=True, env=env,

@@ -98,18 +98,20 @@ def library_dir() -> Path:
     return cache
 
 
-def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str | None = None) -> Path:
-    """Compile every engine source into the shared library ``dest``; returns ``dest``."""
+def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str | None = None,
+                    extra_sources: Sequence[Path] = (), include: Sequence[Path] = ()) -> Path:
+    """Compile every engine source (and ``extra_sources``, with the folders ``include``) into the shared
+    library ``dest``; returns ``dest``. The FMU's binary is this library plus its FMI glue."""
     cc = compiler or find_compiler()
-    sources = [str(p) for p in sorted(SOURCES.glob("*.c"))]
+    sources = [str(p) for p in sorted(SOURCES.glob("*.c"))] + [str(p) for p in extra_sources]
     if not sources:
         raise EngineBuildError(f"no C sources in {SOURCES}")
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
         generated = [str(p) for p in codegen.write(Path(gen)) if p.suffix == ".c"]
-        cmd = [cc, *CFLAGS, *extra_flags, f"-I{INCLUDE}", f"-I{gen}", *sources, *generated, "-o", str(tmp),
-               *LDFLAGS]
+        cmd = [cc, *CFLAGS, *extra_flags, f"-I{INCLUDE}", f"-I{gen}", *(f"-I{p}" for p in include), *sources,
+               *generated, "-o", str(tmp), *LDFLAGS]
         proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         tmp.unlink(missing_ok=True)
@@ -118,13 +120,20 @@ def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str |
     return dest
 
 
-def build(extra_flags: Sequence[str] = ()) -> Path:
-    """The current engine library (compiled now unless a build of these sources exists)."""
+def library_name(extra_flags: Sequence[str] = ()) -> str:
+    """The file name of the library these sources and flags make."""
     suffix = ".dll" if sys.platform == "win32" else ".so"
-    dest = library_dir() / f"{LIBRARY_STEM}-{digest(extra_flags)}{suffix}"
-    if dest.is_file():
-        return dest
-    return compile_library(dest, extra_flags)
+    return f"{LIBRARY_STEM}-{digest(extra_flags)}{suffix}"
+
+
+def build(extra_flags: Sequence[str] = ()) -> Path:
+    """The current engine library: the one ``pip install`` put into the package, else one built
+    earlier into the package's or the user's cache folder, else compiled now."""
+    name = library_name(extra_flags)
+    for folder in (HERE / "_lib", Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"):
+        if (folder / name).is_file():
+            return folder / name
+    return compile_library(library_dir() / name, extra_flags)
 
 
 def main() -> int:

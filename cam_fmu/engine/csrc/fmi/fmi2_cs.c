@@ -2,7 +2,7 @@
  *
  * Thin by design: the FMI state machine, argument checks, logging and the FMU state objects.
  * Everything the drive does is behind cam_instance_*; an FMI 3.0 glue would replace only this file.
- * Compiled into the FMU's binary with the engine (csrc/src/*.c) and the official FMI 2.0 headers
+ * Compiled into the FMU's binary with the engine (csrc/src/ *.c) and the official FMI 2.0 headers
  * (those fmpy ships); CAM_GUID is defined at build time from the model description.
  *
  * Rules kept here (docs/fmu.md, "Errors"):
@@ -10,8 +10,11 @@
  * - A refused request writes nothing: a multi-value set checks every value before writing one.
  * - Output arrays of get calls are filled with safe values (0, false, "") before anything is
  *   checked, so a host that ignores a refusal never reads garbage.
- * - After fmi2Error only get calls, state calls, fmi2Reset, fmi2Terminate and fmi2FreeInstance
- *   are allowed; fmi2SetFMUstate or fmi2Reset makes the instance usable again.
+ * - A refused request (a value out of range, an unknown variable, a call out of order) is fmi2Error
+ *   and changes nothing: the instance goes on. An error of the model itself (initialisation or a
+ *   step that cannot be computed correctly) puts the instance into the error state: then only get
+ *   calls, state calls, fmi2Reset, fmi2Terminate and fmi2FreeInstance are allowed, and
+ *   fmi2SetFMUstate or fmi2Reset makes it usable again.
  * - fmi2Discard (a step the solver cannot complete at this size) leaves the state as before the
  *   step: fmi2GetBooleanStatus(fmi2Terminated) is true, fmi2LastSuccessfulTime where it stands.
  */
@@ -47,7 +50,10 @@ typedef enum {
 #define ANY_STATE (INSTANTIATED | INITIALIZATION | STEP_COMPLETE | STEP_FAILED | ERROR_STATE | TERMINATED)
 #define GET_STATES (INITIALIZATION | STEP_COMPLETE | STEP_FAILED | ERROR_STATE | TERMINATED)
 
+#define INSTANCE_MAGIC 0x63616d32u   /* 'cam2': a pointer a host passes is checked to be an instance */
+
 typedef struct {
+    unsigned magic;               /* INSTANCE_MAGIC while alive, 0 once freed */
     CamInstance *drive;
     fmi2CallbackLogger logger;
     fmi2ComponentEnvironment environment;
@@ -78,20 +84,29 @@ static const char *state_name(InstanceState s) {
 }
 
 static void log_message(Instance *S, fmi2Status status, const char *category, const char *format, ...) {
-    char text[MESSAGE_MAX];
+    char text[MESSAGE_MAX], escaped[2 * MESSAGE_MAX];
+    size_t k, n = 0;
     va_list args;
     if (!S->logger || (status == fmi2OK && !S->logging_on)) return;
     va_start(args, format);
     vsnprintf(text, sizeof text, format, args);
     va_end(args);
     if (strlen(text) == sizeof text - 1) memcpy(text + sizeof text - 5, "...", 4);
-    /* the text as an argument, never as the format: a value may contain '%' */
-    S->logger(S->environment, S->name, status, category, "%s", text);
+    /* The text is the logger's format with every '%' doubled and no arguments: hosts that format
+     * it (printf-style, as the standard says) and hosts that cannot see varargs (ctypes) both
+     * show the message itself. */
+    for (k = 0; text[k] && n + 2 < sizeof escaped; k++) {
+        if (text[k] == '%') escaped[n++] = '%';
+        escaped[n++] = text[k];
+    }
+    escaped[n] = '\0';
+    S->logger(S->environment, S->name, status, category, escaped);
 }
 
-static fmi2Status fail(Instance *S, const char *format_name, const char *text) {
-    log_message(S, fmi2Error, "logStatusError", "%s: %s", format_name, text);
-    if (S->state != INSTANTIATED) S->state = ERROR_STATE;
+/* A refused request: fmi2Error with the message; the instance stays as it was (nothing of the
+ * request was done), so the host may correct the request and go on. */
+static fmi2Status fail(Instance *S, const char *call, const char *text) {
+    log_message(S, fmi2Error, "logStatusError", "%s: %s", call, text);
     return fmi2Error;
 }
 
@@ -103,6 +118,8 @@ static int allowed(Instance *S, int states, const char *call) {
     return 0;
 }
 
+/* The drive's verdict on initialisation or a step: a discarded step (the state as before it) or an
+ * error of the model (the instance goes to the error state: fmi2Reset or fmi2SetFMUstate). */
 static fmi2Status drive_status(Instance *S, int status, const char *call) {
     if (status == CAM_OK) return fmi2OK;
     if (status == CAM_ERR_REJECTED) {
@@ -110,7 +127,9 @@ static fmi2Status drive_status(Instance *S, int status, const char *call) {
         S->state = STEP_FAILED;
         return fmi2Discard;
     }
-    return fail(S, call, cam_instance_message(S->drive));
+    log_message(S, fmi2Error, "logStatusError", "%s: %s", call, cam_instance_message(S->drive));
+    S->state = ERROR_STATE;
+    return fmi2Error;
 }
 
 /* ------------------------------------------------------------------ common functions */
@@ -159,12 +178,20 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     S->environment = probe.environment;
     S->logging_on = loggingOn ? 1 : 0;
     S->state = INSTANTIATED;
+    S->magic = INSTANCE_MAGIC;
     return S;
 }
 
-void fmi2FreeInstance(fmi2Component c) {
+/* The instance behind a component a host passes, or NULL (NULL, freed, or not an instance). */
+static Instance *instance(fmi2Component c) {
     Instance *S = c;
+    return S && S->magic == INSTANCE_MAGIC ? S : NULL;
+}
+
+void fmi2FreeInstance(fmi2Component c) {
+    Instance *S = instance(c);
     if (!S) return;
+    S->magic = 0;
     cam_instance_free(S->drive);
     free(S->name);
     free(S);
@@ -172,7 +199,7 @@ void fmi2FreeInstance(fmi2Component c) {
 
 fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)nCategories;
     (void)categories;
     if (!S) return fmi2Error;
@@ -182,7 +209,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[200];
     (void)toleranceDefined;
     (void)tolerance;
@@ -199,7 +226,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!allowed(S, INSTANTIATED, "fmi2EnterInitializationMode")) return fmi2Error;
     S->state = INITIALIZATION;
@@ -207,7 +234,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     fmi2Status status;
     if (!S) return fmi2Error;
     if (!allowed(S, INITIALIZATION, "fmi2ExitInitializationMode")) return fmi2Error;
@@ -220,7 +247,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!allowed(S, STEP_COMPLETE | STEP_FAILED | ERROR_STATE, "fmi2Terminate")) return fmi2Error;
     S->state = TERMINATED;
@@ -228,7 +255,7 @@ fmi2Status fmi2Terminate(fmi2Component c) {
 }
 
 fmi2Status fmi2Reset(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     cam_instance_reset(S->drive);
     S->state = INSTANTIATED;
@@ -239,25 +266,26 @@ fmi2Status fmi2Reset(fmi2Component c) {
 /* ------------------------------------------------------------------ variables */
 
 static int check_references(Instance *S, const fmi2ValueReference vr[], size_t nvr, const void *value,
-                            CamVariableType type, const char *call) {
+                            CamKind type, const char *call) {
     char text[300];
     size_t k;
+    CamKind kind;
+    const char *name;
     if (nvr == 0) return 1;
     if (!vr || !value) {
         fail(S, call, "the value reference and value arrays must not be NULL");
         return 0;
     }
     for (k = 0; k < nvr; k++) {
-        if (vr[k] >= CAM_N_VARIABLES) {
+        if (!cam_instance_variable(vr[k], &kind, &name)) {
             snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %d)", vr[k],
-                     CAM_N_VARIABLES - 1);
+                     CAM_VR_PARAMS + CAM_N_PARAMS - 1);
             fail(S, call, text);
             return 0;
         }
-        if (CAM_VARIABLES[vr[k]].type != type) {
-            snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s",
-                     CAM_VARIABLES[vr[k]].name, vr[k], cam_type_name(CAM_VARIABLES[vr[k]].type),
-                     cam_type_name(type));
+        if (kind != type) {
+            snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s", name, vr[k],
+                     cam_kind_name(kind), cam_kind_name(type));
             fail(S, call, text);
             return 0;
         }
@@ -266,12 +294,12 @@ static int check_references(Instance *S, const fmi2ValueReference vr[], size_t n
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (value) for (k = 0; k < nvr; k++) value[k] = 0.0;
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetReal")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2GetReal")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_REAL, "fmi2GetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (cam_instance_get_real(S->drive, vr[k], &value[k]) != CAM_OK)
             return fail(S, "fmi2GetReal", cam_instance_message(S->drive));
@@ -279,8 +307,9 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
+    (void)vr;
     if (value) for (k = 0; k < nvr; k++) value[k] = 0;
     if (!S) return fmi2Error;
     if (nvr == 0) return fmi2OK;
@@ -288,13 +317,13 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     int v;
     if (value) for (k = 0; k < nvr; k++) value[k] = fmi2False;
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetBoolean")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2GetBoolean")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_BOOLEAN, "fmi2GetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) {
         if (cam_instance_get_boolean(S->drive, vr[k], &v) != CAM_OK)
             return fail(S, "fmi2GetBoolean", cam_instance_message(S->drive));
@@ -304,12 +333,12 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (value) for (k = 0; k < nvr; k++) value[k] = "";
     if (!S) return fmi2Error;
     if (!allowed(S, GET_STATES, "fmi2GetString")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_STRING, "fmi2GetString")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_STRING, "fmi2GetString")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (cam_instance_get_string(S->drive, vr[k], &value[k]) != CAM_OK) {
             value[k] = "";
@@ -321,12 +350,12 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 #define SET_STATES (INSTANTIATED | INITIALIZATION | STEP_COMPLETE)
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[MESSAGE_MAX];
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetReal")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_REAL, "fmi2SetReal")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_REAL, "fmi2SetReal")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* all or nothing: every value is checked before one is written */
         if (cam_instance_check_real(S->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
             return fail(S, "fmi2SetReal", text);
@@ -337,7 +366,7 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)vr;
     (void)value;
     if (!S) return fmi2Error;
@@ -346,11 +375,11 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetBoolean")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_BOOLEAN, "fmi2SetBoolean")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_BOOLEAN, "fmi2SetBoolean")) return fmi2Error;
     for (k = 0; k < nvr; k++) /* booleans are parameters: the drive refuses them after initialisation */
         if (cam_instance_initialized(S->drive))
             return fail(S, "fmi2SetBoolean", "parameters are fixed after initialisation (fmi2Reset first)");
@@ -361,11 +390,11 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
 }
 
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     if (!S) return fmi2Error;
     if (!allowed(S, SET_STATES, "fmi2SetString")) return fmi2Error;
-    if (!check_references(S, vr, nvr, value, CAM_STRING, "fmi2SetString")) return fmi2Error;
+    if (!check_references(S, vr, nvr, value, CAM_KIND_STRING, "fmi2SetString")) return fmi2Error;
     for (k = 0; k < nvr; k++)
         if (!value[k]) return fail(S, "fmi2SetString", "a string value must not be NULL");
     /* Strings are checked as they are set; a multi-value set is undone on refusal by saving first. */
@@ -392,7 +421,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
-    Instance *S = c;
+    Instance *S = instance(c);
     char text[300];
     double now;
     fmi2Status status;
@@ -416,14 +445,14 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     return fail(S, "fmi2CancelStep", "cam.fmu steps synchronously: there is no step to cancel");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)vr;
     (void)order;
     (void)value;
@@ -434,7 +463,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     (void)vr;
     (void)order;
@@ -445,7 +474,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = fmi2OK;
     if (!S || !value) return fmi2Error;
     if (s == fmi2DoStepStatus) return fmi2OK; /* steps are synchronous: never pending */
@@ -453,7 +482,7 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 }
 
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = 0.0;
     if (!S || !value) return fmi2Error;
     if (s != fmi2LastSuccessfulTime) return fail(S, "fmi2GetRealStatus", "only fmi2LastSuccessfulTime is a Real status");
@@ -462,7 +491,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 }
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)s;
     if (value) *value = 0;
     if (!S) return fmi2Error;
@@ -470,7 +499,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (value) *value = fmi2False;
     if (!S || !value) return fmi2Error;
     if (s != fmi2Terminated) return fail(S, "fmi2GetBooleanStatus", "only fmi2Terminated is a Boolean status");
@@ -479,7 +508,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 }
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    Instance *S = c;
+    Instance *S = instance(c);
     (void)s;
     if (value) *value = "";
     if (!S) return fmi2Error;
@@ -501,7 +530,7 @@ static SavedState *save_state(Instance *S) {
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     SavedState *saved;
     if (!S || !FMUstate) return fmi2Error;
     saved = save_state(S);
@@ -525,14 +554,14 @@ static fmi2Status restore(Instance *S, const SavedState *saved, const char *call
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (!S) return fmi2Error;
     if (!FMUstate) return fail(S, "fmi2SetFMUstate", "FMUstate must not be NULL");
     return restore(S, FMUstate, "fmi2SetFMUstate");
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
-    if (!c) return fmi2Error;
+    if (!instance(c)) return fmi2Error;
     if (FMUstate) {
         free(*FMUstate);
         *FMUstate = NULL;
@@ -541,7 +570,7 @@ fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
-    Instance *S = c;
+    Instance *S = instance(c);
     if (size) *size = 0;
     if (!S || !size) return fmi2Error;
     if (!FMUstate) return fail(S, "fmi2SerializedFMUstateSize", "FMUstate must not be NULL");
@@ -562,7 +591,7 @@ static unsigned long get_u32(const unsigned char *p) {
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size) {
-    Instance *S = c;
+    Instance *S = instance(c);
     const SavedState *saved = FMUstate;
     unsigned char *out = (unsigned char *)serializedState;
     if (!S) return fmi2Error;
@@ -578,7 +607,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                    fmi2FMUstate *FMUstate) {
-    Instance *S = c;
+    Instance *S = instance(c);
     const unsigned char *in = (const unsigned char *)serializedState;
     SavedState *saved;
     size_t payload;
@@ -601,7 +630,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    Instance *S = c;
+    Instance *S = instance(c);
     size_t k;
     (void)vUnknown_ref;
     (void)vKnown_ref;

@@ -2,7 +2,7 @@
  * communication steps, outputs, and the saved state (parameters included). The FMI glues
  * (csrc/fmi/) call only these functions; the drive behind them is cam_model.h's CamInstance.
  *
- * Value references are those of the generated variable table (cam_variables.h, generated from
+ * Value references are those of the generated table (cam_params.h, generated from
  * cam_fmu/physics/parameters.py and variables.py): the inputs, then the outputs, then the
  * parameters, in table order, from 0.
  *
@@ -18,6 +18,10 @@
 #include "cam_model.h"
 
 typedef struct CamInstance CamInstance;
+
+/* The kind and name of value reference vr; 0 if vr is no variable. */
+int cam_instance_variable(unsigned vr, CamKind *kind, const char **name);
+const char *cam_kind_name(CamKind kind);
 
 /* A new drive: parameters at their defaults, inputs at their start values; NULL if out of memory. */
 CamInstance *cam_instance_new(void);

@@ -1,0 +1,115 @@
+"""Build cam.fmu from the C engine: a binary FMU that needs nothing but the C library.
+
+Build time only. Steps:
+
+1. The GUID: a hash of the variable table (``model_description.variable_rows``)
+   and of the engine's sources (``engine.build.digest``).
+2. The generated headers (``engine.codegen``: the variable and parameter tables of
+   ``physics/parameters.py`` and ``physics/variables.py``) in a temporary folder.
+3. The binary: every engine source (``engine/csrc/src/*.c``) and the FMI 2.0
+   glue (``engine/csrc/fmi/fmi2_cs.c``) compiled into one shared library with the
+   official FMI headers (fmpy's copy), only the FMI functions exported, linked
+   with libc and libm only: ``binaries/linux64/cam.so``; with the MinGW-w64 cross
+   compiler also ``binaries/win64/cam.dll`` (Windows' own KERNEL32 and msvcrt only).
+4. ``modelDescription.xml``: ``model_description.skeleton`` completed by
+   ``model_description.postprocess`` (units, ranges, structure, the default
+   experiment of the paper's fig. 6 scene).
+5. The C sources under ``sources/``, with the generated table and the official
+   headers: anyone can rebuild the binary for another platform
+   (``cc -std=c99 -shared -fPIC -include sources/guid.h -Isources sources/*.c -lm``).
+"""
+from __future__ import annotations
+
+import shutil
+import tempfile
+import zipfile
+from pathlib import Path
+from typing import Sequence
+
+from ..engine import build as engine_build
+from ..engine import codegen
+from . import model_description
+
+MODEL_IDENTIFIER = "cam"
+DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
+               "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
+FMI = engine_build.CSRC / "fmi"
+GLUE = (FMI / "instance.c", FMI / "fmi2_cs.c")  # the instance layer and the FMI 2.0 glue
+# Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
+BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
+# win64: Debian's MinGW-w64 cross compiler; libgcc linked in, so the DLL needs only Windows' own
+# KERNEL32.dll and msvcrt.dll.
+WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
+WIN64_FLAGS: tuple[str, ...] = ("-static-libgcc",)
+PLATFORMS = ("linux64", "win64")
+
+
+class FmuBuildError(RuntimeError):
+    """The FMU could not be built; the message says why."""
+
+
+def default_experiment() -> tuple[float, float, float]:
+    """(start, stop, step) [s] of the paper's fig. 6 scene: the FMU's default experiment."""
+    from ..experiments.scenes import find_scene
+
+    scene = find_scene("paper_fig6")
+    return 0.0, float(scene.stop_time), float(scene.output_interval)
+
+
+def engine_guid() -> str:
+    """The GUID of a cam.fmu built from this checkout."""
+    return model_description.guid(model_description.variable_rows(), engine_build.digest())
+
+
+def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = ()) -> Path:
+    """Compile the engine, the instance layer and the FMI 2.0 glue into the shared library ``dest``."""
+    try:
+        return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DCAM_GUID="{guid}"', *extra_flags), compiler,
+                                            extra_sources=GLUE, include=(engine_build.fmi_headers(),))
+    except engine_build.EngineBuildError as exc:
+        raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
+
+
+def win64_compiler() -> str | None:
+    """The MinGW-w64 cross compiler on PATH, or None."""
+    return shutil.which(WIN64_COMPILER)
+
+
+def build(dest: Path, win64: bool | None = None) -> Path:
+    """Build cam.fmu at ``dest`` (a path ending in .fmu) and return it.
+
+    ``win64``: True requires the win64 binary (FmuBuildError without the cross compiler), False
+    leaves it out, None (the default) adds it when the cross compiler is installed."""
+    dest = Path(dest).resolve()
+    if dest.suffix != ".fmu":
+        raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
+    cross = win64_compiler() if win64 is not False else None
+    if win64 and not cross:
+        raise FmuBuildError(f"the win64 binary needs the MinGW-w64 cross compiler {WIN64_COMPILER} "
+                            "(Debian: apt-get install gcc-mingw-w64-x86-64; setup.sh installs it)")
+    rows = model_description.variable_rows()
+    guid = engine_guid()
+    with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
+        root = Path(tmp)
+        compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid)
+        if cross:
+            compile_binary(root / "fmu" / "binaries" / "win64" / f"{MODEL_IDENTIFIER}.dll", guid, cross, WIN64_FLAGS)
+        xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
+                                            default_experiment(), DESCRIPTION, rows)
+        (root / "fmu" / "modelDescription.xml").write_bytes(xml)
+        sources = root / "fmu" / "sources"
+        generated = codegen.write(sources)  # the generated table, beside the hand-written sources
+        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *FMI.glob("*.[ch]"),
+                     *(engine_build.fmi_headers() / f"fmi2{name}.h" for name in ("Functions", "FunctionTypes",
+                                                                                   "TypesPlatform"))]:
+            shutil.copyfile(path, sources / path.name)
+        (sources / "guid.h").write_text(f'#define CAM_GUID "{guid}"\n')
+        del generated
+        out = root / f"{MODEL_IDENTIFIER}.fmu"
+        with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
+            for path in sorted((root / "fmu").rglob("*")):
+                if path.is_file():
+                    z.write(path, path.relative_to(root / "fmu").as_posix())
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(out, dest)
+    return dest
