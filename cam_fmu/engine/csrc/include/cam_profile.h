@@ -20,6 +20,9 @@
 #define CAM_SHAPE_CONST 0           /* A = c */
 #define CAM_SHAPE_SIN 1             /* A = c sin(x) */
 #define CAM_SHAPE_COS 2             /* A = c cos(x) */
+/* rad: the shortest rise or return, 0.01 deg (kinematics.cam_program.MIN_STROKE_ANGLE: the stroke's
+ * derivatives scale with 1/angle^3, which under- and overflows near 0) */
+#define CAM_MIN_STROKE_ANGLE (0.01 * 3.141592653589793 / 180.0)
 
 #define CAM_TABLE_MAX_ROWS 10000000     /* rows of a motion table, at most */
 #define CAM_TABLE_MAX_LIFT_MM 10000.0   /* mm: a table's lifts lie in [0, 10 m], the lift parameter's range */

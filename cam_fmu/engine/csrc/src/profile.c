@@ -38,13 +38,13 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
         return cam_fail(err, err_len, "angles must be finite and >= 0 [rad]: %s", list);
     }
     for (k = 0; k < 4; k += 2) {
-        if (angle[k] == 0.0) {
+        if (angle[k] < CAM_MIN_STROKE_ANGLE) {
             cam_repr(angle[k], r);
             pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s=%s", pos ? ", " : "", names[k], r);
         }
     }
     if (pos) {
-        return cam_fail(err, err_len, "rise and return angles must be > 0 [rad]: %s", list);
+        return cam_fail(err, err_len, "rise and return angles must be >= 0.000174533 rad (0.01 deg) [rad]: %s", list);
     }
     total = angle[0] + angle[1] + angle[2] + angle[3];
     if (fabs(total - TWO_PI) > 1e-9) {
