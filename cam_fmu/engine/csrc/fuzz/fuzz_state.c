@@ -4,7 +4,7 @@
  * fmi2DeSerializeFMUstate hand it): it must refuse them with a message and leave the instance as
  * it was, or restore a state from which a step either succeeds with finite outputs or is refused
  * with a message. A broken promise aborts, which libFuzzer (or tests/engine_c/state_driver.c under
- * ASan/UBSan) reports as a crash. Commands: docs/architecture.md, "Fuzzing".
+ * ASan/UBSan) reports as a crash. Commands: docs/architecture.md, "Fuzzing the parsers of untrusted bytes".
  */
 #include "cam_instance.h"
 

@@ -3,7 +3,7 @@
  * Any bytes are a motion_table string: the parser must refuse them with a message or build a
  * table whose curve stays within its rows' lifts. A violated promise aborts, which the fuzzer
  * (or tests/engine_c/fuzz_driver.c under ASan/UBSan) reports as a crash. Commands: docs/architecture.md,
- * "Fuzzing the motion table parser".
+ * "Fuzzing the parsers of untrusted bytes".
  */
 #include "cam_profile.h"
 
