@@ -25,3 +25,5 @@ fi
 python -m pip install -c constraints/test.txt -e ".[test]"
 # the drive kernel's extension beside its .py (Cython + gcc; skipped while current), so the tests use it
 python -m cam_fmu.kernel.compile
+# the C engine's shared library (gcc; skipped while current: its name hashes its sources)
+python -m cam_fmu.engine.build
