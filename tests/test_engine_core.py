@@ -155,7 +155,7 @@ def test_the_energy_guard_is_the_same_error():
         sim.set_state(state)
     errors = [_error(lambda sim=sim: sim, 0.2, 1e-3, 3.5, 1.0) for sim in sims]
     assert errors[0][0] is SimulationError and "energy was created" in errors[0][1]
-    assert errors[1] == errors[0]
+    _same_but_the_rk45_advice(errors[0], errors[1])
 
 
 def _baseline_cases():
@@ -252,4 +252,13 @@ def test_the_clearance_guard_is_the_same_error():
         state["mode"] = dict(state["mode"], stuck=True, contact=0, s_free=out["s_cam"] + 0.01)
     old, new = _from_state({"c": 5e-4}, 100, change, (0.1, 1e-3, 0.0, 1.0))
     assert old[0] is SimulationError and "a contact event was missed" in old[1]
-    assert new == old
+    _same_but_the_rk45_advice(old, new)
+
+
+def _same_but_the_rk45_advice(old, new):
+    """The same error and text, but for the advice to a user of rk45, which the C engine changes on
+    purpose (issue 19, item 13): it names rtol and atol and no longer advises the solver in use."""
+    assert new[0] is old[0]
+    head, _, advice = old[1].partition("; solver 'rk45' with ")
+    assert advice and new[1].startswith(head + "; solver 'rk45' with rtol = ")
+    assert "rtol/atol" in new[1] and "use solver 'rk45'" not in new[1]

@@ -39,6 +39,15 @@ static void consistent_outputs(CamDrive *d, double out[])
 static void consistent_advice(const CamDrive *d, char *buf, size_t len)
 {
     const CamParamSpec *solver = cam_param_spec(CAM_P_SOLVER);
+    const CamMethod *method = cam_method(d->model.solver);
+    if (method != NULL && method->adaptive) {
+        /* its accuracy is rtol/atol's: name them, never advise the solver in use */
+        snprintf(buf, len, "solver '%s' with rtol = %g, atol = %g and h_max = %g s: tighten rtol/atol "
+                 "(defaults %g, %g), reduce h_max or the communication step", solver->choices[d->model.solver],
+                 d->model.rtol, d->model.atol, d->model.h_max, cam_param_spec(CAM_P_RTOL)->default_value,
+                 cam_param_spec(CAM_P_ATOL)->default_value);
+        return;
+    }
     snprintf(buf, len, "solver '%s' with h_max = %g s: reduce h_max or the communication step, or use solver 'rk45'",
              solver->choices[d->model.solver], d->model.h_max);
 }
