@@ -139,6 +139,13 @@ def test_messages_name_the_variable_or_setting_at_fault(slave):
     assert all(len(text) < 4096 for text in slave.errors())  # the bad value is cut, not echoed whole
 
 
+def test_a_step_count_that_h_max_makes_impossible_names_h_max(slave):
+    assert slave.init(h_max=1e-9, max_steps=10.0) == OK
+    assert slave.step(1e-3) == DISCARD
+    text = slave.errors()[-1]
+    assert "h_max = 1e-09 s caps every internal step" in text and "1e+06" in text
+
+
 def test_loose_rk45_tolerances_are_named_in_the_advice(slave):
     """rk45 with rtol = 0.1, atol = 1 and h_max = 0.1 s at 0.1 s steps breaks the energy bound: the
     refusal names rtol and atol and does not advise the solver in use."""

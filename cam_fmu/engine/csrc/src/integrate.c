@@ -173,7 +173,11 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
 {
     const CamModel *m = &d->model;
     char advice[256];
-    if (method->adaptive)
+    if (h > m->h_max * (double)m->max_steps)  /* h_max alone makes the count impossible: say so */
+        snprintf(advice, sizeof advice, "h_max = %g s caps every internal step, so this communication step "
+                 "needs at least %.4g of them: raise h_max or max_steps, or shorten the communication step",
+                 m->h_max, h / m->h_max);
+    else if (method->adaptive)
         snprintf(advice, sizeof advice, "raise max_steps, loosen rtol/atol or shorten the communication step%s",
                  m->has_current && !method->exact_electrical_pole
                      ? "; with L > 0 the electrical pole is stiff: use solver 'etdrk4'" : "");
