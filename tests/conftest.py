@@ -14,12 +14,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # --------------------------------------------------------------------------- cam.fmu
 def _build_fmu(dest: Path) -> Path:
-    """Build cam.fmu with build_fmu.py in a subprocess.
-
-    A subprocess, because building imports the slave script as a top-level module
-    (``camdrive_fmu_slave``) and pythonfmu inserts folders into sys.path: neither
-    may leak into the test process.
-    """
+    """Build cam.fmu with build_fmu.py in a subprocess: the command users run, from this checkout."""
     cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--dest", str(dest)]
     package_dir = os.environ.get("CAM_FMU_BUILD_PACKAGE_DIR")  # developers only: build from another tree
     if package_dir:
@@ -43,12 +38,10 @@ def cam_fmu_path(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
-def engine_fmu_path(tmp_path_factory) -> Path:
-    """cam.fmu built from the C engine (cam_fmu.fmu.engine_fmu) once per test session. It hosts no
-    Python: loading it into the pytest process is safe."""
-    from cam_fmu.fmu import engine_fmu
-
-    return engine_fmu.build(tmp_path_factory.mktemp("engine_fmu_build") / "cam.fmu")
+def engine_fmu_path(cam_fmu_path) -> Path:
+    """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
+    pytest process is safe."""
+    return cam_fmu_path
 
 
 def run_fmu_script(script: Path, *args: str, cwd: Path | None = None, timeout: float = 300,

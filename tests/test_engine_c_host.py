@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from cam_fmu.engine import build, codegen
-from cam_fmu.engine.simulator import EngineSimulator
+from cam_fmu.engine.simulator import DriveSimulator
 
 HOST = build.CSRC / "hosts" / "scene_host.c"
 SANITIZE = ("-fsanitize=address,undefined", "-fno-omit-frame-pointer", "-fno-sanitize-recover=all", "-g")
@@ -34,7 +34,7 @@ def _lines(stdout: str) -> dict[str, list[str]]:
 
 
 def _python_line(params: dict, steps: int) -> list[str]:
-    sim = EngineSimulator(params)
+    sim = DriveSimulator(params)
     for k in range(steps):
         sim.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
     out = sim.outputs()

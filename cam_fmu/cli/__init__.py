@@ -40,19 +40,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-FMU_SLAVE_MODULE = "camdrive_fmu_slave"  # imported into this process when cam.fmu is loaded here
-FMU_SLAVE_MODULES = (FMU_SLAVE_MODULE, "pi_speed_fmu_slave")  # any of them loaded: leave with os._exit
+# Imported into this process (under a private name, ``pi_speed_fmu_slave_<hash>``) when pi_speed.fmu, a
+# pythonfmu FMU, is loaded here: then leave with os._exit. cam.fmu hosts no Python (its binary is the C engine).
+FMU_SLAVE_MODULES = ("pi_speed_fmu_slave",)
 
 
 def exit_after_fmu(status: int) -> int:
-    """Leave at once (no interpreter teardown) when cam.fmu was loaded into this process.
+    """Leave at once (no interpreter teardown) when a pythonfmu FMU was loaded into this process.
 
     pythonfmu 0.7.0 can corrupt the heap when the interpreter tears down a
     process that has loaded a pythonfmu FMU: glibc then aborts with "corrupted
     double-linked list" after all the work is done (seen once in about 60 runs,
     under load). Output is flushed first; nothing is lost.
     """
-    if any(name in sys.modules for name in FMU_SLAVE_MODULES):
+    if any(loaded.startswith(FMU_SLAVE_MODULES) for loaded in list(sys.modules)):
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)

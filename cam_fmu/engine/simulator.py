@@ -1,4 +1,4 @@
-"""The C engine's drive from Python: ``EngineSimulator`` (DriveSimulator's public API) and ``run_scene``.
+"""The C engine's drive from Python: ``DriveSimulator`` (DriveSimulator's public API) and ``run_scene``.
 
 The engine (``csrc/``) owns the state, the formulation, the solver and every
 check; this module converts parameters and states between Python values and
@@ -18,7 +18,7 @@ from ..physics.parameters import BY_NAME, ParameterError
 from ..physics.variables import INPUT_STARTS, OUTPUT_NAMES
 from .library import load
 
-__all__ = ["EngineSimulator", "run_scene"]
+__all__ = ["DriveSimulator", "run_scene"]
 
 N_OUTPUTS = len(OUTPUT_NAMES)
 MESSAGE_LEN = 1024
@@ -113,7 +113,7 @@ def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any
         raise_for(err)
 
 
-class EngineSimulator:
+class DriveSimulator:
     """One cam drive in the C engine, advanced by ``do_step`` (DriveSimulator's API)."""
 
     def __init__(self, params: Mapping[str, Any] | None = None) -> None:
@@ -247,4 +247,4 @@ class EngineSimulator:
 def run_scene(params: Mapping[str, Any] | None, table: Sequence[Sequence[float]]) -> list[array]:
     """A whole scene in one engine call: a new drive from params, then the rows (t, h, u, omega_ref,
     omega_dot_ref) of ``table``; the outputs after each step."""
-    return EngineSimulator(params).run(table)
+    return DriveSimulator(params).run(table)

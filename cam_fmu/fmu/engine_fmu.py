@@ -48,6 +48,14 @@ class FmuBuildError(RuntimeError):
     """The FMU could not be built; the message says why."""
 
 
+def sources() -> list[Path]:
+    """Every file whose content shapes cam.fmu: the engine's C, the FMI glue, the generators and the tables."""
+    package = engine_build.HERE.parent
+    return [*engine_build.source_files(), *sorted(FMI.glob("*.[ch]")), Path(__file__), Path(model_description.__file__),
+            Path(codegen.__file__), Path(engine_build.__file__), package / "physics" / "parameters.py",
+            package / "physics" / "variables.py"]
+
+
 def default_experiment() -> tuple[float, float, float]:
     """(start, stop, step) [s] of the paper's fig. 6 scene: the FMU's default experiment."""
     from ..experiments.scenes import find_scene

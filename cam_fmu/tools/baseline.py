@@ -36,7 +36,7 @@ step to step, so a difference at any step (a constant, an operation order, an ev
 step later, a changed step size of rk45) shows in every later sample: sampling loses nothing
 but the step at which a divergence began. Floats are written by ``json`` with ``repr``, which
 round-trips exactly. The files also hold the Python, numpy, scipy, hypothesis and Cython
-versions, whether the compiled kernel ran, and the git commit the record was made at.
+versions and the git commit the record was made at.
 
 The comparison (``compare``): every recorded sample to RTOL = 1e-12 relative, where a value
 below ZERO = 1e-3 of its output's scale (the largest |value| of that output over the case's
@@ -225,11 +225,6 @@ def provenance() -> dict[str, Any]:
             info[module.lower()] = __import__(module).__version__
         except ImportError:
             info[module.lower()] = None
-    try:
-        from ..kernel import compiled
-        info["kernel"] = "compiled" if compiled() else "pure-python"
-    except ImportError:
-        info["kernel"] = None
     git = ["git", "-C", str(ROOT)]
     try:
         commit = subprocess.run(git + ["rev-parse", "HEAD"], capture_output=True, text=True, check=True).stdout.strip()

@@ -116,16 +116,16 @@ def promised(case: Case, theta_span: float) -> float:
 
     rk45 (adaptive): error control at rtol (1e4 rtol per radian turned covers error growth over
     the run); fixed-step solvers: the relative error their stability and resolution limits keep
-    (``Stepper.promised_relative``); a formulation that is its own reference (the paper
+    (``engine.solvers``: promised_relative); a formulation that is its own reference (the paper
     formulation, the speed drive): rounding only.
     """
+    from ..engine.solvers import SOLVERS
     from ..physics.drive import DriveModel
-    from ..physics.formulations import FORMULATIONS, formulation_name
-    from ..solvers import SOLVERS
+    from ..physics.formulations import OWN_REFERENCE, formulation_name
 
     scale = 1.0 + theta_span
     model = DriveModel(case.params)
-    if FORMULATIONS[formulation_name(model)].own_reference:
+    if formulation_name(model) in OWN_REFERENCE:
         return 1e-9 * scale
     stepper = SOLVERS[model.params["solver"]]
     if stepper.adaptive:

@@ -1,13 +1,13 @@
-"""Build cam.fmu's own linux64 binary and put it, with what it needs, into a built FMU.
+"""Build a Python FMU's own linux64 binary (pi_speed.fmu) and put it, with what it needs, into the FMU.
 
-Build time only (never bundled). Three steps, used by ``build_fmu.py``:
+Build time only (never bundled). Three steps, used by ``python_fmu.build``:
 
 1. ``privatize(staging, package, script_stem)``: before pythonfmu packs the
    staged files, rename the bundled package ``cam_fmu`` to
-   ``cam_fmu_<8 hex>`` and the slave script to ``camdrive_fmu_slave_<8 hex>``
+   ``cam_fmu_<8 hex>`` and the slave script to ``pi_speed_fmu_slave_<8 hex>``
    (a hash of everything that runs inside the FMU), rewriting the slave's
    absolute ``cam_fmu`` imports. Neither a host's own cam_fmu nor another
-   build of cam.fmu in the same process can then shadow the bundled modules.
+   Python FMU in the same process can then shadow the bundled modules.
 2. ``build_binary(dest_so)``: compile ``fmi2_python.c`` with the system C
    compiler (``$CC``, else ``cc``/``gcc``/``clang``) against the headers of the
    Python that runs the build. No compiler: ``NativeBuildError`` (no silent
@@ -18,9 +18,6 @@ Build time only (never bundled). Three steps, used by ``build_fmu.py``:
    into the private package (``<package>._pythonfmu``) and add the bridge
    (``<package>._fmi_bridge``). pythonfmu's win64 binary stays as it is.
 
-``compile_kernel`` compiles the staged drive kernel under the private name
-(build_fmu.py without --pure-python; the extension loads on linux64 with the
-build's Python version, the bundled .py everywhere else).
 """
 from __future__ import annotations
 
@@ -37,7 +34,7 @@ import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional
 
 HERE = Path(__file__).resolve().parent
 C_SOURCE = HERE / "fmi2_python.c"
@@ -77,24 +74,20 @@ def _rewrite_imports(source: str, old: str, new: str) -> str:
     return re.sub(rf"^(\s*import\s+){re.escape(old)}(?=[\s.,]|$)", rf"\g<1>{new}", source, flags=re.M)
 
 
-def content_digest(staging: Path, package: str, script: Path, extra: Sequence[Path] = ()) -> str:
-    """8 hex digits of a hash over everything that runs inside the FMU (``extra``: files added later)."""
+def content_digest(staging: Path, package: str, script: Path) -> str:
+    """8 hex digits of a hash over everything that runs inside the FMU."""
     h = hashlib.sha256()
-    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE, *extra]
+    files = sorted((staging / package).rglob("*.py")) + [script, C_SOURCE, BRIDGE]
     files += [_pythonfmu_dir() / name for name in PYTHONFMU_RUNTIME]
     for path in files:
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()[:8]
 
 
-def privatize(staging: Path, package: str, script_stem: str, extra: Sequence[Path] = ()) -> PrivateNames:
-    """Rename the staged package and slave script to private names (see the module doc).
-
-    ``extra``: files put into the package after this (the compiled kernel), hashed
-    into the name too: a compiled and a pure-Python build never share a name.
-    """
+def privatize(staging: Path, package: str, script_stem: str) -> PrivateNames:
+    """Rename the staged package and slave script to private names (see the module doc)."""
     script = staging / f"{script_stem}.py"
-    digest = content_digest(staging, package, script, extra)
+    digest = content_digest(staging, package, script)
     names = PrivateNames(f"{package}_{digest}", f"{script_stem}_{digest}", digest)
     (staging / package).rename(staging / names.package)
     text = _rewrite_imports(script.read_text(encoding="utf-8"), package, names.package)
@@ -106,26 +99,6 @@ def privatize(staging: Path, package: str, script_stem: str, extra: Sequence[Pat
         if fixed != src:
             path.write_text(fixed, encoding="utf-8")
     return names
-
-
-def compile_kernel(kernel_dir: Path, staged_kernel: Path, modules: Sequence[str]) -> List[Path]:
-    """Compile the staged (privatized) kernel modules beside their staged .py; return the extensions.
-
-    Not a copy of the checkout's extension: a Cython module also enters itself
-    into sys.modules under the dotted name it was compiled with, so the
-    checkout's (``cam_fmu.kernel.drive_kernel``) would put a public name into
-    every host process and shadow a host's own cam_fmu. Compiled from the staged
-    copy, the name is the private ``cam_fmu_<hash>.kernel.drive_kernel``.
-    """
-    from ...kernel import compile as kernel_compile
-
-    for name in modules:  # the C types beside the staged .py, for Cython only (not shipped)
-        shutil.copy2(kernel_dir / f"{name}.pxd", staged_kernel / f"{name}.pxd")
-    try:
-        return kernel_compile.build_extension(staged_kernel, modules=tuple(modules), force=True)
-    finally:
-        for name in modules:
-            (staged_kernel / f"{name}.pxd").unlink()
 
 
 def find_compiler() -> str:

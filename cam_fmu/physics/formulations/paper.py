@@ -18,13 +18,10 @@ while |c_m i - M_l| <= M_f, and a step that would reverse omega stops it at 0.
 from __future__ import annotations
 
 import math
-from typing import Any
-
-from ...errors import SimulationError, StepRejected
+from ...errors import StepRejected
 from ..contact import play
 from ..drive import DriveModel, sign, solve_guide_friction
 from ..variables import output_record
-from .base import Formulation
 
 
 class PaperScheme:
@@ -46,17 +43,6 @@ class PaperScheme:
         self.alpha = 0.0
         self.voltage = 0.0
         self.M_l = 0.0
-
-    def get_state(self) -> dict[str, Any]:
-        return {name: getattr(self, name) for name in self.FIELDS + ("M_l",)}
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        values = {name: float(state[name]) for name in self.FIELDS + ("M_l",)}
-        bad = [name for name, value in values.items() if not math.isfinite(value)]
-        if bad:
-            raise SimulationError(f"state entries {bad} of the paper scheme are not finite")
-        for name, value in values.items():
-            setattr(self, name, value)
 
     def _shaft_friction(self, drive_torque: float) -> float | None:
         """M_f with its sign, or None when the shaft stays stuck this step."""
@@ -181,50 +167,3 @@ def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J:
         omega += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
         i += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
     return omega, i
-
-
-class PaperVoltage(Formulation):
-    """The paper's algorithm under the voltage input u, with T = the largest step <= h_max dividing h."""
-
-    own_reference = True
-
-    energy_bounded = True
-
-    def __init__(self, model: DriveModel, u: float) -> None:
-        p = model.params
-        self.scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
-        self.h_max = p["h_max"]
-        self.max_steps = int(p["max_steps"])
-        self.u = u
-
-    def set_inputs(self, u: float, omega_ref: float, omega_dot_ref: float) -> None:
-        self.u = u
-
-    def advice(self, stepper: Any) -> str:
-        return (f"the paper formulation (the published steps 1-9, whose eq. (12) lags the follower's inertia "
-                f"by a calculation step of h_max = {self.h_max:g} s) is not trustworthy here: reduce h_max, "
-                "or use formulation 'consistent'")
-
-    def advance(self, h: float, integrator: Any, time: float) -> int:
-        n = max(1, math.ceil(h / self.h_max - 1e-9))
-        budget = self.max_steps
-        if n > budget:
-            raise StepRejected(
-                f"the paper formulation needs {n} calculation steps of h_max = {self.h_max:g} s in one "
-                f"communication step of {h:g} s at t = {time:g} s, more than max_steps = {budget}: "
-                "raise h_max or max_steps, or shorten the communication step")
-        used = 0
-        for _ in range(n):
-            used += self.scheme.step(h / n, self.u, budget - used)
-        return used
-
-    def outputs(self, integrator: Any) -> dict[str, float]:
-        return self.scheme.outputs()
-
-    def get_state(self) -> dict[str, Any]:
-        return {"scheme": self.scheme.get_state()}
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        """The engine's state: this formulation's entries and the input held."""
-        self.u = float(state["u"])
-        self.scheme.set_state(state["scheme"])

@@ -9,7 +9,7 @@ from ...experiments.scenes import find_scene
 from ...experiments.signals import constant
 from ...physics.parameters import defaults
 from ...physics.variables import INPUT_STARTS
-from ...solvers import SOLVERS
+from ...engine.solvers import SOLVERS
 
 SOLVER_KEYS = ("solver", "h_max", "rtol", "atol", "max_steps")
 FIXED_STEP_H = (1e-3, 2.5e-4, 1e-4)  # s, h_max of euler, rk4, etdrk4

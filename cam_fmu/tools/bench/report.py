@@ -6,7 +6,7 @@ import math
 from pathlib import Path
 from typing import Sequence
 
-from ...solvers import SOLVERS
+from ...engine.solvers import SOLVERS
 from .cases import CASES, LEVELS, TARGET_ERR, TARGET_RATIO
 
 COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
