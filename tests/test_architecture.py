@@ -17,7 +17,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "cam_fmu"
 DOC = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
-BUNDLED = {"kinematics", "kernel", "physics", "solvers"}
+BUNDLED = {"kinematics", "physics", "control"}
 LEAVES = ("physics.variables", "experiments.signals", "errors")
 
 
@@ -53,7 +53,7 @@ def layer(module: str) -> str:
 
 
 def rule_table() -> dict[str, set[str]]:
-    section = DOC[DOC.index("## Dependency direction"):DOC.index("## What the FMU bundles")]
+    section = DOC[DOC.index("## Dependency direction"):DOC.index("## What the FMUs carry")]
     table = {}
     for row in re.findall(r"^\| `(\w+)` \|([^|]*)\|", section, flags=re.M):
         table[row[0]] = set(re.findall(r"`(\w+)`", row[1]))
@@ -93,7 +93,7 @@ def test_the_bundled_layers_stay_among_themselves():
         assert rule_table()[name] <= BUNDLED | {"errors"}, name
 
 
-@pytest.mark.parametrize("importer,target", [("fmu.build", "experiments"), ("plots.scene", "experiments"),
+@pytest.mark.parametrize("importer,target", [("fmu.build", "experiments"), ("fmu.engine_fmu", "experiments"), ("plots.scene", "experiments"),
                                              ("experiments.scenes", "plots")])
 def test_upward_imports_are_not_run_at_import_time(importer, target):
     found = [(t, top) for t, top in imports(importer, modules()[importer]) if layer(t) == target]
@@ -107,20 +107,3 @@ def test_every_test_file_the_code_and_docs_cite_exists():
         cited |= {(m, path.name) for m in re.findall(r"tests/(test_\w+\.py)", path.read_text(encoding="utf-8"))}
     missing = sorted((name, where) for name, where in cited if not (ROOT / "tests" / name).is_file())
     assert cited and not missing, missing
-
-
-def test_kernel_shape_codes_are_the_motion_laws():
-    """drive_kernel repeats kinematics.motion_law's segment-shape codes (it cites this test)."""
-    from cam_fmu.kinematics import motion_law
-
-    # read from the source: the compiled kernel keeps these as C constants, not module attributes
-    tree = ast.parse(modules()["kernel.drive_kernel"].read_text(encoding="utf-8"))
-    codes = {}
-    for node in tree.body:
-        if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Tuple):
-            names = [n.id for n in node.targets[0].elts if isinstance(n, ast.Name)]
-            if "SHAPE_CONST" in names:
-                codes = dict(zip(names, ast.literal_eval(node.value)))
-    assert set(codes) == {"SHAPE_CONST", "SHAPE_SIN", "SHAPE_COS"}
-    for name, code in codes.items():
-        assert code == getattr(motion_law, name), name

@@ -6,13 +6,13 @@ import math
 import re
 from pathlib import Path
 
-from cam_fmu.fmu.camdrive_fmu_slave import DEFAULT_EXPERIMENT
+from cam_fmu.engine.solvers import SOLVERS
+from cam_fmu.fmu.engine_fmu import default_experiment
 from cam_fmu.fmu.model_description import BASE_UNITS
 from cam_fmu.kinematics.presets import PRESETS
 from cam_fmu.physics import parameters
 from cam_fmu.physics.formulations import FORMULATIONS
 from cam_fmu.physics.variables import INPUTS, OUTPUTS
-from cam_fmu.solvers import SOLVERS
 from cam_fmu.experiments.scenes import find_scene
 
 PACKAGE = Path(__file__).resolve().parents[1] / "cam_fmu"
@@ -40,30 +40,23 @@ def test_every_unit_in_use_has_base_units():
 
 def test_default_experiment_is_the_paper_fig6_scene():
     scene = find_scene("paper_fig6")
-    assert DEFAULT_EXPERIMENT.start_time == 0.0
-    assert math.isclose(DEFAULT_EXPERIMENT.stop_time, scene.stop_time)
-    assert math.isclose(DEFAULT_EXPERIMENT.step_size, scene.output_interval)
+    start, stop, step = default_experiment()
+    assert start == 0.0
+    assert math.isclose(stop, scene.stop_time)
+    assert math.isclose(step, scene.output_interval)
 
 
 def test_no_module_over_400_lines():
-    """400 lines at most; a compiled module (kernel.COMPILED_MODULES) 800: it is one extension, whose
-    methods call each other in C. Split in two, those calls would become Python calls, or cimports
-    naming the package, which the FMU renames to its private name."""
-    from cam_fmu.kernel import COMPILED_MODULES
-
-    compiled = {PACKAGE / "kernel" / f"{name}.py" for name in COMPILED_MODULES}
-    long = {str(p.relative_to(PACKAGE)): n for p in MODULES
-            if (n := len(p.read_text().splitlines())) > (800 if p in compiled else 400)}
+    long = {str(p.relative_to(PACKAGE)): n for p in MODULES if (n := len(p.read_text().splitlines())) > 400}
     assert long == {}
 
 
-def test_each_pxd_is_the_twin_of_a_compiled_module():
-    """The C types (.pxd, read by cam_fmu/kernel/compile.py) exist exactly for COMPILED_MODULES, beside their .py."""
-    from cam_fmu.kernel import COMPILED_MODULES
-
-    pxds = {p.relative_to(PACKAGE) for p in PACKAGE.rglob("*.pxd")}
-    assert pxds == {Path("kernel") / f"{m}.pxd" for m in COMPILED_MODULES}
-    assert all((PACKAGE / "kernel" / f"{m}.py").is_file() for m in COMPILED_MODULES)
+def test_no_c_file_over_700_lines():
+    """The engine's C: one job per file (the FMI glue, the largest, included)."""
+    sources = [*(PACKAGE / "engine" / "csrc").rglob("*.[ch]")]
+    assert len(sources) >= 20
+    long = {str(p.relative_to(PACKAGE)): n for p in sources if (n := len(p.read_text().splitlines())) > 700}
+    assert long == {}
 
 
 def test_imports_inside_the_package_are_relative():
@@ -88,7 +81,7 @@ def test_no_string_dispatch_on_solver_or_formulation_outside_the_registries():
     found = []
     for path in MODULES:
         rel = path.relative_to(PACKAGE)
-        if rel in (Path("solvers/__init__.py"), Path("physics/formulations/__init__.py")):
+        if rel in (Path("engine/solvers.py"), Path("physics/formulations/__init__.py")):
             continue
         for k, line in enumerate(path.read_text().splitlines(), 1):
             if pattern.search(line):
@@ -113,12 +106,9 @@ def _package_imports(path: Path) -> set[str]:
     return {name for name in found if name.split(".")[0] == "cam_fmu"}
 
 
-# The run-time engine: the reference's readable model must not use its code (issue 18: FMU against
-# reference is a check of two implementations).
-ENGINE = ("cam_fmu.kernel", "cam_fmu.solvers", "cam_fmu.engine", "cam_fmu.fmu")
-# The one engine module that still lives under physics: the consistent formulation as the engine
-# steps it (its state in the kernel, the fixed-step solvers); it goes with the Cython kernel.
-ENGINE_STEPPER = PACKAGE / "physics" / "formulations" / "consistent_voltage.py"
+# The run-time engine: the reference's readable model must not use its code (FMU against reference is a
+# check of two implementations).
+ENGINE = ("cam_fmu.engine", "cam_fmu.fmu")
 
 
 def _under(name: str, prefixes: tuple[str, ...]) -> bool:
@@ -126,16 +116,14 @@ def _under(name: str, prefixes: tuple[str, ...]) -> bool:
 
 
 def test_the_model_and_the_reference_import_nothing_of_the_engine():
-    """physics, kinematics and reference never import the kernel, the solvers or the engine: the scipy
-    reference integrates physics, a model written independently of the code that runs in the FMU."""
+    """physics, kinematics and reference never import the engine or the FMU layer: the scipy reference
+    integrates physics, a model written independently of the code that runs in the FMU."""
     layers = [PACKAGE / layer for layer in ("physics", "kinematics", "reference")]
-    checked = [p for p in MODULES if any(layer in p.parents for layer in layers) and p != ENGINE_STEPPER]
+    checked = [p for p in MODULES if any(layer in p.parents for layer in layers)]
     assert len(checked) >= 20
     found = [f"{p.relative_to(PACKAGE)}: {name}" for p in checked for name in sorted(_package_imports(p))
              if _under(name, ENGINE)]
     assert found == []
-    # the exception is still needed (else it goes): it is the one that imports the engine's solvers
-    assert any(_under(name, ENGINE) for name in _package_imports(ENGINE_STEPPER))
 
 
 def test_kinematics_imports_no_other_layer():
@@ -148,7 +136,6 @@ def test_kinematics_imports_no_other_layer():
 def test_the_import_check_resolves_relative_imports():
     """The checks above see through relative imports (the package's only kind)."""
     assert "cam_fmu.physics.drive" in _package_imports(PACKAGE / "reference" / "integrate.py")
-    assert "cam_fmu.physics.variables" in _package_imports(PACKAGE / "kernel" / "drive_kernel.py")
+    assert "cam_fmu.engine.library" in _package_imports(PACKAGE / "engine" / "simulator.py")
     formulations = _package_imports(PACKAGE / "physics" / "formulations" / "__init__.py")
-    assert {"cam_fmu.physics.formulations.base", "cam_fmu.physics.drive"} <= formulations
-    assert "cam_fmu.solvers.dopri" in _package_imports(ENGINE_STEPPER)
+    assert "cam_fmu.physics.drive" in formulations
