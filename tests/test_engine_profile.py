@@ -1,8 +1,8 @@
 """The C engine's cam program (cam_fmu/engine/csrc: cam_profile.h) against the Python one.
 
 Laws, law programs and the breakpoint search are compared to the bit with
-kinematics.motion_law.MotionLaw, kinematics.cam_program.CamProgram and the drive
-kernel's Profile / first_angle_crossed; motion tables to the bit with the Python model
+kinematics.motion_law.MotionLaw and kinematics.cam_program.CamProgram (derivatives and
+first_angle_crossed); motion tables to the bit with the Python model
 (kinematics.motion_table), on dense grids, at the breakpoints and one ulp either side.
 Shape properties of random tables (hypothesis), the refusals and their messages, a
 10^6-row table with its comparison count, and the C library's own messages.
@@ -18,8 +18,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from cam_fmu.engine.profile import EngineProfile, first_crossed, law_eval, law_segments
-from cam_fmu.kernel.drive_kernel import Profile, first_angle_crossed
-from cam_fmu.kinematics.cam_program import CamProgram
+from cam_fmu.kinematics.cam_program import CamProgram, first_angle_crossed
 from cam_fmu.kinematics.motion_law import MotionLaw
 from cam_fmu.kinematics.motion_table import parse_motion_table, program_from_table_text
 from cam_fmu.kinematics.presets import PRESETS
@@ -114,11 +113,11 @@ def program_cases():
     return cases
 
 
-def test_law_program_is_the_drive_kernel_profile_to_the_bit():
+def test_law_program_is_the_python_cam_program_to_the_bit():
     rng = np.random.default_rng(3)
     for case in program_cases():
         program = CamProgram(*case)
-        kernel, engine = Profile(program), EngineProfile.from_laws(*case)
+        engine = EngineProfile.from_laws(*case)
         points = program.breakpoints()
         assert bits(engine.breakpoints()) == bits(points)
         assert engine.feature_angle() == program.feature_angle()
@@ -127,8 +126,8 @@ def test_law_program_is_the_drive_kernel_profile_to_the_bit():
         grid += [math.nextafter(p, d) for p in points for d in (-1.0, 7.0)]
         grid += [0.0, -0.0, -1e-300, 5e-324, -TWO_PI, TWO_PI, 1e300, -1e300, math.nan]
         for theta in grid:
-            assert bits(engine.derivatives(float(theta))) == bits(kernel.derivatives(float(theta))), (case, theta)
-        for theta in (math.inf, -math.inf):                     # the lower dwell, as the kernel's NaN path
+            assert bits(engine.derivatives(float(theta))) == bits(program.derivatives(float(theta))), (case, theta)
+        for theta in (math.inf, -math.inf):                     # no angle: the lower dwell
             assert engine.derivatives(theta) == (0.0, 0.0, 0.0, 0.0)
 
 
@@ -155,7 +154,7 @@ def test_law_program_refusals():
 
 # -- the first breakpoint ---------------------------------------------------------------------------
 
-def test_first_breakpoint_is_the_kernels_to_the_bit():
+def test_first_breakpoint_is_the_python_programs_to_the_bit():
     rng = np.random.default_rng(21)
     for trial in range(60):
         n = int(rng.integers(0, 40)) if trial % 10 else int(rng.integers(1000, 3000))
@@ -173,7 +172,7 @@ def test_first_breakpoint_is_the_kernels_to_the_bit():
                 start = points[int(rng.integers(len(points)))] + TWO_PI * float(rng.integers(-3, 4))
                 start = math.nextafter(start, float(rng.choice([-1e300, 1e300]))) if rng.random() < 0.5 else start
             end = start + float(rng.choice([rng.uniform(-10, 10), rng.uniform(-1e-6, 1e-6), 0.0, 1e6, -TWO_PI]))
-            expected = first_angle_crossed(arr, len(arr), start, end)
+            expected = first_angle_crossed(points, start, end)
             found, _ = first_crossed(points, start, end)
             assert bits((found,)) == bits((expected,)), (points[:5], start, end)
         for start, end in ((math.nan, 1.0), (1.0, math.nan), (2.0, 2.0)):
@@ -187,7 +186,7 @@ def test_first_breakpoint_costs_log_n():
     for start, end in ((0.1, 0.2), (-5.0, 40.0), (1e9, 1e9 - 3.0), (3.0, -1e12)):
         found, evaluations = first_crossed(points, start, end)
         assert evaluations <= bound
-        assert bits((found,)) == bits((first_angle_crossed(array("d", points), n, start, end),))
+        assert bits((found,)) == bits((first_angle_crossed(points, start, end),))
 
 
 # -- motion tables ----------------------------------------------------------------------------------

@@ -131,7 +131,7 @@ def test_speed_drive_scene_needs_voltage_on_the_reference():
 # --------------------------------------------------------------------------- bench.png
 def _bench_rows(span_decades=3.0):
     from cam_fmu.tools.bench.cases import CASES
-    from cam_fmu.solvers import SOLVERS
+    from cam_fmu.engine.solvers import SOLVERS
     rows = []
     for case in CASES[:2]:
         for k, solver in enumerate(list(SOLVERS)[:2]):
