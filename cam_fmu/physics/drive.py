@@ -217,16 +217,21 @@ class DriveModel:
         J = self.J_m + self.m * s1 * s1
         return LoadState(omega_dot, M, J, f, v, a, alpha, s)
 
-    def breakaway_direction(self, theta: float, torque: float, engaged: bool = True) -> float:
+    def breakaway_direction(self, theta: float, torque: float, engaged: bool = True,
+                            engaged_backward: bool | None = None) -> float:
         """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).
 
         At rest, friction opposes the motion that would start: the shaft moves
         forward only if it accelerates forward with friction against it, and so
-        on. With no friction and zero net torque it stays at rest.
+        on. With no friction and zero net torque it stays at rest. ``engaged``:
+        the follower loads the shaft going forward (and backward, unless
+        ``engaged_backward`` says otherwise: with backlash the cam may move away
+        from the follower in one direction only).
         """
+        backward = engaged if engaged_backward is None else engaged_backward
         if self.omega_dot(theta, 0.0, torque, 1.0, engaged) > 0.0:
             return 1.0
-        if self.omega_dot(theta, 0.0, torque, -1.0, engaged) < 0.0:
+        if self.omega_dot(theta, 0.0, torque, -1.0, backward) < 0.0:
             return -1.0
         return 0.0
 

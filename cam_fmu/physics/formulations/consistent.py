@@ -204,11 +204,21 @@ class HybridDrive:
             if abs(n_r) > SIDE_HYSTERESIS:
                 mode.side = -1.0 if n_r < 0.0 else 1.0
 
+    def _engaged_toward(self, theta: float, mode: Mode, direction: float) -> bool:
+        """Does the follower load the shaft when it starts toward ``direction`` from rest? Not when it is
+        free in the gap, nor (backlash) where the cam would move away from it: the follower stays put."""
+        if mode.contact == 0:
+            return False
+        if not self.backlash:
+            return True
+        s1 = self.model.program.derivatives(theta)[1]
+        return not mode.contact * s1 * direction < 0.0
+
     def _breakaway_margin(self, y, u: float, mode: Mode) -> float:
-        """> 0 when the shaft would start moving from rest [rad/s2]."""
-        model, torque, engaged = self.model, self.torque(y, u), mode.contact != 0
-        forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, engaged)
-        backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, engaged)
+        """> 0 when the shaft would start moving from rest [rad/s2], each direction with its own engagement."""
+        model, torque = self.model, self.torque(y, u)
+        forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, self._engaged_toward(y[THETA], mode, 1.0))
+        backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, self._engaged_toward(y[THETA], mode, -1.0))
         return max(forward, backward)
 
     def apply_event(self, y, u: float, mode: Mode, name: str) -> None:
@@ -248,19 +258,25 @@ class HybridDrive:
         instead of waiting for the next communication step.
         """
         model = self.model
-        torque, engaged = self.torque(y, u), mode.contact != 0
+        torque = self.torque(y, u)
         if not mode.stuck:
             if y[OMEGA] != 0.0:
                 return
             # At rest but marked as moving (it started under other inputs, or at
             # a break-away): it goes on unless it now accelerates backwards.
+            engaged = self._engaged_toward(y[THETA], mode, mode.direction)
             if mode.direction * model.omega_dot(y[THETA], 0.0, torque, mode.direction, engaged) >= 0.0:
                 return
             mode.stuck = True
-        direction = model.breakaway_direction(y[THETA], torque, engaged)
+        # Each direction with the follower as it would be there: the break-away event's margin is the
+        # same test, so a located break-away always starts the shaft (an event that fired without effect
+        # fired again at once: with gravity, backlash and L > 0 the engine chattered at a stall).
+        forward_engaged = self._engaged_toward(y[THETA], mode, 1.0)
+        backward_engaged = self._engaged_toward(y[THETA], mode, -1.0)
+        direction = model.breakaway_direction(y[THETA], torque, forward_engaged, backward_engaged)
         if direction == 0.0 and at_threshold:
-            forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, engaged)
-            backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, engaged)
+            forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, forward_engaged)
+            backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, backward_engaged)
             if forward == backward and self.has_current:
                 # A tie (no shaft friction, zero torque as the current passes through 0): the
                 # shaft goes where the current is heading. Taking +1 here made the reference

@@ -136,11 +136,12 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     out->a = a;
 }
 
-double cam_breakaway_direction(const CamModel *m, double theta, double torque, int engaged)
+double cam_breakaway_direction(const CamModel *m, double theta, double torque, int engaged_forward,
+                               int engaged_backward)
 {
-    if (cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged, 0.0) > 0.0)
+    if (cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged_forward, 0.0) > 0.0)
         return 1.0;
-    if (cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged, 0.0) < 0.0)
+    if (cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged_backward, 0.0) < 0.0)
         return -1.0;
     return 0.0;
 }

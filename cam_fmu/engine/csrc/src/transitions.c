@@ -25,12 +25,22 @@ int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EV
     return n;
 }
 
+int cam_engaged_toward(const CamModel *m, const CamMode *mode, double theta, double direction)
+{
+    double d[4];
+    if (mode->contact == 0)
+        return 0;
+    if (!m->backlash)
+        return 1;
+    cam_profile_eval(&m->profile, theta, d);
+    return !(mode->contact * d[1] * direction < 0.0);
+}
+
 double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double i, double u)
 {
     double torque = cam_torque(m, 0.0, i, u);
-    int engaged = mode->contact != 0;
-    double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged, 0.0);
-    double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged, 0.0);
+    double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, cam_engaged_toward(m, mode, theta, 1.0), 0.0);
+    double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, cam_engaged_toward(m, mode, theta, -1.0), 0.0);
     return backward > forward ? backward : forward;
 }
 
@@ -88,19 +98,24 @@ void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], d
 static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], double u, int at_threshold)
 {
     double theta = x[CAM_THETA], torque = cam_torque(m, x[CAM_OMEGA], x[CAM_CURRENT], u), direction, d[4];
-    int engaged = mode->contact != 0, leaves = 0;
+    int forward_engaged, backward_engaged, leaves = 0;
     if (!mode->stuck) {
         if (x[CAM_OMEGA] != 0.0)
             return;
         /* at rest but marked as moving: it goes on unless it now accelerates backwards */
-        if (mode->direction * cam_omega_dot(m, theta, 0.0, torque, mode->direction, engaged, 0.0) >= 0.0)
+        if (mode->direction * cam_omega_dot(m, theta, 0.0, torque, mode->direction,
+                                            cam_engaged_toward(m, mode, theta, mode->direction), 0.0) >= 0.0)
             return;
         mode->stuck = 1;
     }
-    direction = cam_breakaway_direction(m, theta, torque, engaged);
+    /* each direction with the follower as it would be there: the break-away event's margin is the same
+     * test, so a break-away it locates always starts the shaft (no event that fires without effect) */
+    forward_engaged = cam_engaged_toward(m, mode, theta, 1.0);
+    backward_engaged = cam_engaged_toward(m, mode, theta, -1.0);
+    direction = cam_breakaway_direction(m, theta, torque, forward_engaged, backward_engaged);
     if (direction == 0.0 && at_threshold) {
-        double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged, 0.0);
-        double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged, 0.0);
+        double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, forward_engaged, 0.0);
+        double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, backward_engaged, 0.0);
         if (forward == backward && m->has_current) {
             /* a tie (no shaft friction, zero torque as the current passes through 0): the shaft goes
              * where the current is heading */
