@@ -34,6 +34,7 @@ typedef struct {
     int fsal;                                     /* 1: f at the new state is stage s + 1 (first same as last) */
     double e[CAM_MAX_STAGES + 1];                 /* error weights b - b_hat, the FSAL stage last; all 0: none */
     double error_exponent;                        /* -1/(q+1) for an embedded pair of order q (dopri5: -0.2) */
+    double b_divisor;                             /* > 0: x + (h / b_divisor) * sum b_j k_j (rk4's h/6) */
 } CamTableau;
 
 /* Scratch of one step: the stages, the new state, its error and f at it. */
@@ -66,8 +67,16 @@ typedef struct CamMethod {
 /* The method the parameter ``solver`` names (CAM_CHOICE_SOLVER_*), or NULL (methods.c). */
 const CamMethod *cam_method(int solver_choice);
 
-/* The tableaus: const data (no mutable state), Dormand-Prince 5(4) in rk.c. */
-extern const CamTableau cam_dopri5;
+/* The tableaus: const data (no mutable state), in rk.c. */
+extern const CamTableau cam_dopri5;   /* Dormand-Prince 5(4), FSAL, embedded error */
+extern const CamTableau cam_rk4;      /* the classical Runge-Kutta method, order 4 */
+extern const CamTableau cam_euler;    /* explicit Euler, order 1 */
+
+/* Exponential RK4 (Cox and Matthews 2002) on (theta, omega, e), e the current's deviation from its
+ * quasi-static value: exact on the electrical pole -R/L and on its torque on omega (etdrk4.c); the
+ * classical RK4 when the current is no state (L = 0). */
+void cam_etdrk4_step(const struct CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX],
+                     double u, double h, CamStepWork *w);
 
 /* The generic explicit Runge-Kutta step over method->tableau. */
 void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX],

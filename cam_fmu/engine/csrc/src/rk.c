@@ -23,7 +23,23 @@ const CamTableau cam_dopri5 = {
     1,
     {71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0},
     -0.2,
+    0.0,
 };
+
+/* The classical Runge-Kutta method: x + (h / 6) (k1 + 2 k2 + 2 k3 + k4), in that order. */
+const CamTableau cam_rk4 = {
+    4,
+    {{0.0}, {0.5}, {0.0, 0.5}, {0.0, 0.0, 1.0}},
+    {1.0, 2.0, 2.0, 1.0},
+    {0.0, 0.5, 0.5, 1.0},
+    0,
+    {0.0},
+    0.0,
+    6.0,
+};
+
+/* Explicit Euler: x + h k1. */
+const CamTableau cam_euler = {1, {{0.0}}, {1.0}, {0.0}, 0, {0.0}, 0.0, 0.0};
 
 /* h * sum_j coef[j] k[j] + x for slot i over the nonzero coefficients (see the file's comment). */
 static double increment(const double *coef, int n, double (*k)[CAM_NX], int slot, double x, double h)
@@ -62,8 +78,14 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
             arg[slot] = increment(t->a[i], i, w->k, slot, x[slot], h);
         cam_rhs(m, mode, arg, u, w->k[i]);
     }
-    for (slot = 0; slot < CAM_NX; slot++)
-        w->x_new[slot] = increment(t->b, s, w->k, slot, x[slot], h);
+    if (t->b_divisor > 0.0) {   /* x + (h / d) * (b_1 k_1 + ...): the weights' common factor first */
+        double scaled = h / t->b_divisor;
+        for (slot = 0; slot < CAM_NX; slot++)
+            w->x_new[slot] = x[slot] + scaled * increment(t->b, s, w->k, slot, 0.0, 1.0);   /* 0 + 1 sum: exact */
+    } else {
+        for (slot = 0; slot < CAM_NX; slot++)
+            w->x_new[slot] = increment(t->b, s, w->k, slot, x[slot], h);
+    }
     if (t->fsal) {
         cam_rhs(m, mode, w->x_new, u, w->k[s]);
         for (slot = 0; slot < CAM_NX; slot++)
