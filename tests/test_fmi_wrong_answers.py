@@ -2,7 +2,7 @@
 
 Against the FMI 2.0 interface only (fmpy's FMU2Slave, call by call), so they hold whatever
 engine is inside cam.fmu; here the C-built one. Each compares the FMU with an independent answer:
-the table itself. (The classes that wait for the rest of the C engine are in test_fmi_pending.py.)
+the table itself. (The classes of the formulations and the stall are in test_fmi_formulations.py.)
 """
 from __future__ import annotations
 

@@ -46,10 +46,28 @@ def _play_along(program, s: float, start: float, end: float, c: float) -> float:
     return play(program.derivatives(end)[0], s, c)
 
 
-def speed_engaged(program, theta: float, s: float, omega: float, c: float) -> bool:
-    """Is the follower at s [m] dragged by the cam at theta moving at omega (not free in the gap)?"""
+def speed_engaged(program, theta: float, s: float, omega: float, c: float, omega_dot: float = 0.0,
+                  F_gx: float = 0.0) -> bool:
+    """Is the follower at s [m] carried by the cam at theta moving at omega (not free in the gap)?
+
+    Moving: where it sits at an edge of the gap that the cam pushes forward. At rest (omega = 0):
+    under a force along the stroke (gravity, F_gx [N]) it lies on the cam at the edge that force
+    pushes it to (``rest_position``), so the cam carries it; without one, where the cam's
+    acceleration omega_dot [rad/s2] pushes it. So the holding torque at rest does not vanish
+    with a clearance, and results converge to those of c = 0 as c -> 0.
+    """
     if c == 0.0:
         return True
     s_cam, s1, _, _ = program.derivatives(theta)
+    if omega == 0.0 and F_gx != 0.0:
+        return True
     gap = s_cam - s
-    return abs(gap) >= c * (1.0 - 1e-9) and gap * s1 * omega > 0.0
+    return abs(gap) >= c * (1.0 - 1e-9) and gap * s1 * (omega if omega != 0.0 else omega_dot) > 0.0
+
+
+def rest_position(s_cam: float, c: float, F_gx: float, s: float) -> float:
+    """Where the follower lies at rest [m]: on the cam at the edge of the gap that the force along the
+    stroke F_gx [N] pushes it to (s_cam + c for F_gx > 0), or where it is without such a force."""
+    if c == 0.0 or F_gx == 0.0:
+        return s
+    return s_cam + c if F_gx > 0.0 else s_cam - c

@@ -21,11 +21,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..experiments.signals import Signal, constant
-from ..physics.contact import follower_along, speed_engaged
+from ..physics.contact import follower_along, rest_position, speed_engaged
 from ..physics.drive import DriveModel
 from ..physics.formulations import formulation_name
 from ..physics.formulations.consistent import HybridDrive
-from ..physics.formulations.paper import PaperScheme
+from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 
@@ -214,14 +214,14 @@ def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signa
 
 
 def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
-    """The paper's algorithm with its calculation step T = h_max (it is its own reference)."""
+    """The paper's algorithm on its fixed grid of calculation steps T = h_max (it is its own reference)."""
     p = model.params
     scheme = PaperScheme(model, p["theta0"], p["omega0"], p["i0"])
     scheme.voltage = u.value(0.0)
     rows = [scheme.outputs()]
     for t0, t1 in zip(grid[:-1], grid[1:]):
         h = float(t1 - t0)
-        steps = max(1, math.ceil(h / p["h_max"] - 1e-9))
+        steps = calculation_steps(h, p["h_max"])
         for j in range(steps):
             scheme.step(h / steps, u.value(float(t0) + j * h / steps), int(p["max_steps"]))
         rows.append(scheme.outputs())
@@ -246,11 +246,14 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
             s = follower_along(model.program, s, theta, end, model.c)  # the same play operator as the FMU
             theta = end
         omega = omega_ref.value(float(t))
-        engaged = speed_engaged(model.program, theta, s, omega, model.c)
+        if omega == 0.0:  # at rest the follower lies on the cam where its weight pushes it
+            s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
         # At a kink of omega(t) the acceleration of the interval that ends at t
         # counts, as in a co-simulation step that ends there.
         t_left = float(t) - 1e-12 * max(1.0, float(t)) if k else 0.0
-        rows.append(speed_drive_outputs(model, theta, omega, omega_ref.slope(t_left), s, engaged))
+        omega_dot = omega_ref.slope(t_left)
+        engaged = speed_engaged(model.program, theta, s, omega, model.c, omega_dot, model.F_gx)
+        rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged))
     return _collect(rows, grid)
 
 

@@ -167,3 +167,17 @@ def _rk4_motor_inductive(model: DriveModel, omega: float, i: float, M: float, J:
         omega += h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
         i += h / 6.0 * (b1 + 2 * b2 + 2 * b3 + b4)
     return omega, i
+
+
+def calculation_steps(h: float, h_max: float) -> int:
+    """How many calculation steps T = h_max one communication step of h [s] is: the grid is fixed, so the
+    scheme's answer does not follow the host's step pattern. StepRejected when h is no whole number of
+    them (to 1e-9 relative)."""
+    ratio = h / h_max
+    n = math.floor(ratio + 0.5)
+    if n < 1 or abs(ratio - n) > 1e-9 * n:
+        raise StepRejected(
+            f"formulation 'paper' computes on a fixed grid of calculation steps of h_max = {h_max:g} s; a "
+            f"communication step of {h:g} s is not a whole number of them: use communication steps that are "
+            "multiples of h_max, or set h_max to the communication step")
+    return n

@@ -13,11 +13,9 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
         return status;
     d->form = cam_formulation(d->model.formulation);
-    if (d->form == NULL || (d->model.formulation == CAM_FORM_CONSISTENT && cam_method(d->model.solver) == NULL)) {
-        const char *what = d->form == NULL ? (d->model.formulation == CAM_FORM_SPEED ? "the speed drive"
-                                              : "formulation 'paper'") : "this solver";
-        status = cam_error(err, CAM_ERR_PARAMETER, "%s is not yet available in the C engine (solver '%s')", what,
-                           cam_param_spec(CAM_P_SOLVER)->choices[d->model.solver]);
+    if (d->form == NULL || cam_method(d->model.solver) == NULL) {   /* the generated choices and the registries */
+        status = cam_error(err, CAM_ERR_PARAMETER, "formulation %d or solver %d is not in the engine",
+                           (int)d->model.formulation, d->model.solver);
         cam_model_free(&d->model);
         return status;
     }

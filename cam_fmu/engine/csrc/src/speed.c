@@ -1,0 +1,153 @@
+/* The speed drive (physics/formulations/speed.py; docs/model.md section 8): omega(t) is imposed, the
+ * torque, current and voltage it needs are outputs. Over a communication step omega(t) = omega_ref +
+ * omega_dot_ref (t - t_k), so a ramp of omega is exact; the play operator sees every breakpoint passed
+ * (where the extrema of s_cam lie), not only the end point. At rest the follower lies on the cam at the
+ * edge of the gap its weight pushes it to (physics.contact.rest_position), so the holding torque does
+ * not vanish with a clearance. */
+#include <math.h>
+
+#include "cam_model.h"
+
+#define TWO_PI (2.0 * 3.141592653589793)
+
+static double play(double s_cam, double s_prev, double c)
+{
+    if (s_cam > s_prev + c)
+        return s_cam - c;
+    if (s_cam < s_prev - c)
+        return s_cam + c;
+    return s_prev;
+}
+
+static double s_at(const CamProfile *p, double theta)
+{
+    double d[4];
+    cam_profile_eval(p, theta, d);
+    return d[0];
+}
+
+/* The play operator along start -> end, through every breakpoint passed, in order. */
+static double play_along(const CamProfile *p, double s, double start, double end, double c)
+{
+    double at = start, next;
+    for (;;) {
+        next = cam_profile_first_breakpoint(p, at, end);
+        if (next != next)
+            break;
+        s = play(s_at(p, next), s, c);
+        at = next;
+    }
+    return play(s_at(p, end), s, c);
+}
+
+/* The follower's position [m] after the cam turns from start to end [rad] (contact.follower_along):
+ * whole turns after the first change nothing. */
+static double follower_along(const CamProfile *p, double s, double start, double end, double c)
+{
+    double turns, direction;
+    if (c == 0.0)
+        return s_at(p, end);
+    turns = floor(fabs(end - start) / TWO_PI);
+    if (turns >= 2.0) {
+        direction = end > start ? 1.0 : -1.0;
+        s = play_along(p, s, start, start + direction * TWO_PI, c);
+        start = start + direction * TWO_PI * turns;
+    }
+    return play_along(p, s, start, end, c);
+}
+
+/* contact.speed_engaged: is the follower carried by the cam? */
+static int engaged(const CamModel *m, double theta, double s, double omega, double omega_dot)
+{
+    double d[4], gap;
+    if (m->c == 0.0)
+        return 1;
+    cam_profile_eval(&m->profile, theta, d);
+    if (omega == 0.0 && m->F_gx != 0.0)
+        return 1;
+    gap = d[0] - s;
+    return fabs(gap) >= m->c * (1.0 - 1e-9) && gap * d[1] * (omega != 0.0 ? omega : omega_dot) > 0.0;
+}
+
+/* contact.rest_position: on the cam at the edge the force along the stroke pushes the follower to. */
+static double rest_position(const CamModel *m, double theta, double s)
+{
+    if (m->c == 0.0 || m->F_gx == 0.0)
+        return s;
+    return m->F_gx > 0.0 ? s_at(&m->profile, theta) + m->c : s_at(&m->profile, theta) - m->c;
+}
+
+static int speed_init(CamDrive *d, CamError *err)
+{
+    (void)err;
+    d->speed.theta = d->model.params.v[CAM_P_THETA0];
+    d->speed.speed = d->omega_ref;
+    d->speed.s = s_at(&d->model.profile, d->speed.theta);
+    return CAM_OK;
+}
+
+static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
+{
+    (void)u;
+    (void)omega_dot_ref;
+    d->speed.speed = omega_ref;
+}
+
+static int speed_advance(CamDrive *d, double h, double time, long *steps, CamError *err)
+{
+    CamSpeedState *st = &d->speed;
+    double end = st->theta + (d->omega_ref + 0.5 * d->omega_dot_ref * h) * h;
+    (void)time;
+    (void)err;
+    st->speed = d->omega_ref + d->omega_dot_ref * h;
+    st->s = follower_along(&d->model.profile, st->s, st->theta, end, d->model.c);
+    st->theta = end;
+    if (st->speed == 0.0)
+        st->s = rest_position(&d->model, st->theta, st->s);
+    *steps = 1;
+    return CAM_OK;
+}
+
+/* speed.speed_drive_outputs: c_m i = J_m omega_dot + M; the voltage adds L di/dt, di/dt = omega dM/dtheta
+ * at constant speed (central difference, 1e-6 rad). */
+static void speed_outputs(CamDrive *d, double out[])
+{
+    const CamModel *m = &d->model;
+    const CamSpeedState *st = &d->speed;
+    double omega = st->speed, omega_dot = d->omega_dot_ref, theta = st->theta, direction, i, voltage;
+    CamLoad load, ahead, behind;
+    int on = engaged(m, theta, st->s, omega, omega_dot);
+    direction = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
+    cam_load(m, theta, omega, omega_dot, direction, on, &load);
+    i = (m->J_m * omega_dot + load.M) / m->c_m;
+    voltage = m->R * i + m->c_e * omega;
+    if (m->L > 0.0 && omega != 0.0) {
+        double step = 1e-6, dM;
+        cam_load(m, theta + step, omega, omega_dot, direction, on, &ahead);
+        cam_load(m, theta - step, omega, omega_dot, direction, on, &behind);
+        dM = (ahead.M - behind.M) / (2.0 * step);
+        voltage += m->L * omega * dM / m->c_m;
+    }
+    out[CAM_O_OMEGA] = omega;
+    out[CAM_O_THETA] = theta;
+    out[CAM_O_S] = st->s;
+    out[CAM_O_I] = i;
+    out[CAM_O_M] = load.M;
+    out[CAM_O_J] = load.J;
+    out[CAM_O_V] = load.v;
+    out[CAM_O_A] = load.a;
+    out[CAM_O_ALPHA] = load.alpha;
+    out[CAM_O_S_CAM] = s_at(&m->profile, theta);
+    out[CAM_O_VOLTAGE] = voltage;
+}
+
+static void speed_advice(const CamDrive *d, char *buf, size_t len)
+{
+    (void)d;
+    if (len > 0)
+        buf[0] = '\0';   /* not energy-bounded: the guards that name an advice do not apply */
+}
+
+const CamFormulation cam_speed = {
+    "speed", 0, speed_init, speed_set_inputs, speed_advance, speed_outputs, speed_advice,
+};
