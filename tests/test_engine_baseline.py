@@ -52,10 +52,24 @@ def _as_fixed(case, now) -> dict:
     return recorded
 
 
+POLE_LIMIT = 3.0  # cam_solver.h CAM_POLE_LIMIT: rk45 steps longer than this many L/R are exponential
+
+
+def _stiff_pole(case) -> bool:
+    """rk45 may take a step of this case as the exponential pair (a step longer than 3 L/R is possible):
+    the engine's integrator differs there on purpose (issue 18: stable at any L), so the record holds
+    only to the tolerance the step control promises, 1e3 rtol, not to the bit."""
+    p = resolve(case["params"])
+    return (p["drive"] == "voltage" and p["formulation"] == "consistent" and p["solver"] == "rk45"
+            and p["inductance"] and p["L"] > 0.0
+            and min(p["h_max"], case["comm_step"]) * p["R"] / p["L"] > POLE_LIMIT)
+
+
 @pytest.mark.parametrize("case", CASES, ids=[case["name"] for case in CASES])
 def test_the_engine_reproduces_its_baseline(case):
     now = baseline.replay(case)
-    problems, _worst = baseline.compare(_as_fixed(case, now), now)
+    rtol = max(baseline.RTOL, 1e3 * resolve(case["params"])["rtol"]) if _stiff_pole(case) else baseline.RTOL
+    problems, _worst = baseline.compare(_as_fixed(case, now), now, rtol)
     assert problems == [], f"{case['name']}: " + "\n".join(problems)
 
 

@@ -160,9 +160,10 @@ def replay(case: dict[str, Any]) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ compare
-def compare(recorded: dict[str, Any], result: dict[str, Any]) -> tuple[list[str], float]:
+def compare(recorded: dict[str, Any], result: dict[str, Any], rtol: float = RTOL) -> tuple[list[str], float]:
     """The differences of ``result`` (a replay) from ``recorded``, and the largest
-    |difference| / tolerance over the samples (<= 1 passes; 0: bit-identical)."""
+    |difference| / tolerance over the samples (<= 1 passes; 0: bit-identical). ``rtol``: the
+    relative tolerance (RTOL unless a change of the engine is meant to move the numbers)."""
     problems, worst = [], 0.0
     if result["error"] is None or recorded["error"] is None:
         if result["error"] != recorded["error"]:
@@ -178,7 +179,7 @@ def compare(recorded: dict[str, Any], result: dict[str, Any]) -> tuple[list[str]
         for k, a, b in zip(recorded["steps"], old, new):
             if a == b or (math.isnan(a) and math.isnan(b)):
                 continue
-            tol = RTOL * max(abs(a), ZERO * scale)
+            tol = rtol * max(abs(a), ZERO * scale)
             ratio = abs(a - b) / tol if tol > 0.0 else math.inf
             worst = max(worst, ratio)
             if not ratio <= 1.0:

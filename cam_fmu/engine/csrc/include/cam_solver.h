@@ -98,7 +98,19 @@ typedef struct {
     int n_events;
     int have_before;            /* before[] holds the values at the current x */
     int hit;                    /* the code of the event first found */
+    int exponential;            /* the adaptive step in hand is the exponential pair (a stiff pole) */
 } CamIntegrator;
+
+/* rk45 and the electrical pole: where a step is longer than CAM_POLE_LIMIT electrical time constants
+ * L/R, Dormand-Prince would be unstable (its real-axis limit is 3.3), so the adaptive driver takes the
+ * step as the exponential pair instead: etdrk4 over the step and over its two halves, the halves
+ * accepted, their difference / 15 the error estimate (Richardson, order 4). Exact on the pole at any
+ * L, with the same error control (docs/model.md section 7). */
+#define CAM_POLE_LIMIT 3.0
+
+/* The exponential pair of size h from x (the mode and u fixed): x_new and error into w. */
+void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double h,
+                          CamStepWork *w);
 
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is

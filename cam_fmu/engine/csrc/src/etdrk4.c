@@ -111,7 +111,7 @@ void cam_etdrk4_step(const CamMethod *method, const CamModel *m, const CamMode *
     double rate, a, y[CAM_NX], n_y[CAM_NX], st_a[CAM_NX], n_a[CAM_NX], st_b[CAM_NX], n_b[CAM_NX];
     double st_c[CAM_NX], n_c[CAM_NX], mix[CAM_NX], wt = 1.0 / 6.0, a_full;
     int slot;
-    if (!m->has_current) {   /* no pole: the classical RK4 (method only names the solver here) */
+    if (!m->has_current) {   /* no pole: the classical RK4 (the pair is used only with a pole) */
         CamMethod rk4 = *method;
         rk4.tableau = &cam_rk4;
         cam_rk_step(&rk4, m, mode, x, u, h, w);
@@ -139,4 +139,20 @@ void cam_etdrk4_step(const CamMethod *method, const CamModel *m, const CamMode *
                           + h * a_full * (k.dd_f[0] * n_y[2] + 2.0 * k.dd_f[1] * (n_a[2] + n_b[2]) + k.dd_f[2] * n_c[2]);
     w->x_new[CAM_CURRENT] = k.e_full * y[2] + h * (k.f[0] * n_y[2] + 2.0 * k.f[1] * (n_a[2] + n_b[2]) + k.f[2] * n_c[2]);
     w->x_new[CAM_CURRENT] += quasi_static_current(m, u, w->x_new[CAM_OMEGA]);
+}
+
+void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double h,
+                          CamStepWork *w)
+{
+    double full[CAM_NX], mid[CAM_NX];
+    int slot;
+    cam_etdrk4_step(NULL, m, mode, x, u, h, w);
+    for (slot = 0; slot < CAM_NX; slot++)
+        full[slot] = w->x_new[slot];
+    cam_etdrk4_step(NULL, m, mode, x, u, 0.5 * h, w);
+    for (slot = 0; slot < CAM_NX; slot++)
+        mid[slot] = w->x_new[slot];
+    cam_etdrk4_step(NULL, m, mode, mid, u, 0.5 * h, w);
+    for (slot = 0; slot < CAM_NX; slot++)
+        w->error[slot] = (w->x_new[slot] - full[slot]) / 15.0;
 }

@@ -21,9 +21,14 @@ static void ensure_k1(CamDrive *d, double u)
     }
 }
 
-/* One step of the method of size h from d->x into it->work (k1 valid). */
+/* One step of size h from d->x into it->work (k1 valid): the method's, or the exponential pair when the
+ * step in hand is one (so the event locator's trial steps continue the step that was taken). */
 static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
 {
+    if (it->exponential) {
+        cam_exponential_pair(&d->model, &d->mode, d->x, u, h, &it->work);
+        return;
+    }
     memcpy(it->work.k[0], d->solver.k1, sizeof d->solver.k1);
     it->method->step(it->method, &d->model, &d->mode, d->x, u, h, &it->work);
 }
@@ -39,6 +44,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
         dt = m->h_max;
     ensure_k1(d, u);
     for (;;) {
+        it->exponential = m->has_current && dt * m->R / m->L > CAM_POLE_LIMIT;
         method_step(d, it, dt, u);
         norm = cam_error_norm(m, d->x, &it->work);
         if (norm <= 1.0) {
@@ -56,7 +62,8 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
                 d->solver.h_next = t > d->solver.h_next ? t : d->solver.h_next;
             }
             memcpy(it->x_end, it->work.x_new, sizeof it->x_end);
-            memcpy(it->f_end, it->work.f_new, sizeof it->f_end);
+            if (!it->exponential)
+                memcpy(it->f_end, it->work.f_new, sizeof it->f_end);
             *dt_out = dt;
             return CAM_OK;
         }
@@ -177,10 +184,8 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
         snprintf(advice, sizeof advice, "h_max = %g s caps every internal step, so this communication step "
                  "needs at least %.4g of them: raise h_max or max_steps, or shorten the communication step",
                  m->h_max, h / m->h_max);
-    else if (method->adaptive)
-        snprintf(advice, sizeof advice, "raise max_steps, loosen rtol/atol or shorten the communication step%s",
-                 m->has_current && !method->exact_electrical_pole
-                     ? "; with L > 0 the electrical pole is stiff: use solver 'etdrk4'" : "");
+    else if (method->adaptive)   /* the pole is no cause here: the exponential pair takes it */
+        snprintf(advice, sizeof advice, "raise max_steps, loosen rtol/atol or shorten the communication step");
     else
         snprintf(advice, sizeof advice, "raise max_steps or h_max (now %g s), or shorten the communication step; "
                  "'%s' takes steps no longer than its stability limit", m->h_max, method->name);
@@ -210,6 +215,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         }
         remaining = h - t;
         next_valid = 0;   /* does it->f_end hold f at the step's end? */
+        it->exponential = 0;
         if (d->mode.stuck) {
             dt = remaining;
             it->x_end[CAM_THETA] = d->x[CAM_THETA];
@@ -218,7 +224,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         } else {
             if (it->method->adaptive) {
                 status = cam_step_adaptive(d, it, remaining, time + t, h, &dt, err);
-                next_valid = 1;
+                next_valid = !it->exponential;   /* the pair computes no f at its end */
             } else {
                 ensure_k1(d, u);
                 status = cam_step_fixed(d, it, remaining, &dt, &retries, err);
