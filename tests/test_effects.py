@@ -37,17 +37,22 @@ def test_without_the_follower_the_drive_is_the_bare_first_order_motor(shaft_fric
     assert np.allclose(run["M"][1:], m_f, rtol=0, atol=1e-15)  # no follower load at all
 
 
-def test_a_switched_off_follower_costs_no_profile_evaluation():
-    """With the follower's inertia, gravity and guide friction off, the dynamics never read the profile:
-    the kernel's count is one evaluation per published state (the outputs s, s_cam and alpha need it)."""
-    off = DriveSimulator(FOLLOWER_OFF)
-    on = DriveSimulator({})
+def test_a_switched_off_follower_leaves_the_bare_motor():
+    """With the follower's inertia, gravity and guide friction off, the shaft is the bare motor with
+    Coulomb friction: omega(t) = w (1 - exp(-t/tau)), w = (c_m u/R - M_f) R/(c_m c_e), tau = R J_m/(c_m c_e)
+    (the closed form; 1e-9 relative over 0.1 s), and it costs fewer internal steps than the full drive."""
+    from cam_fmu.physics.parameters import defaults
+
+    p = defaults()
+    off, on = DriveSimulator(FOLLOWER_OFF), DriveSimulator({})
     for k in range(100):
         off.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
         on.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
-    assert off.steps_taken >= 100
-    assert off.kernel.evaluations <= 101
-    assert on.kernel.evaluations > 6 * on.steps_taken  # rk45 reads it at every stage
+    R, c_e, c_m, J_m, M_f = (p[n] for n in ("R", "c_e", "c_m", "J_m", "M_f"))
+    w = (c_m * 3.5 / R - M_f) * R / (c_m * c_e)
+    tau = R * J_m / (c_m * c_e)
+    assert off.outputs()["omega"] == pytest.approx(w * (1.0 - np.exp(-0.1 / tau)), rel=1e-9)
+    assert 100 <= off.steps_taken < on.steps_taken
 
 
 def test_inductance_switch_off_ignores_L():

@@ -43,13 +43,21 @@ def _hand_threshold(theta: float, gamma: float, beta: float, sigma: float) -> fl
     return sigma * M_F + (-F_gx + sig_v * f) * s1
 
 
-def _run_sim(params, u, steps, h=1e-3):
+def _run_sim(params, u, steps, h=1e-3, events=None):
+    """The C engine's outputs at every step; ``events``: a list that receives its transitions
+    (the engine's event log, read after every step: it keeps the last 256)."""
     sim = DriveSimulator(params)
     sim.set_inputs(u, 1.0)
     rows = [sim.outputs()]
+    seen = -1
     for k in range(steps):
         sim.do_step(k * h, h, u, 1.0)
         rows.append(sim.outputs())
+        if events is not None:
+            fresh = [e for e in sim.events() if e["index"] > seen]
+            assert not fresh or fresh[0]["index"] == seen + 1, "the log dropped transitions"
+            seen = fresh[-1]["index"] if fresh else seen
+            events += [(e["name"], e["before"], e["after"], Mode(**e["mode_before"])) for e in fresh]
     return {name: np.array([r[name] for r in rows]) for name in rows[0]}
 
 
@@ -196,11 +204,13 @@ def test_backlash_run_lag_momentum_and_energy(engine, spy_events):
     - on the rise, once engaged, the follower lags by c: s = s_cam - c (1e-12 m); on the
       return it leads by c: s = s_cam + c; before the first pick-up it rests at 0.
     """
-    if engine == "simulator":
-        out = _run_sim(dict(c=C), 3.5, 2000)
-    else:
+    if engine == "simulator":  # the C engine: its own event log
+        events: list = []
+        out = _run_sim(dict(c=C), 3.5, 2000, events=events)
+    else:  # the reference: the readable model's transitions, spied
         out = simulate_reference(dict(c=C), 2.0, 1e-3)
-    engagements = [e for e in spy_events if e[0] in (ENGAGE_UP, ENGAGE_DOWN)]
+        events = spy_events
+    engagements = [e for e in events if e[0] in (ENGAGE_UP, ENGAGE_DOWN)]
     assert len(engagements) >= 2 * int(out["theta"][-1] / (2 * math.pi))  # two per turn
     for name, before, after, mode in engagements:
         theta, w_minus, w_plus = before[0], before[1], after[1]

@@ -32,6 +32,23 @@ BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
 STATE_VERSION = 1.0
 
 
+from ..physics.formulations.consistent import EVENT_NAMES  # noqa: E402  (cam_model.h CAM_EV_*, in order)
+
+
+class CamMode(ctypes.Structure):
+    """cam_model.h CamMode."""
+
+    _fields_ = [("stuck", ctypes.c_int), ("direction", ctypes.c_double), ("contact", ctypes.c_int),
+                ("s_free", ctypes.c_double), ("side", ctypes.c_double)]
+
+
+class CamEventRecord(ctypes.Structure):
+    """cam_model.h CamEventRecord: one transition of the consistent formulation."""
+
+    _fields_ = [("code", ctypes.c_int), ("time", ctypes.c_double), ("x_before", ctypes.c_double * 3),
+                ("x_after", ctypes.c_double * 3), ("mode_before", CamMode)]
+
+
 class CamError(ctypes.Structure):
     """The engine's error: its status (0 ok, 1 parameter, 2 simulation, 3 step rejected, 4 memory) and message."""
 
@@ -63,6 +80,9 @@ _SIGNATURES = {
     "cam_drive_steps_taken": (ctypes.c_long, [_P]),
     "cam_drive_last_steps": (ctypes.c_long, [_P]),
     "cam_drive_nx": (ctypes.c_int, [_P]),
+    "cam_drive_event": (ctypes.POINTER(CamEventRecord), [_P, ctypes.c_long]),
+    "cam_drive_events_logged": (ctypes.c_long, [_P]),
+    "cam_event_record_sizeof": (ctypes.c_size_t, []),
 }
 
 
@@ -225,6 +245,27 @@ class DriveSimulator:
         if energy is not None:
             s[S_BUDGET:S_BUDGET + 6] = array("d", [float(energy[key]) for key in BUDGET_KEYS])
         self.set_state_array(s)
+
+    def events(self) -> list[dict[str, Any]]:
+        """The transitions of the consistent formulation kept by the engine's log (the last 256), oldest
+        first: its index (counted from the drive's first transition), name, time [s], the state (theta,
+        omega, i) before and after, the mode before."""
+        lib = self._lib
+        if lib.cam_event_record_sizeof() != ctypes.sizeof(CamEventRecord):
+            raise RuntimeError("the engine's CamEventRecord differs from the binding's")
+        total = lib.cam_drive_events_logged(self._drive)
+        out = []
+        for k in range(max(0, total - 256), total):
+            pointer = lib.cam_drive_event(self._drive, k)
+            if not pointer:
+                continue
+            r = pointer.contents
+            mode = r.mode_before
+            out.append({"index": k, "name": EVENT_NAMES[r.code], "time": r.time, "before": list(r.x_before),
+                        "after": list(r.x_after),
+                        "mode_before": {"stuck": bool(mode.stuck), "direction": mode.direction,
+                                        "contact": mode.contact, "s_free": mode.s_free, "side": mode.side}})
+        return out
 
     def run(self, table: Sequence[Sequence[float]]) -> list[array]:
         """Many communication steps in one engine call: rows (t, h, u, omega_ref, omega_dot_ref);

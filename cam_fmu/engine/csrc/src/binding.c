@@ -40,3 +40,20 @@ double *cam_drive_values(CamDrive *d)
 {
     return d->values;
 }
+
+const CamEventRecord *cam_drive_event(const CamDrive *d, long k)
+{
+    if (k < 0 || k >= d->events_logged || k < d->events_logged - CAM_EVENT_LOG)
+        return NULL;
+    return &d->event_log[k % CAM_EVENT_LOG];
+}
+
+long cam_drive_events_logged(const CamDrive *d)
+{
+    return d->events_logged;
+}
+
+size_t cam_event_record_sizeof(void)
+{
+    return sizeof(CamEventRecord);
+}

@@ -100,21 +100,28 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
     double out[CAM_N_OUTPUTS];
     char shown[40];
     long steps = 0;
-    int status, verdict;
+    int status, verdict, opened = 0;
+    CamEnergy opening;
     if (!(h > 0.0 && isfinite(h)))
         return cam_error(err, CAM_ERR_SIMULATION, "communication step size = %s s: allowed (0, inf)",
                         cam_num(h, shown));
     if ((status = cam_drive_set_inputs(d, u, omega_ref, omega_dot_ref, err)) != CAM_OK)
         return status;
-    if (!d->have_budget && d->form->energy_bounded) {
-        if (d->stale)
+    if (!d->have_budget && d->form->energy_bounded) {   /* the books open at the first step that is taken */
+        if (d->stale) {
             d->form->outputs(d, d->values);
-        cam_energy_init(&d->budget, &d->model, d->values[CAM_O_THETA], d->values[CAM_O_OMEGA], d->values[CAM_O_I],
+            d->stale = 0;
+        }
+        cam_energy_init(&opening, &d->model, d->values[CAM_O_THETA], d->values[CAM_O_OMEGA], d->values[CAM_O_I],
                         d->values[CAM_O_S], d->values[CAM_O_J]);
-        d->have_budget = 1;
+        opened = 1;
     }
     if ((status = d->form->advance(d, h, d->time, &steps, err)) != CAM_OK)
-        return status;
+        return status;   /* refused: the state as before the step, the books unopened */
+    if (opened) {
+        d->budget = opening;
+        d->have_budget = 1;
+    }
     d->form->outputs(d, out);
     verdict = cam_publishable(&d->model, out, d->have_budget ? &d->budget : NULL, d->u, h);
     d->last_steps = steps;

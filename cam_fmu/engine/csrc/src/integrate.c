@@ -259,7 +259,16 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         memcpy(d->x, it->x_hit, sizeof d->x);
         t += tau;
         d->solver.k1_valid = 0;
-        cam_apply_event(m, &d->mode, d->x, it->hit, u);
+        {
+            CamEventRecord *record = &d->event_log[d->events_logged % CAM_EVENT_LOG];
+            record->code = it->hit;
+            record->time = time + t;
+            memcpy(record->x_before, d->x, sizeof d->x);
+            record->mode_before = d->mode;
+            cam_apply_event(m, &d->mode, d->x, it->hit, u);
+            memcpy(record->x_after, d->x, sizeof d->x);
+            d->events_logged += 1;
+        }
         it->n_events = cam_event_codes(m, &d->mode, it->codes);
         it->have_before = 0;
     }
@@ -273,8 +282,9 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
 int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err)
 {
     CamIntegrator it;
-    double x[CAM_NX];
+    double x[CAM_NX], h_next = d->solver.h_next;
     CamMode mode = d->mode;
+    long logged = d->events_logged;
     int status;
     memset(&it, 0, sizeof it);
     it.method = cam_method(d->model.solver);
@@ -286,6 +296,8 @@ int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err
         memcpy(d->x, x, sizeof x);
         d->mode = mode;
         d->solver.k1_valid = 0;
+        d->solver.h_next = h_next;
+        d->events_logged = logged;   /* its transitions did not happen */
     }
     return status;
 }

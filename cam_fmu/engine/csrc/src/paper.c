@@ -157,11 +157,13 @@ static int scheme_step(CamDrive *d, double T, double u, long budget, long *used,
 
 static int paper_init(CamDrive *d, CamError *err)
 {
+    double unused[CAM_NX];
     const CamModel *m = &d->model;
     const double *v = m->params.v;
     CamPaperState *p = &d->paper;
     double dd[4];
     (void)err;
+    cam_initial(&d->model, d->model.params.v[CAM_P_THETA0], 0.0, 0.0, unused, &d->mode);   /* a valid mode in every saved state */
     /* step 1: initial values */
     p->theta = v[CAM_P_THETA0];
     p->omega = v[CAM_P_OMEGA0];

@@ -79,7 +79,9 @@ static double rest_position(const CamModel *m, double theta, double s)
 
 static int speed_init(CamDrive *d, CamError *err)
 {
+    double unused[CAM_NX];
     (void)err;
+    cam_initial(&d->model, d->model.params.v[CAM_P_THETA0], 0.0, 0.0, unused, &d->mode);   /* a valid mode in every saved state */
     d->speed.theta = d->model.params.v[CAM_P_THETA0];
     d->speed.speed = d->omega_ref;
     d->speed.s = s_at(&d->model.profile, d->speed.theta);
