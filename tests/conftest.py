@@ -38,6 +38,18 @@ def cam_fmu_path(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="session")
+def pi_speed_fmu_path(tmp_path_factory) -> Path:
+    """pi_speed.fmu built once per test session (build_fmu.py --model pi_speed): the Python FMU, with the
+    project's Python-hosting linux64 binary. Load it only in subprocesses, as a pythonfmu FMU."""
+    dest = tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu"
+    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", "pi_speed", "--dest", str(dest)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
+    if proc.returncode != 0 or not dest.is_file():
+        pytest.fail(f"build_fmu.py --model pi_speed failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+    return dest
+
+
+@pytest.fixture(scope="session")
 def engine_fmu_path(cam_fmu_path) -> Path:
     """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
     pytest process is safe."""

@@ -1,4 +1,5 @@
-"""Helpers for the tests of cam.fmu's own linux64 binary (tests/test_native_*.py).
+"""Helpers for the tests of the Python-hosting linux64 binary (pi_speed.fmu; tests/test_native_*.py) and of
+the C hosts.
 
 Tools that CI installs (gcc, valgrind, ecos + libtbb12, libcosimpy) are required:
 a missing one FAILS the test, it never skips.
@@ -66,7 +67,7 @@ def compile_host(dest: Path) -> Path:
 
 VALGRIND_OPTIONS = ["--error-limit=no", "--num-callers=40", "--leak-check=full", "--show-leak-kinds=definite",
                     "--errors-for-leak-kinds=none", f"--suppressions={SUPPRESSIONS}"]
-OWN_CODE = ("fmi2_python.c", "/cam.so")  # frames of cam.fmu's binary in a valgrind stack
+OWN_CODE = ("fmi2_python.c", "/pi_speed.so", "/cam.so")  # frames of the FMUs' binaries in a valgrind stack
 
 
 def valgrind_prefix(log: Path, trace_children: bool = False) -> List[str]:
@@ -80,7 +81,7 @@ def valgrind_summary(log: Path) -> dict:
     """Errors (after the suppressions) and definitely lost bytes from a valgrind log (all processes)."""
     text = log.read_text(errors="replace") if log.is_file() else ""
     errors = sum(int(m) for m in re.findall(r"ERROR SUMMARY: (\d+) errors", text))
-    # definitely lost blocks allocated by cam.fmu's binary (numpy's module init leaks a few at every exit)
+    # definitely lost blocks allocated by the FMU's binary (numpy's module init leaks a few at every exit)
     records = re.split(r"\n==\d+== \n", text)
     own_lost = [r for r in records if "definitely lost in loss record" in r and any(o in r for o in OWN_CODE)]
     lost = sum(int(re.search(r"([\d,]+) (?:\(\S+ direct, \S+ indirect\) )?bytes", r).group(1).replace(",", ""))

@@ -1,5 +1,6 @@
-"""The exchange of cam.fmu's linux64 binary: fmi2GetReal of outputs and inputs, and fmi2SetReal of inputs
-within their ranges, answered in C from a buffer the bridge keeps current (docs/fmu.md#the-exchange).
+"""The exchange of the Python-hosting linux64 binary, on pi_speed.fmu: fmi2GetReal of outputs and inputs, and
+fmi2SetReal of inputs within their ranges (finite values), answered in C from a buffer the bridge keeps
+current (docs/fmu.md#the-exchange).
 
 What could go wrong, and is checked here: a value answered in C that the slave does not hold (stale
 outputs after a state restore or a reset, inputs the slave never saw), a bad input accepted without its
@@ -21,7 +22,7 @@ md = read_model_description(sys.argv[1])
 vr = {v.name: v.valueReference for v in md.modelVariables}
 outs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
 ins = [v.valueReference for v in md.modelVariables if v.causality == "input"]
-fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[1]), modelIdentifier="cam", instanceName="a")
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[1]), modelIdentifier="pi_speed", instanceName="a")
 fmu.instantiate(); fmu.setupExperiment(startTime=0.0); fmu.enterInitializationMode(); fmu.exitInitializationMode()
 package = dict(x.split("=", 1) for x in open(str(fmu.unzipDirectory) + "/resources/native.txt").read().split())["package"]
 bridge = sys.modules[package + "._fmi_bridge"]
@@ -33,21 +34,21 @@ for name in [n for n, f in vars(bridge.Instance).items() if callable(f) and not 
     setattr(bridge.Instance, name, counting)
 t = 0.0
 for k in range(200):
-    fmu.setReal([vr["u"]], [3.0 + 0.005 * k])
-    fmu.setReal([vr["omega_ref"], vr["omega_dot_ref"]], [1.0, 0.0])
+    fmu.setReal([vr["omega_meas"]], [3.0 + 0.005 * k])
+    fmu.setReal([vr["M_load"], vr["J_load"]], [0.01, 0.002])
     fmu.doStep(t, 1e-3); t += 1e-3
-    fmu.getReal([vr["theta"], vr["omega"]]); fmu.getReal(outs + ins)
+    fmu.getReal([vr["u"], vr["integral"]]); fmu.getReal(outs + ins)
 per_step = dict(calls)
-fmu.getReal([vr["theta"], vr["J_m"]])          # a parameter among the outputs: Python answers
+fmu.getReal([vr["u"], vr["kp"]])               # a parameter among the outputs: Python answers
 mixed = calls.get("get_real", 0)
-fmu.setReal([vr["u"], vr["omega_ref"]], [3.5, 1.0])
+fmu.setReal([vr["omega_meas"], vr["M_load"]], [3.5, 1.0])
 print(json.dumps({"per_step": per_step, "mixed_get": mixed, "after_set": calls.get("set_real", 0)}))
 """
 
 
-def test_only_do_step_crosses_into_python_per_step(cam_fmu_path, tmp_path):
-    shutil.copyfile(cam_fmu_path, tmp_path / "cam.fmu")
-    r = run_python(PER_STEP_CALLS, str(tmp_path / "cam.fmu"), cwd=tmp_path)
+def test_only_do_step_crosses_into_python_per_step(pi_speed_fmu_path, tmp_path):
+    shutil.copyfile(pi_speed_fmu_path, tmp_path / "pi_speed.fmu")
+    r = run_python(PER_STEP_CALLS, str(tmp_path / "pi_speed.fmu"), cwd=tmp_path)
     assert r["per_step"] == {"do_step": 200}, r  # set of inputs, get of outputs and inputs: in C
     assert r["mixed_get"] == 1 and r["after_set"] == 0, r
 
@@ -60,9 +61,9 @@ from fmpy.fmi1 import FMICallException
 md = read_model_description(sys.argv[1])
 vr = {v.name: v.valueReference for v in md.modelVariables}
 outs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
-inputs = ["u", "omega_ref", "omega_dot_ref"]
+inputs = ["omega_meas", "omega_setpoint", "M_load", "J_load"]
 start = {v.name: float(v.start) for v in md.modelVariables if v.name in inputs}
-fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[1]), modelIdentifier="cam", instanceName="a")
+fmu = FMU2Slave(guid=md.guid, unzipDirectory=extract(sys.argv[1]), modelIdentifier="pi_speed", instanceName="a")
 fmu.instantiate(callbacks=None)
 package = dict(x.split("=", 1) for x in open(str(fmu.unzipDirectory) + "/resources/native.txt").read().split())["package"]
 bridge = sys.modules[package + "._fmi_bridge"]
@@ -81,14 +82,11 @@ for n in range(int(sys.argv[3])):
             fmu.setReal([vr[name]], [value]); model[name] = value
         elif op == "set_two":
             a, b = rng.uniform(0.0, 10.0), rng.uniform(-5.0, 5.0)
-            fmu.setReal([vr["u"], vr["omega_ref"]], [a, b]); model["u"], model["omega_ref"] = a, b
+            fmu.setReal([vr["omega_meas"], vr["M_load"]], [a, b]); model["omega_meas"], model["M_load"] = a, b
         elif op == "set_bad":
-            fmu.setReal([vr["u"]], [rng.choice([1e9, -1e9, math.nan, math.inf])])
+            fmu.setReal([vr["omega_meas"]], [rng.choice([math.nan, math.inf, -math.inf])])
             raise AssertionError("a bad input was accepted")
         elif op == "step":
-            u = model["u"]
-            if abs(u) > 12.0:
-                fmu.setReal([vr["u"]], [3.5]); model["u"] = 3.5
             fmu.doStep(t, 1e-3); t += 1e-3
         elif op == "save":
             saved, saved_model = fmu.getFMUstate(), dict(model)
@@ -109,7 +107,7 @@ for n in range(int(sys.argv[3])):
     fast = fmu.getReal(outs + [vr[x] for x in inputs])
     slave = instance.slave
     exchange_dirty = instance.exchange.head[bridge._DIRTY]
-    held = slave.get_real(outs) if slave._sim is not None else None
+    held = slave.get_real(outs) if slave._initialized else None
     if held is not None:
         assert fast[:len(outs)] == held, (n, op)
     assert fast[len(outs):] == [model[x] for x in inputs], (n, op, fast[len(outs):], model)
@@ -122,18 +120,18 @@ print(json.dumps({"checks": checks, "refused": refused, "kinds": kinds}))
 
 
 @pytest.mark.parametrize("seed", [1, 2])
-def test_fast_answers_agree_with_the_slave_through_random_calls(cam_fmu_path, tmp_path, seed):
+def test_fast_answers_agree_with_the_slave_through_random_calls(pi_speed_fmu_path, tmp_path, seed):
     """A random sequence of sets (good and bad), steps, state saves and restores, resets: after each call,
     fmi2GetReal answered in C equals the slave's own getters (outputs) and the inputs last accepted."""
-    shutil.copyfile(cam_fmu_path, tmp_path / "cam.fmu")
-    r = run_python(AGREES_WITH_SLAVE, str(tmp_path / "cam.fmu"), str(seed), "400", cwd=tmp_path)
+    shutil.copyfile(pi_speed_fmu_path, tmp_path / "pi_speed.fmu")
+    r = run_python(AGREES_WITH_SLAVE, str(tmp_path / "pi_speed.fmu"), str(seed), "400", cwd=tmp_path)
     assert r["checks"] == 400 and r["refused"] >= r["kinds"]["set_bad"] > 10, r
     assert min(r["kinds"].get(k, 0) for k in ("restore", "reset", "step", "set_two")) > 10, r
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(cam_fmu_path, tmp_path_factory):
-    return extract(cam_fmu_path, tmp_path_factory.mktemp("exchange_fmu"))
+def fmu_dir(pi_speed_fmu_path, tmp_path_factory):
+    return extract(pi_speed_fmu_path, tmp_path_factory.mktemp("exchange_fmu"))
 
 
 def test_native_host_bad_input_still_named_and_state_restores_inputs(fmu_dir, tmp_path):
@@ -141,21 +139,22 @@ def test_native_host_bad_input_still_named_and_state_restores_inputs(fmu_dir, tm
     Python; a restored state brings back the inputs and outputs it was taken with."""
     host = compile_host(tmp_path / "host")
     vr = value_references(fmu_dir)
-    watch = f"{vr['theta']},{vr['omega']},{vr['u']},{vr['omega_ref']}"
-    r = run_host(host, fmu_dir, "inst", "init", "setr", str(vr["u"]), "5", "setr", str(vr["omega_ref"]), "2",
+    watch = f"{vr['integral']},{vr['error']},{vr['omega_meas']},{vr['M_load']}"
+    r = run_host(host, fmu_dir, "inst", "init", "setr", str(vr["omega_meas"]), "5", "setr", str(vr["M_load"]), "2",
                  "step", "20", "0.001", "getr", watch, "save",
-                 "setr", str(vr["u"]), "1", "step", "20", "0.001", "getr", watch,
+                 "setr", str(vr["omega_meas"]), "1", "step", "20", "0.001", "getr", watch,
                  "restore", "getr", watch,
-                 "setr", str(vr["u"]), "1e9", "getr", watch, "reset", "getr", watch, env=EMPTY_ENV)
+                 "setr", str(vr["omega_meas"]), "nan", "getr", watch, "reset", "getr", watch, env=EMPTY_ENV)
     assert r["rc"] == 0 and r["lines"][-1] == {"exit": 0}, r
     assert [x["status"] for x in r["cmds"] if x["cmd"] == "setr"] == [0, 0, 0, 3]
     gets = [x["values"] for x in r["cmds"] if x["cmd"] == "getr"]
     assert gets[0][2:] == [5.0, 2.0] and gets[1][2:] == [1.0, 2.0]
-    assert gets[1][0] != gets[0][0]                       # it moved on with u = 1
+    assert gets[1][0] != gets[0][0]                       # the integrator moved on with omega_meas = 1
     assert gets[2] == gets[0]                             # restored: outputs and inputs as saved
     assert gets[3] == gets[2]                             # the refused value changed nothing
-    assert gets[4][2:] == [3.5, 1.0] and gets[4][0] == 0.0  # reset: start values, outputs from theta0 = 0
-    assert any(x["log"] == 3 and "'u'" in x["msg"] and "allowed range" in x["msg"] for x in r["logs"]), r["logs"]
+    assert gets[4][2:] == [0.0, 0.0] and gets[4][0] == 0.0  # reset: start inputs, an empty integrator
+    assert any(x["log"] == 3 and "'omega_meas'" in x["msg"] and "not finite" in x["msg"] for x in r["logs"]), \
+        r["logs"]
 
 
 def test_the_header_layout_is_the_same_on_both_sides():

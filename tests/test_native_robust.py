@@ -1,8 +1,8 @@
-"""The FMUs' own linux64 binary with hosts that are careless or strict.
+"""The FMUs' own linux64 binaries with hosts that are careless or strict.
 
 - No shipped FMU (cam.fmu, pi_speed.fmu) logs a warning when it starts: fmpy with debug logging and
-  the C host (tests/native_host) both see none. pi_speed.fmu's slave has no exchange layout, and the
-  bridge's None must not be read as a bytearray.
+  the C host (tests/native_host) both see none. (pi_speed.fmu logs its start with debug logging on;
+  cam.fmu logs only what goes wrong.)
 - A call the wrapper refuses (a NULL or bogus component, an unknown value reference) still writes safe
   values (0, false, "") into every output array: a host that ignores the status reads no garbage.
 """
@@ -29,39 +29,38 @@ sys.stdout.flush(); os._exit(0)  # pythonfmu 0.7.0 may abort at interpreter tear
 
 
 @pytest.fixture(scope="module")
-def pi_speed_fmu(tmp_path_factory) -> Path:
-    dest = tmp_path_factory.mktemp("pi_speed") / "pi_speed.fmu"
-    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--model", "pi_speed", "--dest", str(dest)],
-                          capture_output=True, text=True, cwd=dest.parent, timeout=900)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return dest
-
-
-@pytest.fixture(scope="module")
 def host(tmp_path_factory) -> Path:
     return compile_host(tmp_path_factory.mktemp("robust_host") / "host")
 
 
 @pytest.fixture(params=["cam", "pi_speed"])
-def shipped(request, cam_fmu_path, pi_speed_fmu) -> Path:
-    return cam_fmu_path if request.param == "cam" else pi_speed_fmu
+def shipped(request, cam_fmu_path, pi_speed_fmu_path) -> Path:
+    return cam_fmu_path if request.param == "cam" else pi_speed_fmu_path
+
+
+def _guid(fmu_dir: Path) -> str:
+    import xml.etree.ElementTree as ET
+
+    return ET.parse(fmu_dir / "modelDescription.xml").getroot().get("guid")
 
 
 def test_no_warning_at_start_in_fmpy(shipped, tmp_path):
     logs = run_python(FMPY_START, str(shipped), cwd=tmp_path)
-    assert logs, "debug logging on: the FMU logs its start"
+    if shipped.name == "pi_speed.fmu":
+        assert logs, "debug logging on: the FMU logs its start"
     assert [x for x in logs if x[0] >= 1] == [], f"{shipped.name} warns or fails at start"
 
 
 def test_no_warning_at_start_in_the_c_host(shipped, host, tmp_path):
-    r = run_host(host, extract(shipped, tmp_path / "fmu"), "inst", "init", "step", "10", "0.001", "free")
+    fmu_dir = extract(shipped, tmp_path / "fmu")
+    r = run_host(host, fmu_dir, "guid", _guid(fmu_dir), "inst", "init", "step", "10", "0.001", "free")
     assert r["rc"] == 0 and r["lines"][-1] == {"exit": 0}, r
     assert [x["status"] for x in r["cmds"] if "status" in x] == [0, 0, 0]
     assert r["logs"] == [] and r["stderr"] == "", f"{shipped.name}: {r['logs']} {r['stderr']}"
 
 
-def test_null_and_bogus_components_get_safe_outputs(host, cam_fmu_path, tmp_path):
-    r = run_host(host, extract(cam_fmu_path, tmp_path / "fmu"), "nullcalls")
+def test_null_and_bogus_components_get_safe_outputs(host, shipped, tmp_path):
+    r = run_host(host, extract(shipped, tmp_path / "fmu"), "nullcalls")
     assert r["rc"] == 0 and r["lines"][-1] == {"exit": 0}, r
     calls = [x for x in r["cmds"] if x["cmd"] == "nullcalls"]
     assert [x["component"] for x in calls] == ["null", "bogus"]
@@ -72,15 +71,17 @@ def test_null_and_bogus_components_get_safe_outputs(host, cam_fmu_path, tmp_path
         assert x["status"] == 0 and x["real_status"] == 0 and x["integer_status"] == 0, x
         assert x["boolean_status"] == 0, x
         assert x["directional"] == [0, 0] and x["output_derivatives"] == [0, 0], x
-    assert r["stderr"].count("invalid fmi2Component") == 22  # each refusal says why, on stderr
+    if shipped.name == "pi_speed.fmu":  # the Python-hosting binary says why on stderr (it has no logger then)
+        assert r["stderr"].count("invalid fmi2Component") == 22
 
 
-def test_unknown_value_reference_leaves_safe_outputs(host, cam_fmu_path, tmp_path):
-    fmu_dir = extract(cam_fmu_path, tmp_path / "fmu")
+def test_unknown_value_reference_leaves_safe_outputs(host, shipped, tmp_path):
+    fmu_dir = extract(shipped, tmp_path / "fmu")
     vr = value_references(fmu_dir)
     unknown = str(max(vr.values()) + 1000)
-    r = run_host(host, fmu_dir, "inst", "init", "getr", f"{vr['omega']},{unknown}", "gets",
-                 f"{vr['rise_law']},{unknown}", "free")
+    real, string = ("omega", "rise_law") if shipped.name == "cam.fmu" else ("u", "external_setpoint")
+    r = run_host(host, fmu_dir, "guid", _guid(fmu_dir), "inst", "init", "getr", f"{vr[real]},{unknown}", "gets",
+                 f"{vr[string]},{unknown}", "free")
     getr = next(x for x in r["cmds"] if x["cmd"] == "getr")
     gets = next(x for x in r["cmds"] if x["cmd"] == "gets")
     assert getr["status"] == 3 and getr["values"] == [0, 0], getr

@@ -44,14 +44,15 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, model: str = "cam", verbose: bool = False) -> Path:
-    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it."""
+def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Path | None = None) -> Path:
+    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it.
+    ``package_dir``: a Python FMU's bundle from another copy of the package (developers' tests)."""
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
     try:
         if model == "cam":
             return engine_fmu.build(dest)
-        return python_fmu.build(dest, model, verbose=verbose)
+        return python_fmu.build(dest, model, package_dir=package_dir, verbose=verbose)
     except (engine_fmu.FmuBuildError, python_fmu.BuildError) as exc:
         raise BuildError(str(exc)) from None
 
@@ -74,12 +75,13 @@ def main(argv: List[str] | None = None) -> int:
                              "(else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
     parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules of a Python FMU")
+    parser.add_argument("--package-dir", type=Path, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     try:
         if args.dest is not None:
-            print(build(args.dest, args.model, args.verbose))
+            print(build(args.dest, args.model, args.verbose, args.package_dir))
             return 0
-        built = {name: build(default_model_path(name), name, args.verbose) for name in MODELS}
+        built = {name: build(default_model_path(name), name, args.verbose, args.package_dir) for name in MODELS}
         for path in built.values():
             print(path)
         print(build_ssp(default_model_path(SSP_NAME, ".ssp"), built["cam"], built["pi_speed"]))

@@ -9,13 +9,17 @@ direct feedthrough).
 
 The module name ``pi_speed_fmu_slave`` is unique (pythonfmu imports the script
 as a top-level module; module names are process-global), and so is the class
-name. Imports at run time: pythonfmu and ``cam_fmu.control.pi`` (math only).
+name. Imports at run time: pythonfmu and ``cam_fmu.control.pi`` (math only). The project's
+Python-hosting binary answers fmi2GetReal of the outputs and inputs and fmi2SetReal of
+finite inputs in C (``exchange_layout``, docs/fmu.md); only fmi2DoStep enters Python per step.
 Errors are reported as in camdrive_fmu_slave: logged, printed to stderr, raised
 (pythonfmu returns fmi2Fatal).
 """
 from __future__ import annotations
 
+import math
 import sys
+from array import array
 from typing import Any, Dict
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Real, String
@@ -65,7 +69,10 @@ class PiSpeedSlave(Fmi2Slave):
 
     def _input_setter(self, name: str):
         def setter(value: Any) -> None:
-            self._inputs[name] = float(value)
+            number = float(value)
+            if not math.isfinite(number):  # a NaN in would be a NaN command out, with status OK
+                self._fail(f"input {name!r} = {number!r} [{_pi.UNITS[name]}] is not finite: allowed any finite value")
+            self._inputs[name] = number
         return setter
 
     def _output_getter(self, name: str):
@@ -114,6 +121,32 @@ class PiSpeedSlave(Fmi2Slave):
         except ParameterError as exc:
             self._fail(f"at t = {current_time!r} s: {exc}")
         return True  # a falsy return would become a silent fmi2Discard
+
+    # ----------------------------------------------------------------- the exchange (the Python-hosting binary)
+    def exchange_layout(self) -> tuple:
+        """(output value references, input value references, input ranges): the variables whose
+        fmi2GetReal (and fmi2SetReal within range, for inputs) the binary answers in C, without Python.
+        The ranges are the finite doubles: a NaN or an infinity goes to Python, for its message."""
+        by_name = {var.name: vr for vr, var in self.vars.items()}
+        finite = (-1.7976931348623157e308, 1.7976931348623157e308)
+        return (tuple(by_name[name] for name, _u, _d in _pi.OUTPUTS),
+                tuple(by_name[name] for name, _u, _s, _d in _pi.INPUTS),
+                tuple(finite for _ in _pi.INPUTS))
+
+    def published_outputs(self) -> array | None:
+        """The outputs as an FMI get would return them, or None before they are calculated."""
+        if not self._initialized:
+            return None
+        values = self._ctrl.outputs()
+        return array("d", [values[name] for name, _u, _d in _pi.OUTPUTS])
+
+    def input_values(self) -> array:
+        """The inputs in INPUTS order (C doubles)."""
+        return array("d", [self._inputs[name] for name, _u, _s, _d in _pi.INPUTS])
+
+    def take_inputs(self, values: list) -> None:
+        """Inputs in INPUTS order, already checked against their ranges by the binary."""
+        self._inputs.update(zip((name for name, _u, _s, _d in _pi.INPUTS), values))
 
     def _get_fmu_state(self) -> Dict[str, Any]:
         return {"params": dict(self._params), "inputs": dict(self._inputs), "initialized": self._initialized,

@@ -164,7 +164,7 @@ int main(int argc, char **argv)
                 statuses[6] = fmi2GetIntegerStatus(x, 0, &is);
                 statuses[7] = fmi2GetBooleanStatus(x, 3, &bs);
                 statuses[8] = fmi2GetStringStatus(x, 0, &ss);
-                statuses[9] = fmi2GetDirectionalDerivative(x, vrs, 1, z, 2, dv, dz);
+                statuses[9] = fmi2GetDirectionalDerivative(x, vrs, 2, z, 1, dv, dz);   /* 2 unknowns: dz[0..1] */
                 statuses[10] = fmi2GetRealOutputDerivatives(x, z, 2, order, od);
                 printf("{\"cmd\": \"nullcalls\", \"component\": \"%s\", \"statuses\": [", which ? "bogus" : "null");
                 for (int i = 0; i < 11; i++) printf(i ? ", %d" : "%d", statuses[i]);

@@ -1385,8 +1385,8 @@ EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component comp, const fmi2Val
                                                const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
                                                fmi2Real dz[])
 {
-    (void)u; (void)nu; (void)z; (void)dv;
-    zero_out(dz, nz, sizeof *dz);
+    (void)u; (void)z; (void)nz; (void)dv;
+    zero_out(dz, nu, sizeof *dz);   /* dvUnknown holds nUnknown values */
     ENTER("fmi2GetDirectionalDerivative", 1)
     logf_(c, fmi2Error, "logStatusError", "fmi2GetDirectionalDerivative is not supported");
     LEAVE(fmi2Error);
