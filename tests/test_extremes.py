@@ -31,7 +31,7 @@ U_BREAK = R * M_F / C_M  # V: at theta = 0, s' = 0: only the shaft friction hold
 # name: start values, input u [V] (number or (times, values)), stop time [s], communication step [s]
 CASES: dict[str, dict] = {
     "L_1e-6_etdrk4_10ms": dict(start={"L": 1e-6, "solver": "etdrk4"}, u=3.5, stop=2.0, step=1e-2),
-    "L_1e-6_rk45_refuses": dict(start={"L": 1e-6}, u=3.5, stop=0.1, step=1e-2, fails=True),
+    "L_1e-6_rk45_10ms": dict(start={"L": 1e-6}, u=3.5, stop=2.0, step=1e-2),
     "L_0.1": dict(start={"L": 0.1}, u=3.5, stop=2.0, step=1e-3),
     # explicit solvers asked for steps 190x beyond their stability limit (R/L = 1.9e4 1/s)
     "rk4_beyond_stability": dict(start={"L": 1e-3, "solver": "rk4", "h_max": 1e-2}, u=3.5, stop=0.5, step=1e-2),
@@ -200,19 +200,14 @@ def test_u_100V_many_revolutions_per_step(runs):
     assert np.max(np.diff(run["theta"])) > 4 * 2 * PI
 
 
-def test_rk45_refuses_a_stiff_pole_it_cannot_afford(runs):
-    """L = 1e-6 H: R/L = 1.9e7 1/s caps rk45's step near 1.7e-7 s, ~6e4 steps per 10 ms step.
-
-    With the default max_steps (1e4 per communication step) it must say so, and
-    name the solver that handles it, instead of grinding (it took 576 s for 2 s
-    of simulated time with max_steps 1e5).
-    """
-    run = runs["L_1e-6_rk45_refuses"]
-    # cam.fmu's own binary: the refused step is fmi2Discard ("not at this step size"); fmpy then ends
-    # the run early at the last successful time without raising (an fmi2Error would raise status 3)
-    assert (run["error"] is None and run["time"][-1] < 0.1) or "status 3" in (run["error"] or ""), run["error"]
-    text = " ".join(run["messages"])
-    assert "max_steps" in text and "etdrk4" in text
+def test_rk45_takes_a_stiff_pole_at_10_ms_steps(runs):
+    """L = 1e-6 H: R/L = 1.9e7 1/s held rk45's step near 1.7e-7 s, ~6e4 steps per 10 ms step, and it was
+    refused. Now rk45 takes steps longer than 3 L/R as the exponential pair (docs/model.md section 6.4):
+    it completes, and agrees with etdrk4, exact on the pole, at every communication point (etdrk4's own
+    promise, 1e-2 relative, is the looser; measured against each other: below 1e-5 rad)."""
+    run, exact = runs["L_1e-6_rk45_10ms"], runs["L_1e-6_etdrk4_10ms"]
+    _completed(run, "L_1e-6_rk45_10ms")
+    assert np.allclose(run["theta"], exact["theta"], rtol=1e-4, atol=1e-6)
 
 
 def test_at_rest_nothing_moves(runs):

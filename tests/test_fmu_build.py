@@ -81,18 +81,26 @@ def test_model_description_complete(md_root):
     assert by_name["omega"].find("Real").get("unit") == "rad/s"
 
 
-def test_bundle_holds_only_numpy_only_modules(cam_fmu_path):
+def test_cam_fmu_carries_no_python(cam_fmu_path):
+    """cam.fmu is the C engine: binaries and their C sources, no Python module, no pythonfmu, no python.txt."""
     with zipfile.ZipFile(cam_fmu_path) as z:
         names = z.namelist()
+    assert "binaries/linux64/cam.so" in names and "sources/cam_model.h" in names
+    assert not [n for n in names if n.endswith((".py", ".pyc")) or "python" in n.lower()], names
+
+
+def test_pi_speed_bundle_holds_only_numpy_only_modules(pi_speed_fmu_path):
+    with zipfile.ZipFile(pi_speed_fmu_path) as z:
+        names = z.namelist()
         private = dict(line.split("=", 1) for line in z.read("resources/native.txt").decode().split())
-        pkg, slave = private["package"], private["slave_module"]  # cam_fmu_<hash>, camdrive_fmu_slave_<hash>
+        pkg, slave = private["package"], private["slave_module"]  # cam_fmu_<hash>, pi_speed_fmu_slave_<hash>
         bundled = {n for n in names if n.startswith(f"resources/{pkg}/")}
         sources = {n: z.read(n).decode("utf-8") for n in bundled if n.endswith(".py")}
-    assert pkg.startswith("cam_fmu_") and slave.startswith("camdrive_fmu_slave_")
+    assert pkg.startswith("cam_fmu_") and slave.startswith("pi_speed_fmu_slave_")
     assert f"resources/{slave}.py" in names
-    assert {f"resources/{pkg}/physics/parameters.py", f"resources/{pkg}/fmu/engine.py"} <= bundled
+    assert {f"resources/{pkg}/control/pi.py", f"resources/{pkg}/physics/parameters.py"} <= bundled
     for unwanted in ("reference/integrate.py", "cli/__init__.py", "plots/curve.py", "fmu/model_description.py",
-                     "fmu/build.py", "tools/ecos_host.py", "tools/host_env.py"):
+                     "fmu/build.py", "engine/simulator.py", "tools/ecos_host.py", "tools/host_env.py"):
         assert f"resources/{pkg}/{unwanted}" not in bundled
     for name, text in sources.items():
         for heavy in ("scipy", "matplotlib"):
@@ -110,48 +118,51 @@ except ImportError:
 from fmpy import simulate_fmu
 import numpy as np
 path_before, modules_before = list(sys.path), set(sys.modules)
-res = simulate_fmu("cam.fmu", output_interval=1e-3)
+res = simulate_fmu(sys.argv[2], output_interval=1e-3)
 added = sorted(m for m in set(sys.modules) - modules_before if m.startswith(("cam", "pythonfmu")))
 print(json.dumps({
     "importable_before": importable,
     "stop": float(res["time"][-1]),
     "finite": bool(all(np.all(np.isfinite(res[n])) for n in res.dtype.names)),
-    "omega_end": float(res["omega"][-1]),
+    "end": float(res[sys.argv[3]][-1]),
     "added_modules": added, "path_unchanged": sys.path == path_before,
     "scipy_loaded": any(m.split(".")[0] == "scipy" for m in sys.modules),
 }))
 """
 
 
-def test_fmu_runs_where_cam_fmu_is_not_importable(cam_fmu_path, tmp_path):
-    shutil.copyfile(cam_fmu_path, tmp_path / "cam.fmu")
+@pytest.mark.parametrize("model, output", [("cam", "omega"), ("pi_speed", "u")])
+def test_fmu_runs_where_cam_fmu_is_not_importable(model, output, cam_fmu_path, pi_speed_fmu_path, tmp_path):
+    fmu = f"{model}.fmu"
+    shutil.copyfile(cam_fmu_path if model == "cam" else pi_speed_fmu_path, tmp_path / fmu)
     site_dirs = [p for p in {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}]
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
     # -I: no PYTHONPATH, no cwd/script dir, no user site; -S: no site-packages .pth (the editable install)
-    proc = subprocess.run([sys.executable, "-I", "-S", "-c", ISOLATED_RUN, json.dumps(site_dirs)],
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", ISOLATED_RUN, json.dumps(site_dirs), fmu, output],
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     r = json.loads(proc.stdout.strip().splitlines()[-1])
     assert r["importable_before"] is None, f"cam_fmu importable in the isolated process: {r['importable_before']}"
     assert r["stop"] == pytest.approx(2.0, abs=1e-12), "the run stopped before its stop time"
-    assert r["finite"] and r["omega_end"] > 0.5
-    # the FMU ran its bundled copy under private names and took them away after fmi2FreeInstance
+    assert r["finite"] and abs(r["end"]) > 0.5
+    # a Python FMU ran its bundled copy under private names and took them away after fmi2FreeInstance
     assert r["added_modules"] == [] and r["path_unchanged"], r
     assert not r["scipy_loaded"]
 
 
 def test_build_refuses_scipy_in_the_bundle(tmp_path):
-    """The import closure check is live: a bundled module importing scipy fails the build."""
+    """The import closure check of a Python FMU is live: a bundled module importing scipy fails the build."""
     pkg = tmp_path / "cam_fmu"
-    shutil.copytree(ROOT / "cam_fmu", pkg, ignore=shutil.ignore_patterns("__pycache__"))
-    sim = pkg / "fmu" / "engine.py"
-    sim.write_text(sim.read_text(encoding="utf-8") + "\nimport scipy.integrate  # noqa\n", encoding="utf-8")
-    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--package-dir", str(pkg),
-                           "--dest", str(tmp_path / "out" / "cam.fmu")], capture_output=True, text=True,
-                          cwd=tmp_path, timeout=300)
+    shutil.copytree(ROOT / "cam_fmu", pkg, ignore=shutil.ignore_patterns("__pycache__", "_lib"))
+    controller = pkg / "control" / "pi.py"
+    controller.write_text(controller.read_text(encoding="utf-8") + "\nimport scipy.integrate  # noqa\n",
+                          encoding="utf-8")
+    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--model", "pi_speed", "--package-dir",
+                           str(pkg), "--dest", str(tmp_path / "out" / "pi_speed.fmu")], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=300)
     assert proc.returncode != 0
     assert "scipy" in proc.stderr
-    assert not (tmp_path / "out" / "cam.fmu").exists()
+    assert not (tmp_path / "out" / "pi_speed.fmu").exists()
 
 
 def test_docs_variable_table_is_the_generated_one():
