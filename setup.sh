@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 # Debian packages, installed only when missing (apt is not touched otherwise):
-# - gcc:      compiles cam.fmu's own linux64 binary (cam_fmu/fmu/native/fmi2_python.c) and the test host;
+# - gcc:      compiles the C engine (cam.fmu's binary, the library Python calls), pi_speed.fmu's
+#             Python-hosting binary (cam_fmu/fmu/native/fmi2_python.c) and the test hosts;
 # - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
 # - libtbb12: needed by the FMU host `ecos`;
 # - gcc-mingw-w64-x86-64: cross-compiles cam.fmu's win64 binary (cam_fmu/fmu/engine_fmu.py);
@@ -23,7 +24,5 @@ fi
 
 # the test environment pinned (constraints/test.txt; refresh: bash constraints/refresh.sh), the package keeps ranges
 python -m pip install -c constraints/test.txt -e ".[test]"
-# the drive kernel's extension beside its .py (Cython + gcc; skipped while current), so the tests use it
-python -m cam_fmu.kernel.compile
 # the C engine's shared library (gcc; skipped while current: its name hashes its sources)
 python -m cam_fmu.engine.build
