@@ -110,7 +110,7 @@ int main(int argc, char **argv)
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component c = NULL;
     fmi2FMUstate saved = NULL;
-    double time = 0.0;
+    double time = 0.0, saved_time = 0.0;   /* s: the host's clock, and the time of the saved state */
     if (argc < 3) {
         fprintf(stderr, "usage: host <binary.so> <resources-dir> COMMAND...\n");
         return 2;
@@ -267,8 +267,10 @@ int main(int argc, char **argv)
             continue;
         } else if (!strcmp(cmd, "save")) {
             s = fmi2GetFMUstate(c, &saved);
+            saved_time = time;
         } else if (!strcmp(cmd, "restore")) {
             s = fmi2SetFMUstate(c, saved);
+            if (s == fmi2OK) time = saved_time;   /* the clock goes back with the state */
         } else if (!strcmp(cmd, "serial")) {
             size_t size = 0;
             fmi2Byte *buf;
