@@ -98,8 +98,10 @@ def test_scene_table_effects_pareto_and_goal(quick):
     runs = [r for r in quick["rows"] if r["kind"] == "fmu"]
     least = min(_num(r, "theta_err") for r in runs)
     assert any(r["pareto"] == "True" for r in runs if _num(r, "theta_err") == least)
-    assert re.search(r"^# goal \(fig6, defaults, 1 ms, theta\+omega recorded\): compiled path .* the C floor",
+    assert re.search(r"^# fig6 through simulate_fmu \(defaults, 1 ms, theta\+omega recorded\): cam.fmu .* the C floor",
                      quick["stdout"], flags=re.M)
+    for target in ("C host", "fmpy FMU2Slave loop", "in process"):
+        assert re.search(rf"^# target {target}: .*: (met|NOT met)$", quick["stdout"], flags=re.M), target
 
 
 def test_every_run_reached_stop_time(quick):

@@ -267,25 +267,27 @@ class DriveSimulator:
                                         "contact": mode.contact, "s_free": mode.s_free, "side": mode.side}})
         return out
 
-    def run(self, table: Sequence[Sequence[float]]) -> list[array]:
-        """Many communication steps in one engine call: rows (t, h, u, omega_ref, omega_dot_ref);
-        returns the outputs after each step (OUTPUTS order). On an error the exception names it;
+    def run(self, table: Any) -> Any:
+        """Many communication steps in one engine call: ``table`` has one row (t, h, u, omega_ref,
+        omega_dot_ref) per step (a sequence of rows or an (n, 5) array); returns the outputs after each
+        step as an (n, len(OUTPUTS)) numpy array (OUTPUTS order). On an error the exception names it;
         the steps before it are done (their outputs are lost with the exception)."""
-        n = len(table)
-        flat = array("d", (float(v) for row in table for v in row))
-        if len(flat) != 5 * n:
+        import numpy as np
+
+        rows = np.ascontiguousarray(table, dtype=np.float64)
+        if rows.ndim != 2 or rows.shape[1] != 5:
             raise ValueError("every row of the input table has 5 entries: t, h, u, omega_ref, omega_dot_ref")
-        out = array("d", bytes(8 * N_OUTPUTS * n))
+        n = rows.shape[0]
+        out = np.empty((n, N_OUTPUTS), dtype=np.float64)
         done = ctypes.c_long(0)
-        status = self._lib.cam_drive_run(self._drive, n, (ctypes.c_double * len(flat)).from_buffer(flat),
-                                         (ctypes.c_double * len(out)).from_buffer(out), ctypes.byref(done),
-                                         ctypes.byref(self._err))
+        status = self._lib.cam_drive_run(self._drive, n, rows.ctypes.data_as(_D), out.ctypes.data_as(_D),
+                                         ctypes.byref(done), ctypes.byref(self._err))
         if status:
             raise_for(self._err)
-        return [out[k * N_OUTPUTS:(k + 1) * N_OUTPUTS] for k in range(n)]
+        return out
 
 
-def run_scene(params: Mapping[str, Any] | None, table: Sequence[Sequence[float]]) -> list[array]:
+def run_scene(params: Mapping[str, Any] | None, table: Any) -> Any:
     """A whole scene in one engine call: a new drive from params, then the rows (t, h, u, omega_ref,
-    omega_dot_ref) of ``table``; the outputs after each step."""
+    omega_dot_ref) of ``table``; the outputs after each step, an (n, len(OUTPUTS)) numpy array."""
     return DriveSimulator(params).run(table)

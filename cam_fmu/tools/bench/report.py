@@ -142,19 +142,19 @@ def format_pareto(front: list[dict]) -> str:
 
 
 # =========================================================================== per-step tables
-SCENE_HEADER = (f"{'scene':<13}{'record':<13}{'cam':>8}{'pure':>8}{'py_flr':>8}{'c_flr':>8}"
-                f"{'cam/py':>8}{'cam/c':>8}{'pure/py':>8}{'pure/c':>8}   [us/step; ratios]")
+SCENE_HEADER = (f"{'scene':<13}{'record':<13}{'cam':>8}{'py_flr':>8}{'c_flr':>8}"
+                f"{'cam/py':>8}{'cam/c':>8}   [us/step; ratios]")
 
 
 def format_scene_row(row: dict) -> str:
     return (f"{row['scene']:<13}{row['record']:<13}" + "".join(_fmt(row[f"{k}_us"], ".1f", 8) for k in
-                                                               ("cam", "pure", "py_floor", "c_floor"))
-            + "".join(_fmt(row[k], ".2f", 8) for k in ("cam_py_ratio", "cam_c_ratio", "pure_py_ratio", "pure_c_ratio"))
+                                                               ("cam", "py_floor", "c_floor"))
+            + "".join(_fmt(row[k], ".2f", 8) for k in ("cam_py_ratio", "cam_c_ratio"))
             + (f"   error: {row['error']}" if row["error"] else ""))
 
 
 def format_effects(rows: list[dict]) -> str:
-    lines = ["# cost per effect: fig. 6 at the defaults, 1 ms, theta and omega recorded, cam.fmu (compiled path); "
+    lines = ["# cost per effect: fig. 6 at the defaults, 1 ms, theta and omega recorded, cam.fmu; "
              "delta: against the defaults",
              f"{'config':<24}{'change':<24}{'us/step':>9}{'delta':>9}{'/py_flr':>9}{'/c_flr':>9}"]
     for r in rows:
@@ -164,25 +164,18 @@ def format_effects(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def goal_verdict(scene_rows: list[dict], goal_py: float = 1.5, goal_c: float = 2.5) -> str:
-    """The issue's goal on fig. 6 at the defaults, theta and omega recorded: cam.fmu per communication
-    step at most ``goal_py`` x the pythonfmu floor and at most ``goal_c`` x the C floor; both paths."""
+def goal_verdict(scene_rows: list[dict]) -> str:
+    """fig. 6 at the defaults through simulate_fmu, theta and omega recorded: cam.fmu per communication step
+    against both floors (information: the targets are ``targets.verdict``'s, on tight loops)."""
     rows = [r for r in scene_rows if r["scene"] == "paper_fig6" and r["record"] == "theta,omega"]
     if not rows:
-        return "# goal (fig6, defaults, 1 ms, theta+omega recorded): no fig6 row"
+        return "# fig6 through simulate_fmu (defaults, 1 ms, theta+omega recorded): no fig6 row"
     r = rows[0]
-    parts = []
-    for path, key in (("compiled", "cam"), ("pure", "pure")):
-        py, c = r[f"{key}_py_ratio"], r[f"{key}_c_ratio"]
-        if not (math.isfinite(py) and math.isfinite(c)):
-            parts.append(f"{path} path: no measurement")
-            continue
-        ok_py, ok_c = py <= goal_py, c <= goal_c
-        parts.append(f"{path} path {r[key + '_us']:.1f} us/step (best of {r['repeats']} rounds) = {py:.2f}x the pythonfmu floor "
-                     f"({r['py_floor_us']:.1f} us) {'<=' if ok_py else '>'} {goal_py:g}x: {'met' if ok_py else 'NOT met'}, "
-                     f"{c:.2f}x the C floor ({r['c_floor_us']:.1f} us) {'<=' if ok_c else '>'} {goal_c:g}x: "
-                     f"{'met' if ok_c else 'NOT met'}")
-    return "# goal (fig6, defaults, 1 ms, theta+omega recorded): " + "; ".join(parts)
+    if not (math.isfinite(r["cam_py_ratio"]) and math.isfinite(r["cam_c_ratio"])):
+        return "# fig6 through simulate_fmu (defaults, 1 ms, theta+omega recorded): no measurement"
+    return (f"# fig6 through simulate_fmu (defaults, 1 ms, theta+omega recorded): cam.fmu {r['cam_us']:.1f} us/step "
+            f"(best of {r['repeats']} rounds) = {r['cam_py_ratio']:.2f}x the pythonfmu floor ({r['py_floor_us']:.1f} us), "
+            f"{r['cam_c_ratio']:.2f}x the C floor ({r['c_floor_us']:.1f} us)")
 
 
 def plot(rows: list[dict], path: Path) -> None:

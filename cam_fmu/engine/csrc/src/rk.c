@@ -41,29 +41,30 @@ const CamTableau cam_rk4 = {
 /* Explicit Euler: x + h k1. */
 const CamTableau cam_euler = {1, {{0.0}}, {1.0}, {0.0}, 0, {0.0}, 0.0, 0.0};
 
-/* h * sum_j coef[j] k[j] + x for slot i over the nonzero coefficients (see the file's comment). */
-static double increment(const double *coef, int n, double (*k)[CAM_NX], int slot, double x, double h)
+/* The nonzero coefficients of one row: their indices into idx, returning how many. */
+static int nonzero(const double *coef, int n, int idx[CAM_MAX_STAGES + 1])
 {
-    double sum = 0.0;
-    int j, terms = 0, only = -1;
+    int j, count = 0;
     for (j = 0; j < n; j++)
-        if (coef[j] != 0.0) {
-            terms++;
-            only = j;
-        }
-    if (terms == 0)
+        if (coef[j] != 0.0)
+            idx[count++] = j;
+    return count;
+}
+
+/* x + h * sum_j coef[j] k[j][slot] over the nonzero coefficients idx[0..count-1], left to right (a single
+ * one as x + (h coef) k; see the file's comment). */
+static double combine(const double *coef, const int *idx, int count, double (*k)[CAM_NX], int slot, double x,
+                      double h)
+{
+    double sum;
+    int m;
+    if (count == 0)
         return x;
-    if (terms == 1)
-        return x + h * coef[only] * k[only][slot];
-    terms = 0;
-    for (j = 0; j < n; j++) {
-        if (coef[j] == 0.0)
-            continue;
-        if (terms++ == 0)
-            sum = coef[j] * k[j][slot];
-        else
-            sum += coef[j] * k[j][slot];
-    }
+    if (count == 1)
+        return x + h * coef[idx[0]] * k[idx[0]][slot];
+    sum = coef[idx[0]] * k[idx[0]][slot];
+    for (m = 1; m < count; m++)
+        sum += coef[idx[m]] * k[idx[m]][slot];
     return x + h * sum;
 }
 
@@ -72,19 +73,21 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
 {
     const CamTableau *t = method->tableau;
     double arg[CAM_NX];
-    int i, slot, s = t->stages;
+    int i, slot, s = t->stages, idx[CAM_MAX_STAGES + 1], count;
     for (i = 1; i < s; i++) {
+        count = nonzero(t->a[i], i, idx);
         for (slot = 0; slot < CAM_NX; slot++)
-            arg[slot] = increment(t->a[i], i, w->k, slot, x[slot], h);
+            arg[slot] = combine(t->a[i], idx, count, w->k, slot, x[slot], h);
         cam_rhs(m, mode, arg, u, w->k[i]);
     }
+    count = nonzero(t->b, s, idx);
     if (t->b_divisor > 0.0) {   /* x + (h / d) * (b_1 k_1 + ...): the weights' common factor first */
         double scaled = h / t->b_divisor;
         for (slot = 0; slot < CAM_NX; slot++)
-            w->x_new[slot] = x[slot] + scaled * increment(t->b, s, w->k, slot, 0.0, 1.0);   /* 0 + 1 sum: exact */
+            w->x_new[slot] = x[slot] + scaled * combine(t->b, idx, count, w->k, slot, 0.0, 1.0);   /* 0 + 1 sum */
     } else {
         for (slot = 0; slot < CAM_NX; slot++)
-            w->x_new[slot] = increment(t->b, s, w->k, slot, x[slot], h);
+            w->x_new[slot] = combine(t->b, idx, count, w->k, slot, x[slot], h);
     }
     if (t->fsal) {
         cam_rhs(m, mode, w->x_new, u, w->k[s]);
@@ -92,8 +95,9 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
             w->f_new[slot] = w->k[s][slot];
     }
     if (method->adaptive) {   /* the error h * sum e_j k_j, the FSAL stage included */
+        count = nonzero(t->e, s + (t->fsal ? 1 : 0), idx);
         for (slot = 0; slot < CAM_NX; slot++)
-            w->error[slot] = increment(t->e, s + (t->fsal ? 1 : 0), w->k, slot, 0.0, h);
+            w->error[slot] = combine(t->e, idx, count, w->k, slot, 0.0, h);
     }
 }
 
