@@ -13,15 +13,15 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 # --------------------------------------------------------------------------- cam.fmu
-def _build_fmu(dest: Path) -> Path:
-    """Build cam.fmu with build_fmu.py in a subprocess: the command users run, from this checkout."""
-    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--dest", str(dest)]
-    package_dir = os.environ.get("CAM_FMU_BUILD_PACKAGE_DIR")  # developers only: build from another tree
+def _build_fmu(dest: Path, model: str = "cam") -> Path:
+    """Build an FMU with build_fmu.py in a subprocess: the command users run, from this checkout."""
+    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", model, "--dest", str(dest)]
+    package_dir = os.environ.get("CAM_FMU_BUILD_PACKAGE_DIR")  # developers only: a Python FMU from another tree
     if package_dir:
         cmd += ["--package-dir", package_dir]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
     if proc.returncode != 0 or not dest.is_file():
-        pytest.fail(f"build_fmu.py failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+        pytest.fail(f"build_fmu.py --model {model} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
     return dest
 
 
@@ -41,12 +41,7 @@ def cam_fmu_path(tmp_path_factory) -> Path:
 def pi_speed_fmu_path(tmp_path_factory) -> Path:
     """pi_speed.fmu built once per test session (build_fmu.py --model pi_speed): the Python FMU, with the
     project's Python-hosting linux64 binary. Load it only in subprocesses, as a pythonfmu FMU."""
-    dest = tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu"
-    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", "pi_speed", "--dest", str(dest)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
-    if proc.returncode != 0 or not dest.is_file():
-        pytest.fail(f"build_fmu.py --model pi_speed failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
-    return dest
+    return _build_fmu(tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu", "pi_speed")
 
 
 @pytest.fixture(scope="session")

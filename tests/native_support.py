@@ -122,3 +122,28 @@ def run_python(code: str, *args: str, cwd: Optional[Path] = None, env: Optional[
             except json.JSONDecodeError:
                 continue  # a host's own log line
     raise AssertionError("no JSON result\n" + proc.stdout[-3000:] + proc.stderr[-3000:])
+
+
+def libcosim_script(names: Sequence[str], u: Optional[float] = None) -> str:
+    """Python code that runs the FMU ``sys.argv[1]`` in libcosim (libcosimpy: a local slave, 1 ms steps to
+    0.2 s, a last-value observer) and prints ``RESULT`` and the last values of ``names`` as JSON; ``u``: the
+    input's start value, if given."""
+    start = f'ex.real_initial_value(idx, vr["u"], {float(u)!r})\n' if u is not None else ""
+    return (
+        "import json, sys\n"
+        "from libcosimpy.CosimExecution import CosimExecution\n"
+        "from libcosimpy.CosimSlave import CosimLocalSlave\n"
+        "from libcosimpy.CosimObserver import CosimObserver\n"
+        "ex = CosimExecution.from_step_size(step_size=int(1e6))\n"
+        "obs = CosimObserver.create_last_value()\n"
+        "ex.add_observer(obs)\n"
+        "idx = ex.add_local_slave(CosimLocalSlave(fmu_path=sys.argv[1], instance_name='cam'))\n"
+        "vr = {v.name.decode() if isinstance(v.name, bytes) else v.name: v.reference for v in ex.slave_variables(idx)}\n"
+        + start +
+        "ex.simulate_until(target_time=int(0.2e9))\n"
+        f"print('RESULT ' + json.dumps(obs.last_real_values(idx, [vr[n] for n in {list(names)!r}])))\n")
+
+
+def result_line(stdout: str):
+    """The JSON after ``RESULT`` in a host's output (its own log lines around it)."""
+    return json.loads(next(line for line in stdout.splitlines() if line.startswith("RESULT "))[7:])

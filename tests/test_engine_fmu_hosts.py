@@ -25,7 +25,8 @@ from pathlib import Path
 
 import pytest
 
-from native_support import EMPTY_ENV, ROOT, compile_host, ecos_path, extract, require, run_host
+from native_support import (EMPTY_ENV, ROOT, compile_host, ecos_path, extract, libcosim_script, require, result_line,
+                            run_host)
 
 VERSIONS = ("3.10", "3.12", "3.13")  # beside the building Python (3.11: the C host's reference runs beside it)
 PYENV = Path.home() / ".pyenv" / "versions"
@@ -165,28 +166,15 @@ def test_ecos_gives_the_same_outputs(place, reference):
         assert float(last[col]) == pytest.approx(expected[k], abs=1e-6), name  # 6 decimals written
 
 
-LIBCOSIM = r"""
-import json, sys
-from libcosimpy.CosimExecution import CosimExecution
-from libcosimpy.CosimSlave import CosimLocalSlave
-from libcosimpy.CosimObserver import CosimObserver
-ex = CosimExecution.from_step_size(step_size=int(1e6))          # nanoseconds: 1 ms
-obs = CosimObserver.create_last_value()
-ex.add_observer(obs)
-idx = ex.add_local_slave(CosimLocalSlave(fmu_path=sys.argv[1], instance_name="cam"))
-vr = {v.name.decode() if isinstance(v.name, bytes) else v.name: v.reference for v in ex.slave_variables(idx)}
-ex.simulate_until(target_time=int(0.2e9))
-print("RESULT " + json.dumps(obs.last_real_values(idx, [vr[n] for n in ("theta", "omega", "s")])))
-"""
 
 
 def test_libcosim_gives_the_same_outputs(place, reference):
     python = _venv("3.12")
     script = place["folder"] / "libcosim_driver.py"
-    script.write_text(LIBCOSIM)
+    script.write_text(libcosim_script(NAMES))
     proc = hidden([str(python), str(script), str(place["fmu"])], place["folder"])
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
-    values = json.loads(next(line for line in proc.stdout.splitlines() if line.startswith("RESULT "))[7:])
+    values = result_line(proc.stdout)
     assert values == pytest.approx(reference["at_0.2"], rel=1e-12, abs=1e-15)
 
 

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 
 from cam_fmu.fmu.native import soak
-from native_support import (EMPTY_ENV, compile_host, ecos_path, extract, require, run_python, valgrind_prefix,
-                            valgrind_summary)
+from native_support import (EMPTY_ENV, compile_host, ecos_path, extract, libcosim_script, require, result_line,
+                            run_python, valgrind_prefix, valgrind_summary)
 
 
 @pytest.fixture(scope="module")
@@ -83,21 +83,6 @@ def test_ecos_empty_environment_matches_fmpy(fmu, tmp_path):
     assert float(last[col["i"]]) == pytest.approx(ref["i"], abs=2e-6)
 
 
-LIBCOSIM = r"""
-import json, sys
-from libcosimpy.CosimExecution import CosimExecution
-from libcosimpy.CosimSlave import CosimLocalSlave
-from libcosimpy.CosimObserver import CosimObserver
-ex = CosimExecution.from_step_size(step_size=int(1e6))          # nanoseconds: 1 ms
-obs = CosimObserver.create_last_value()
-ex.add_observer(obs)
-idx = ex.add_local_slave(CosimLocalSlave(fmu_path=sys.argv[1], instance_name="cam"))
-vr = {v.name.decode() if isinstance(v.name, bytes) else v.name: v.reference for v in ex.slave_variables(idx)}
-ex.real_initial_value(idx, vr["u"], 3.0)
-ex.simulate_until(target_time=int(0.2e9))
-omega, i = obs.last_real_values(idx, [vr["omega"], vr["i"]])
-print(json.dumps({"omega": omega, "i": i}))
-"""
 
 
 def test_libcosimpy_matches_fmpy(fmu, fmpy_reference, tmp_path):
@@ -105,9 +90,12 @@ def test_libcosimpy_matches_fmpy(fmu, fmpy_reference, tmp_path):
         import libcosimpy  # noqa: F401
     except ImportError:
         pytest.fail("libcosimpy is not installed (pip install -e '.[test]')")
-    r = run_python(LIBCOSIM, str(fmu), cwd=tmp_path)
-    assert r["omega"] == pytest.approx(fmpy_reference["omega"], rel=1e-9)
-    assert r["i"] == pytest.approx(fmpy_reference["i"], rel=1e-9, abs=1e-12)
+    proc = subprocess.run([sys.executable, "-c", libcosim_script(("omega", "i"), u=3.0), str(fmu)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    omega, i = result_line(proc.stdout)
+    assert omega == pytest.approx(fmpy_reference["omega"], rel=1e-9)
+    assert i == pytest.approx(fmpy_reference["i"], rel=1e-9, abs=1e-12)
 
 
 # --------------------------------------------------------------------------- valgrind

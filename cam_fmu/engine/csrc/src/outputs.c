@@ -23,17 +23,23 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
         }
         cam_load(m, theta, omega, omega_dot, mode->direction, engaged, &load);
     }
+    cam_record_outputs(&load, omega, theta, engaged ? load.s_cam - m->c * mode->contact : mode->s_free, i, u, out);
+}
+
+void cam_record_outputs(const CamLoad *load, double omega, double theta, double s, double i, double voltage,
+                        double out[])
+{
     out[CAM_O_OMEGA] = omega;
     out[CAM_O_THETA] = theta;
-    out[CAM_O_S] = engaged ? load.s_cam - m->c * mode->contact : mode->s_free;
+    out[CAM_O_S] = s;
     out[CAM_O_I] = i;
-    out[CAM_O_M] = load.M;
-    out[CAM_O_J] = load.J;
-    out[CAM_O_V] = load.v;
-    out[CAM_O_A] = load.a;
-    out[CAM_O_ALPHA] = load.alpha;
-    out[CAM_O_S_CAM] = load.s_cam;
-    out[CAM_O_VOLTAGE] = u;
+    out[CAM_O_M] = load->M;
+    out[CAM_O_J] = load->J;
+    out[CAM_O_V] = load->v;
+    out[CAM_O_A] = load->a;
+    out[CAM_O_ALPHA] = load->alpha;
+    out[CAM_O_S_CAM] = load->s_cam;
+    out[CAM_O_VOLTAGE] = voltage;
 }
 
 static double mechanical(const CamEnergy *e, double omega, double s, double J)

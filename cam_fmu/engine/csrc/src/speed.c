@@ -130,17 +130,7 @@ static void speed_outputs(CamDrive *d, double out[])
         dM = (ahead.M - behind.M) / (2.0 * step);
         voltage += m->L * omega * dM / m->c_m;
     }
-    out[CAM_O_OMEGA] = omega;
-    out[CAM_O_THETA] = theta;
-    out[CAM_O_S] = st->s;
-    out[CAM_O_I] = i;
-    out[CAM_O_M] = load.M;
-    out[CAM_O_J] = load.J;
-    out[CAM_O_V] = load.v;
-    out[CAM_O_A] = load.a;
-    out[CAM_O_ALPHA] = load.alpha;
-    out[CAM_O_S_CAM] = s_at(&m->profile, theta);
-    out[CAM_O_VOLTAGE] = voltage;
+    cam_record_outputs(&load, omega, theta, st->s, i, voltage, out);   /* load.s_cam: s_cam at theta */
 }
 
 static void speed_advice(const CamDrive *d, char *buf, size_t len)
