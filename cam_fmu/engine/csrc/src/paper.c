@@ -219,18 +219,16 @@ static void paper_outputs(CamDrive *d, double out[])
 {
     const CamPaperState *p = &d->paper;
     double dd[4];
+    CamLoad load;
     cam_profile_eval(&d->model.profile, p->theta, dd);
-    out[CAM_O_OMEGA] = p->omega;
-    out[CAM_O_THETA] = p->theta;
-    out[CAM_O_S] = p->s;
-    out[CAM_O_I] = p->i;
-    out[CAM_O_M] = p->M;
-    out[CAM_O_J] = p->J;
-    out[CAM_O_V] = p->v;
-    out[CAM_O_A] = p->a;
-    out[CAM_O_ALPHA] = p->alpha;
-    out[CAM_O_S_CAM] = dd[0];
-    out[CAM_O_VOLTAGE] = p->voltage;
+    load.M = p->M;
+    load.J = p->J;
+    load.f = 0.0;
+    load.v = p->v;
+    load.a = p->a;
+    load.alpha = p->alpha;
+    load.s_cam = dd[0];
+    cam_record_outputs(&load, p->omega, p->theta, p->s, p->i, p->voltage, out);
 }
 
 static void paper_advice(const CamDrive *d, char *buf, size_t len)
