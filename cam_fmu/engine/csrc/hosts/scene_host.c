@@ -77,6 +77,31 @@ int main(void)
     scene("tilted", &p, 3.5, 1e-3, 2000);
     cam_params_free(&p);
 
+    cam_params_defaults(&p);   /* every formulation and solver, and the exponential pair of rk45 */
+    set_text(&p, "formulation", "paper", &err);
+    scene("paper", &p, 3.5, 1e-3, 2000);
+    set_text(&p, "formulation", "consistent", &err);
+    set_text(&p, "drive", "speed", &err);
+    set(&p, "c", 5e-4, &err);
+    set(&p, "gamma", 1.5707963267948966, &err);
+    scene("speed", &p, 3.5, 1e-3, 2000);
+    cam_params_free(&p);
+    cam_params_defaults(&p);
+    set(&p, "c", 5e-4, &err);
+    set_text(&p, "solver", "euler", &err);
+    set(&p, "h_max", 1e-4, &err);
+    scene("euler", &p, 3.5, 1e-3, 1000);
+    set_text(&p, "solver", "rk4", &err);
+    scene("rk4", &p, 3.5, 1e-3, 1000);
+    set(&p, "L", 1e-3, &err);
+    set_text(&p, "solver", "etdrk4", &err);
+    scene("etdrk4", &p, 3.5, 1e-3, 1000);
+    set_text(&p, "solver", "rk45", &err);
+    set(&p, "h_max", 1e-3, &err);
+    set(&p, "L", 1e-6, &err);
+    scene("stiff-pole", &p, 3.5, 1e-2, 100);
+    cam_params_free(&p);
+
     cam_params_defaults(&p);   /* a motion table: the parser and the table's curve */
     set_text(&p, "motion_table", "angle_deg,lift_mm\n0,0\n90,40\n180,60\n270,20\n360,0\n", &err);
     set(&p, "mu", 0.0, &err);
