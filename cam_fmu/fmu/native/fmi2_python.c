@@ -1,5 +1,5 @@
 /*
- * cam.fmu's own linux64 binary: an FMI 2.0 co-simulation wrapper that hosts
+ * The project's own linux64 binary of a Python FMU (pi_speed.fmu): an FMI 2.0 co-simulation wrapper that hosts
  * the Python slave (a pythonfmu Fmi2Slave subclass).
  *
  * Written for this project (not derived from pythonfmu's C++).  Design:
@@ -154,7 +154,7 @@ static void emit(fmi2CallbackLogger logger, fmi2ComponentEnvironment env, const 
     if (logger) {
         logger(env, name ? name : "cam", status, category, "%s", text);
     } else {
-        fprintf(stderr, "[cam.fmu %s] %s: %s\n", name ? name : "", category, text);
+        fprintf(stderr, "[%s] %s: %s\n", name ? name : "", category, text);
     }
 }
 
@@ -729,7 +729,7 @@ static Instance *checked(fmi2Component comp, const char *fname, int allowed_afte
 {
     Instance *c = comp;
     if (!c || c->magic != INSTANCE_MAGIC) {
-        fprintf(stderr, "[cam.fmu] %s: invalid fmi2Component %p\n", fname, comp);
+        fprintf(stderr, "[FMU] %s: invalid fmi2Component %p\n", fname, comp);
         *st = fmi2Error;
         return NULL;
     }
@@ -872,18 +872,18 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
     (void)guid;
 
     if (type != fmi2CoSimulation) {
-        emit(logger, env, name, fmi2Error, "logStatusError", "cam.fmu supports co-simulation only");
+        emit(logger, env, name, fmi2Error, "logStatusError", "this FMU supports co-simulation only");
         return NULL;
     }
     if (uri_to_path(resourceLocation, resources, sizeof resources) != 0 &&
         resources_from_library(resources, sizeof resources) != 0) {
-        emit(logger, env, name, fmi2Error, "logStatusError", "cam.fmu: cannot locate the resources folder");
+        emit(logger, env, name, fmi2Error, "logStatusError", "this FMU cannot locate its resources folder");
         return NULL;
     }
     if (ensure_python(resources, err, sizeof err, &mode) != 0) {
         char text[2600];
         snprintf(text, sizeof text,
-                 "cam.fmu needs Python %d.%d with numpy and found none usable: %s. Point the environment "
+                 "this FMU needs Python %d.%d with numpy and found none usable: %s. Point the environment "
                  "variable CAM_FMU_PYTHON at a python%d.%d executable (or its libpython%d.%d.so), or edit "
                  "resources/python.txt in the FMU.",
                  PY_MAJOR_VERSION, PY_MINOR_VERSION, err, PY_MAJOR_VERSION, PY_MINOR_VERSION, PY_MAJOR_VERSION,
@@ -922,7 +922,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String 
         goto fail;
     }
     share_exchange(c);
-    logf_(c, fmi2OK, "logAll", "cam.fmu: Python %.*s (%s), module %s", (int)strcspn(p_Py_GetVersion(), " "),
+    logf_(c, fmi2OK, "logAll", "Python %.*s (%s), module %s", (int)strcspn(p_Py_GetVersion(), " "),
           p_Py_GetVersion(), mode, g_slave);
     p_PyGILState_Release(gil);
     return c;
@@ -1193,7 +1193,7 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component comp, fmi2Real currentCommunicationPo
 EXPORT fmi2Status fmi2CancelStep(fmi2Component comp)
 {
     ENTER("fmi2CancelStep", 1)
-    logf_(c, fmi2Error, "logStatusError", "fmi2CancelStep: cam.fmu does not step asynchronously");
+    logf_(c, fmi2Error, "logStatusError", "fmi2CancelStep: this FMU does not step asynchronously");
     LEAVE(fmi2Error);
 }
 
