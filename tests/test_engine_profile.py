@@ -365,3 +365,22 @@ def test_a_million_rows_parse_and_evaluate_in_log_n_comparisons():
         assert s1 == pytest.approx(1.5e-2 * math.cos(3.0 * theta), abs=1e-8)
     _, evaluations = first_crossed([t.angle[k] for k in range(0, n, 1)], 0.3, 0.4)
     assert evaluations <= 3 * (2 * limit + 5)
+
+
+def test_the_angle_reduction_is_fmod_to_the_bit():
+    """cam_angle_mod skips fmod where exact subtractions give its result (docs: cam_profile.h); libm's fmod,
+    through Python's math.fmod, is the oracle: random angles, the multiples of 2 pi and their neighbours."""
+    import ctypes
+
+    from cam_fmu.engine.library import load
+
+    reduce = load().cam_angle_mod
+    reduce.restype, reduce.argtypes = ctypes.c_double, [ctypes.c_double]
+    rng = np.random.default_rng(11)
+    angles = list(rng.uniform(-40.0, 40.0, 100_000)) + list(rng.uniform(-1e6, 1e6, 1000))
+    for k in range(-6, 7):
+        edge = k * TWO_PI
+        angles += [edge, math.nextafter(edge, -math.inf), math.nextafter(edge, math.inf), edge + 5e-324, -0.0, 0.0]
+    for theta in angles:
+        assert bits((reduce(float(theta)),)) == bits((math.fmod(float(theta), TWO_PI),)), theta
+    assert math.isnan(reduce(math.nan)) and math.isnan(reduce(math.inf))

@@ -207,7 +207,7 @@ void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *compar
         d[0] = d[1] = d[2] = d[3] = NAN;
         return;
     }
-    th = fmod(theta, TWO_PI);  /* [0, 2 pi): a knot is its own reduction, so rows come back exactly */
+    th = cam_angle_mod(theta);  /* [0, 2 pi): a knot is its own reduction, so rows come back exactly */
     if (th < 0.0) {
         th += TWO_PI;
         if (th >= TWO_PI) {  /* -tiny + 2 pi rounds to 2 pi */

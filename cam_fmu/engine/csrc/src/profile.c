@@ -165,6 +165,20 @@ void cam_profile_free(CamProfile *p)
     memset(p, 0, sizeof *p);
 }
 
+double cam_angle_mod(double theta)
+{
+    const double two = 2.0 * TWO_PI;
+    if (theta >= 0.0 && theta < TWO_PI)
+        return theta;
+    if (theta >= TWO_PI && theta < two)
+        return theta - TWO_PI;                 /* in [2 pi, 4 pi): exact */
+    if (theta >= two && theta < 2.0 * two) {  /* [4 pi, 8 pi): minus 4 pi exact, then maybe minus 2 pi */
+        double r = theta - two;
+        return r < TWO_PI ? r : r - TWO_PI;
+    }
+    return fmod(theta, TWO_PI);
+}
+
 void cam_profile_eval_counted(const CamProfile *p, double theta, double d[4], size_t *comparisons)
 {
     double th, law[4];
@@ -172,7 +186,7 @@ void cam_profile_eval_counted(const CamProfile *p, double theta, double d[4], si
         cam_table_eval(&p->table, theta, d, comparisons);
         return;
     }
-    th = fmod(theta, TWO_PI);
+    th = cam_angle_mod(theta);
     if (th < 0.0) {
         th += TWO_PI;
         if (th >= TWO_PI) {  /* -tiny + 2 pi rounds to 2 pi */
