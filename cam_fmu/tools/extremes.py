@@ -69,6 +69,10 @@ def draw(rng: random.Random) -> Case:
     elif kind < 0.3:
         params["formulation"] = BY_NAME["formulation"].choices[-1]  # the paper's algorithm
     comm = math.exp(rng.uniform(math.log(1e-4), math.log(1e-2)))
+    if params.get("formulation") == BY_NAME["formulation"].choices[-1] and rng.random() < 0.75:
+        # the paper's algorithm computes on a fixed grid of h_max: most cases put the communication step on
+        # it (so the algorithm runs); the others test that a step off the grid is refused, naming h_max
+        params["h_max"] = comm / rng.randint(1, 10)
     stop = comm * rng.randint(5, 60)
     u_steps = [(0.0, rng.uniform(-30.0, 60.0))]
     if rng.random() < 0.5:
