@@ -215,7 +215,7 @@ def groups() -> Iterator[tuple[str, list[dict[str, Any]]]]:
 
 
 def provenance() -> dict[str, Any]:
-    """Versions, platform, kernel path and git commit of this recording."""
+    """Versions, platform and git commit of this recording."""
     import numpy
     import scipy
 

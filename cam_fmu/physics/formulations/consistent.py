@@ -6,10 +6,9 @@ Discrete mode: stuck (shaft held by static friction), direction of motion,
 backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
 gap) and the follower's position while free. The scipy reference integrates
 ``derivative`` and stops at the zeros of ``event_values`` (docs/model.md sections
-5-6); so do the engine's fixed-step solvers, while its rk45 runs the drive
-kernel's own copy of the formulas and calls back here for the transitions.
-``consistent_voltage.ConsistentVoltage`` is this formulation under a voltage input,
-advanced by the engine's integrator.
+5-6). This is the readable model, written independently of the run-time engine in
+C (cam_fmu/engine/csrc: cam_rhs, cam_event_value, cam_apply_event), which it checks:
+FMU against reference compares the two.
 
 Events are functions that are > 0 while nothing happens; a crossing to <= 0
 triggers ``apply_event`` with the index of the function.

@@ -104,7 +104,7 @@ void cam_profile_free(CamProfile *p);
 double cam_angle_mod(double theta);
 
 /* s [m], ds/dtheta [m/rad], d2s/dtheta2, d3s/dtheta3 at theta [rad] into d[0..3].
- * Laws: exactly drive_kernel.Profile.profile (a NaN or infinite theta gives the lower dwell there).
+ * Laws: exactly kinematics.cam_program.CamProgram.derivatives (a NaN or infinite theta gives the lower dwell there).
  * Tables: the piece ending at a knot (left limit; knot 0 ends the last piece); O(log n);
  * a NaN or infinite theta gives NaN. */
 void cam_profile_eval(const CamProfile *p, double theta, double d[4]);
@@ -117,7 +117,7 @@ void cam_profile_eval_counted(const CamProfile *p, double theta, double d[4], si
  * (periodic: the angle itself, not reduced), or NaN when none; O(log n_points). */
 double cam_profile_first_breakpoint(const CamProfile *p, double start, double end);
 
-/* The same over ascending points[0..n-1] in [0, 2 pi): drive_kernel.first_angle_crossed's result
+/* The same over ascending points[0..n-1] in [0, 2 pi): kinematics.cam_program.first_angle_crossed's result
  * to the bit. Adds to *evaluations (if not NULL) the number of points whose crossing angle it
  * computed: a few per group of equal turn counts (at most 3 groups), O(log n) comparisons. */
 double cam_first_crossed(const double *points, size_t n, double start, double end, size_t *evaluations);

@@ -14,7 +14,7 @@
  * x + h * (a_1 k_1 + a_2 k_2 + ...) summed left to right over the nonzero
  * coefficients only, except a row with a single nonzero coefficient, which is
  * x + (h a) k; the error as h * (e_1 k_1 + ...). This is the order of the
- * former Python/Cython kernel, so results agree with it to the last bit.
+ * former Python engine, so results agree with its recorded outputs to the last bit.
  *
  * C99, libc and libm only, no globals: the tableaus are const data.
  */
@@ -114,7 +114,7 @@ void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x
 
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is
- * 1e-12 of it); below the floor: CAM_ERR_REJECTED with solvers/dopri.py's message. */
+ * 1e-12 of it); below the floor: CAM_ERR_REJECTED with the former engine's message. */
 int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt,
                       CamError *err);
 
@@ -130,7 +130,7 @@ double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, doubl
 /* Advance the consistent formulation's state d->x, d->mode by one communication step h [s] from
  * ``time`` with the method of d->model.solver: every step ends at the profile breakpoint it would
  * cross and at the located zero of the first event, whose transition is cam_apply_event. More than
- * max_steps internal steps: CAM_ERR_REJECTED naming the setting (hybrid.py's message). On any error
+ * max_steps internal steps: CAM_ERR_REJECTED naming the setting (the former engine's message). On any error
  * the state, mode and solver state are as before the call. */
 int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err);
 

@@ -1,4 +1,4 @@
-/* The energy-consistent formulation under a voltage input (physics/formulations/consistent_voltage.py):
+/* The energy-consistent formulation under a voltage input (docs/model.md section 5; the readable model: physics/formulations/consistent.py):
  * an ODE with events, advanced by the solvers of cam_solver.h. */
 #include <stdio.h>
 

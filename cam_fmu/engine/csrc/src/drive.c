@@ -1,4 +1,4 @@
-/* One cam drive stepped from one communication point to the next (fmu/engine.py DriveSimulator): the
+/* One cam drive stepped from one communication point to the next (Python: engine/simulator.py DriveSimulator): the
  * time, the inputs, the formulation and its checks on every published state. Holds no physics. */
 #include <math.h>
 #include <stdio.h>

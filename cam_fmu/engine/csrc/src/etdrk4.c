@@ -1,4 +1,4 @@
-/* Exponential RK4 for the motor's linear part (the former solvers/etd.py), order of operations kept.
+/* Exponential RK4 for the motor's linear part (the former Python engine's etdrk4), order of operations kept.
  *
  * ETD runs on the current's deviation e = i - (u - c_e omega) / R from its quasi-static value:
  * de/dt = -(R/L) e + (c_e/R) omega_dot, and on e's torque c_m e / J on omega. The linear part

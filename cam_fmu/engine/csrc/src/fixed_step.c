@@ -1,5 +1,5 @@
-/* Fixed-step methods inside their stability and resolution limits (the former solvers/hybrid.py
- * _stable_step), with the order of operations kept.
+/* Fixed-step methods inside their stability and resolution limits (the former Python engine's
+ * stable step), with the order of operations kept.
  *
  * Two limits: stability (h times the fastest rate of the dynamics within the method's stability
  * factor) and resolution (the cam turns at most ``resolution`` of the profile's finest angular detail

@@ -2,7 +2,7 @@
  * control (or fixed steps inside the method's limits), profile breakpoints, events located by Illinois
  * false position on re-stepped trial states, transitions, the work bound max_steps, rollback.
  *
- * Ported from the former kernel (drive_kernel.DriveKernel: attempt, trial, locate, first_event,
+ * Ported from the former Python engine (its step attempt, trial, locate, first_event,
  * advance) with the order of floating-point operations kept: rk45 agrees with it to the last bit. */
 #include <math.h>
 #include <stdio.h>

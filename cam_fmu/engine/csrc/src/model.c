@@ -1,7 +1,7 @@
 /* The drive's constants and its physics at one instant (docs/model.md sections 3-5): the load terms,
  * the guide friction's exact solve, omega_dot, the side force, the load, the motor torque.
  *
- * Ported from the former kernel (kernel/drive_kernel.py) with the order of every floating-point
+ * Ported from the former Python engine's kernel with the order of every floating-point
  * operation kept, so that results agree with it to the last bit. */
 #include <math.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
 /* The general harmonic-trapezoid law (7 segments), dimensionless: cam_law_init and cam_law_eval.
  *
  * The same operations in the same order as cam_fmu/kinematics/motion_law.py (MotionLaw), so that
- * every segment field is the same double; evaluation as drive_kernel.Profile.law. Formulas:
+ * every segment field is the same double; evaluation as kinematics.motion_law's. Formulas:
  * docs/model.md section 1 and the docstring of motion_law.py.
  */
 #include "cam_profile.h"

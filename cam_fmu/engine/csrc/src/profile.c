@@ -1,8 +1,8 @@
 /* A cam program of two laws with dwells, its evaluation, breakpoints and breakpoint search.
  *
  * cam_profile_init_laws checks as kinematics/cam_program.py's CamProgram (and physics/parameters.py for
- * the sum of the angles) and computes what drive_kernel.Profile does; cam_profile_eval is
- * drive_kernel.Profile.profile (same operations, same order: the same doubles); breakpoints and the
+ * the sum of the angles) and computes what kinematics.cam_program.CamProgram does; cam_profile_eval is
+ * CamProgram.derivatives (same operations, same order: the same doubles); breakpoints and the
  * feature angle are CamProgram.breakpoints() and CamProgram.feature_angle(). Tables: motion_table.c.
  */
 #include "cam_profile.h"
@@ -133,7 +133,7 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     h = lift;
     p->kr0 = 1.0 / beta;
     p->kr1 = h / beta;
-    p->kr2 = h / pow(beta, 2.0);  /* Python's beta ** 2: libm's pow, as the kernel */
+    p->kr2 = h / pow(beta, 2.0);  /* Python's beta ** 2: libm's pow, as the Python program */
     p->kr3 = h / pow(beta, 3.0);
     beta = return_angle;
     p->kd0 = 1.0 / beta;
@@ -219,13 +219,13 @@ void cam_profile_eval(const CamProfile *p, double theta, double d[4])
 }
 
 /* ---- the first breakpoint crossed ------------------------------------------------------------
- * drive_kernel.first_angle_crossed computes, for every point p, the crossing angle
+ * kinematics.cam_program.first_angle_crossed computes, for every point p, the crossing angle
  *   forward:  K = ceil((start - p) / 2 pi),  a = p + K 2 pi,  a <= start ? a + 2 pi : a   (smallest wins)
  *   backward: K = floor((start - p) / 2 pi), a = p + K 2 pi,  a >= start ? a - 2 pi : a  (largest wins)
  * Rounding is monotone, so over ascending points K never increases (it takes at most 3 values:
  * the points fall into contiguous groups of equal K) and within a group p + K 2 pi never decreases.
  * The extreme of a group is therefore at its ends or where the comparison with start flips, all
- * found by bisection; evaluating the kernel's formula there gives its result to the bit. */
+ * found by bisection; evaluating the Python formula there gives its result to the bit. */
 
 static double turns(double start, double p, int forward)
 {

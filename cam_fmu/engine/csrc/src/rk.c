@@ -1,7 +1,7 @@
 /* Explicit Runge-Kutta methods as data over one generic step, and the error norm of embedded pairs.
  *
  * The stage increments are summed left to right over the nonzero coefficients only; a row with a
- * single nonzero coefficient a is applied as x + (h a) k. That is the order of the former kernel's
+ * single nonzero coefficient a is applied as x + (h a) k. That is the order of the former Python engine's
  * Dormand-Prince step, so rk45 agrees with it to the last bit. */
 #include <math.h>
 

@@ -1,5 +1,5 @@
 /* The drive's state as a flat, versioned array of doubles (the CAM_S_* slots of cam_model.h), and its
- * restoration with every entry checked before use (fmu/engine.py get_state/set_state). */
+ * restoration with every entry checked before use (DriveSimulator.get_state/set_state in engine/simulator.py). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
