@@ -26,6 +26,7 @@ SUBCOMMANDS: tuple[str, ...] = (
     "host_env",   # environment line for native FMU hosts (diagnostic)
     "cosim",      # run an SSP (the speed loop) on the project's co-simulation master
     "sweep",      # parameter sweeps of a scene on dask.distributed
+    "reflect",    # the inertia and load torque the motor sees over one turn
 )
 
 

@@ -1,0 +1,68 @@
+"""`cam-fmu reflect SCENE [--set NAME=VALUE ...] [--rpm N] [--json] [--out DIR]`: what the motor sees.
+
+Over one turn of the cam at a constant speed (``--rpm``, default: the scene's mean
+cam speed is not known before a run, so 60 1/min), the inertia J(theta) the motor
+drives and the load torque M(theta) with its inertial, gravity and friction parts
+(control.reflect; docs/control.md). Writes DIR/<scene>_reflect.csv (SI units in the
+header) and DIR/<scene>_reflect.png, and prints the extremes with the angles where
+they occur; ``--json`` prints them as one JSON object instead (keys J_min, J_max
+[kg m^2], M_min, M_max [N m], f_r_min, f_r_max, f_a_min, f_a_max [Hz], each with its
+theta_<key> [rad]; the resonance keys are null: the drive-train is rigid).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser("reflect", help="the inertia and load torque the motor sees over one turn of the cam",
+                              description="The reflected-load map of a scene's cam drive at a constant cam speed.")
+    p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. paper_fig6) or a scene file (.toml)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="override a parameter (repeatable), e.g. --set m=0.6")
+    p.add_argument("--rpm", type=float, default=60.0, help="cam speed [1/min] (default 60)")
+    p.add_argument("--points", type=int, default=3600, help="angles over the turn (default 3600)")
+    p.add_argument("--json", action="store_true", help="print the extremes as JSON")
+    p.add_argument("--out", metavar="DIR", default="out", help="output directory (default: out)")
+    p.add_argument("--no-plot", action="store_true", help="write the CSV file only")
+    return p
+
+
+def run(args) -> int:
+    from ..control.reflect import COLUMNS, UNITS, reflected_map, summary
+    from ..experiments.scenes import find_scene
+    from .simulate import apply_sets
+
+    scene = apply_sets(find_scene(args.scene), args.set)
+    result = reflected_map(scene.primary.params, args.rpm, args.points)
+    extremes = summary(result, args.rpm)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {args.out!r} exists and is not a directory")
+    out.mkdir(parents=True, exist_ok=True)
+    csv = out / f"{scene.name}_reflect.csv"
+    with csv.open("w", encoding="utf-8") as f:
+        f.write(",".join(f"{name} [{UNITS[name]}]" for name in COLUMNS) + "\n")
+        for k in range(len(result["theta"])):
+            f.write(",".join(repr(float(result[name][k])) for name in COLUMNS) + "\n")
+    written = [csv]
+    if not args.no_plot:
+        from ..plots.reflect import plot_reflected
+
+        written.append(plot_reflected(result, f"{scene.name}: what the motor sees at {args.rpm:g} 1/min",
+                                      out / f"{scene.name}_reflect.png"))
+    if args.json:
+        print(json.dumps(extremes))
+        return 0
+    for key in ("J", "M"):
+        unit = "kg m^2" if key == "J" else "N m"
+        print(f"{key}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} {unit} (min at "
+              f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
+    print("resonance: none (the drive-train is rigid)")
+    for path in written:
+        print(path)
+    sys.stdout.flush()
+    return 0

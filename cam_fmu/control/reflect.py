@@ -1,0 +1,73 @@
+"""What the motor shaft sees over one turn of the cam: the reflected inertia and load torque.
+
+At a constant cam speed omega [rad/s] (omega_dot = 0), for every cam angle theta
+(docs/model.md section 4):
+
+- J(theta) = J_m + m s'^2 [kg m^2], the inertia the motor drives;
+- the load torque M(theta) [N m] and its parts, whose sum it is:
+  inertial m s'' omega^2 s' (the follower's acceleration), gravity -F_gx s',
+  guide friction sigma f s' (f from the exact two-branch solve, sigma = sgn(s' omega)),
+  and shaft friction M_f sgn(omega).
+
+The drive-train is rigid: the resonance and anti-resonance frequencies of a compliant
+shaft are not modelled yet, and the map reports them as None. Plain floats through
+physics.drive.DriveModel; numpy only for the arrays.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..physics.drive import DriveModel, sign, solve_guide_friction
+
+PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
+COLUMNS = ("theta", "J", "M", *PARTS)
+UNITS = {"theta": "rad", "J": "kg.m2", "M": "N.m", **{part: "N.m" for part in PARTS}}
+RESONANCE_KEYS = ("f_r_min", "f_r_max", "f_a_min", "f_a_max")  # Hz: a compliant shaft (not modelled yet)
+
+
+def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 3600) -> dict[str, np.ndarray]:
+    """J(theta) and M(theta) with its parts at ``points`` angles over one turn, at ``rpm`` [1/min] of the cam."""
+    if not (math.isfinite(rpm) and rpm != 0.0 and abs(rpm) <= 1e6):
+        raise ValueError(f"--rpm {rpm!r}: allowed a finite cam speed other than 0, |rpm| <= 1e6 1/min")
+    if points < 8:
+        raise ValueError(f"points = {points}: at least 8 angles over a turn")
+    model = DriveModel(params)
+    omega = rpm * 2.0 * math.pi / 60.0
+    direction = 1.0 if omega > 0.0 else -1.0
+    thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
+    out = {name: np.empty(points) for name in COLUMNS}
+    for k, theta in enumerate(thetas):
+        s, s1, s2, _ = model.program.derivatives(float(theta))
+        tan_a = s1 / (model.r_b + s)
+        sigma = sign(s1 * direction)
+        push = model.m * s2 * omega * omega - model.F_gx
+        f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g, 0.0)
+        out["theta"][k] = theta
+        out["J"][k] = model.J_m + model.m * s1 * s1
+        out["M_inertial"][k] = model.m * s2 * omega * omega * s1
+        out["M_gravity"][k] = -model.F_gx * s1
+        out["M_guide"][k] = sigma * f * s1
+        out["M_shaft"][k] = model.M_f * direction
+        out["M"][k] = model.load(float(theta), omega, 0.0, direction).M
+    return out
+
+
+def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
+    """The extremes and where they occur [rad]: J_min, J_max [kg m^2], M_min, M_max [N m], and the
+    resonance keys (None: the drive-train is rigid)."""
+    theta = result["theta"]
+    out: dict[str, Any] = {"rpm": rpm, "omega": rpm * 2.0 * math.pi / 60.0}
+    for name, key in (("J", "J"), ("M", "M")):
+        low, high = int(np.argmin(result[name])), int(np.argmax(result[name]))
+        out[f"{key}_min"], out[f"theta_{key}_min"] = float(result[name][low]), float(theta[low])
+        out[f"{key}_max"], out[f"theta_{key}_max"] = float(result[name][high]), float(theta[high])
+    for key in RESONANCE_KEYS:
+        out[key] = None
+        out[f"theta_{key}"] = None
+    return out
+
+
+__all__ = ["COLUMNS", "PARTS", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary"]

@@ -1,0 +1,80 @@
+"""The reflected-load map (control.reflect, `cam-fmu reflect`) against closed forms.
+
+The paper's cam (docs/model.md section 2) in closed form (tests/test_drive_closed_form.paper_profile):
+J(theta) = J_m + m s'^2 with peak J_m + m (2 A)^2 where s' = 2 A; the inertial torque m s'' omega^2 s';
+gravity -F_gx s'; the guide friction from a fixed-point iteration, a method independent of the
+two-branch solve; the parts add up to the load torque of the drive model.
+"""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from cam_fmu.control.reflect import PARTS, RESONANCE_KEYS, reflected_map, summary
+from cam_fmu.physics.drive import DriveModel
+from test_drive_closed_form import A, DEFAULTS, friction_fixed_point, paper_profile
+
+TILTED = {"gamma": math.radians(100.0), "beta": math.radians(30.0), "mu": 0.05}
+
+
+@pytest.mark.parametrize("params", [{}, TILTED], ids=["horizontal", "tilted"])
+@pytest.mark.parametrize("rpm", [60.0, -300.0])
+def test_the_map_is_the_closed_form(params, rpm):
+    result = reflected_map(params, rpm, points=720)
+    model = DriveModel(params)
+    omega = rpm * 2.0 * math.pi / 60.0
+    d = 1.0 if omega > 0 else -1.0
+    for k, theta in enumerate(result["theta"]):
+        s, s1, s2 = paper_profile(float(theta))
+        assert result["J"][k] == pytest.approx(DEFAULTS["J_m"] + DEFAULTS["m"] * s1 * s1, rel=1e-12)
+        assert result["M_inertial"][k] == pytest.approx(DEFAULTS["m"] * s2 * omega ** 2 * s1, rel=1e-9, abs=1e-15)
+        assert result["M_gravity"][k] == pytest.approx(-model.F_gx * s1, rel=1e-9, abs=1e-15)
+        tan_a = s1 / (model.r_b + s)
+        sigma = math.copysign(1.0, s1 * d) if s1 != 0.0 else 0.0
+        push = DEFAULTS["m"] * s2 * omega ** 2 - model.F_gx
+        f = friction_fixed_point(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g)
+        assert result["M_guide"][k] == pytest.approx(sigma * f * s1, rel=1e-9, abs=1e-15)
+        assert result["M_shaft"][k] == DEFAULTS["M_f"] * d
+        total = sum(result[part][k] for part in PARTS)
+        assert result["M"][k] == pytest.approx(total, rel=1e-12, abs=1e-15)
+
+
+def test_the_extremes_and_where_they_are():
+    result = reflected_map({}, 60.0, points=3600)
+    found = summary(result, 60.0)
+    assert found["J_max"] == pytest.approx(DEFAULTS["J_m"] + DEFAULTS["m"] * (2 * A) ** 2, rel=1e-9)
+    assert found["J_min"] == pytest.approx(DEFAULTS["J_m"], rel=1e-12)
+    for key in ("J", "M"):  # each extreme is the value at its angle
+        for end in ("min", "max"):
+            k = int(np.argmin(np.abs(result["theta"] - found[f"theta_{key}_{end}"])))
+            assert result[key][k] == found[f"{key}_{end}"]
+    assert found["M_max"] > found["M_min"]
+    assert all(found[key] is None for key in RESONANCE_KEYS)  # the drive-train is rigid
+
+
+@pytest.mark.parametrize("rpm", [0.0, math.nan, 1e9])
+def test_a_bad_speed_names_the_option(rpm):
+    with pytest.raises(ValueError, match="--rpm"):
+        reflected_map({}, rpm)
+
+
+def test_the_command_writes_the_map_and_its_json(tmp_path):
+    cmd = [sys.executable, "-m", "cam_fmu.cli", "reflect", "paper_fig6", "--rpm", "120", "--json", "--out",
+           str(tmp_path), "--set", "m=0.8"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    found = json.loads(proc.stdout.strip().splitlines()[-1])
+    for key in ("J_min", "J_max", "M_min", "M_max", *RESONANCE_KEYS):
+        assert key in found and f"theta_{key}" in found
+    assert found["J_max"] == pytest.approx(DEFAULTS["J_m"] + 0.8 * (2 * A) ** 2, rel=1e-9)  # --set m=0.8 applied
+    header = (tmp_path / "paper_fig6_reflect.csv").read_text().splitlines()[0]
+    assert header.startswith("theta [rad],J [kg.m2],M [N.m]")
+    assert (tmp_path / "paper_fig6_reflect.png").stat().st_size > 10_000
+    bad = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "reflect", "paper_fig6", "--rpm", "0", "--out",
+                          str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--rpm" in bad.stderr
