@@ -19,12 +19,15 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("s", "m", "follower position (after backlash)"),
     ("i", "A", "armature current"),
     ("M", "N.m", "total load torque on the shaft: M_f sgn(omega) + M_l"),
-    ("J", "kg.m2", "equivalent inertia J_m + m (ds/dtheta)^2 (J_m while free in the gap)"),
+    ("J", "kg.m2", "equivalent inertia J_m + J_cam + m (ds/dtheta)^2 (J_m + J_cam while free in the gap)"),
     ("v", "m/s", "follower velocity"),
     ("a", "m/s2", "follower acceleration"),
     ("alpha", "rad", "pressure angle"),
     ("s_cam", "m", "cam profile lift at the contact (before backlash)"),
     ("voltage", "V", "armature voltage: u (voltage drive) or the voltage needed (speed drive)"),
+    ("theta_m", "rad", "motor angle (a rigid shaft: theta)"),
+    ("omega_m", "rad/s", "motor angular velocity (a rigid shaft: omega)"),
+    ("M_shaft", "N.m", "torque of the compliant shaft on the cam, k_shaft twist + d_shaft twist rate (rigid: 0)"),
 )
 # Allowed range of each input [its unit]: far beyond any real drive, finite so that
 # the arithmetic stays finite (a value outside is an error naming the input and the range).

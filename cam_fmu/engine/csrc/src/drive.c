@@ -86,8 +86,7 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
                         d->time, d->model.c, advice);
     {
         double excess, tolerance;
-        cam_energy_excess(&d->budget, out[CAM_O_OMEGA], out[CAM_O_S], out[CAM_O_J], out[CAM_O_I], &excess,
-                          &tolerance);
+        cam_energy_excess(&d->budget, out, &excess, &tolerance);
         return cam_error(err, CAM_ERR_SIMULATION, "the state at t = %g s holds %.6g J more energy than the source "
                         "delivered (tolerance %.3g J): energy was created, the result cannot be trusted; %s", d->time,
                         excess, tolerance, advice);
@@ -112,8 +111,7 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
             d->form->outputs(d, d->values);
             d->stale = 0;
         }
-        cam_energy_init(&opening, &d->model, d->values[CAM_O_THETA], d->values[CAM_O_OMEGA], d->values[CAM_O_I],
-                        d->values[CAM_O_S], d->values[CAM_O_J]);
+        cam_energy_init(&opening, &d->model, d->values);
         opened = 1;
     }
     if ((status = d->form->advance(d, h, d->time, &steps, err)) != CAM_OK)

@@ -39,7 +39,7 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt_
         memcpy(it->work.k[0], d->solver.k1, sizeof d->solver.k1);
         method->step(method, m, &d->mode, d->x, u, dt, &it->work);
         finite = 1;
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             finite = finite && isfinite(it->work.x_new[slot]);
         if (finite) {
             rate_end = cam_stiffness_rate(m, &d->mode, it->work.x_new, electrical);

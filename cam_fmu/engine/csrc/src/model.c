@@ -45,7 +45,7 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
     s = t->d[0];
     s1 = t->d[1];
     mass = m->m;
-    J = m->J_m + mass * s1 * s1;
+    J = m->J_0 + mass * s1 * s1;
     inertial = mass * t->d[2] * omega * omega - m->F_gx;   /* N: the profile's curvature and gravity */
     t->J = J;
     t->x0 = (drive - inertial * s1) / J;
@@ -54,7 +54,7 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
     t->sigma = sign_of(s1 * direction);
     tan_a = s1 / (m->r_b + s);
     t->n0 = (inertial + mass * s1 * t->x0) * tan_a + m->G_y;
-    t->kappa = m->J_m / J * tan_a;
+    t->kappa = m->J_0 / J * tan_a;
     t->f = cam_guide_friction(t->n0, t->kappa, t->sigma, m->mu, m->N_g, side);
 }
 
@@ -64,7 +64,7 @@ double cam_omega_dot(const CamModel *m, double theta, double omega, double torqu
     Terms t;
     double drive = torque - m->M_f * direction;
     if (!(engaged && m->follower))
-        return drive / m->J_m;
+        return drive / m->J_0;
     load_terms(m, theta, omega, drive, direction, side, &t);
     if (m->mu == 0.0)
         return t.x0;
@@ -87,6 +87,18 @@ double cam_torque(const CamModel *m, double omega, double i, double u)
     return m->c_m * (u - m->c_e * omega) / m->R;
 }
 
+double cam_motor_speed(const CamModel *m, const double x[CAM_NX])
+{
+    return m->compliant ? x[CAM_OMEGA_M] : x[CAM_OMEGA];
+}
+
+double cam_drive_torque(const CamModel *m, const double x[CAM_NX], double omega, double u)
+{
+    if (m->compliant)
+        return m->k_shaft * x[CAM_TWIST] + m->d_shaft * (x[CAM_OMEGA_M] - omega);
+    return cam_torque(m, omega, x[CAM_CURRENT], u);
+}
+
 double cam_current_at_rest(const CamModel *m, double i, double u, double dt)
 {
     double target = u / m->R;
@@ -95,16 +107,22 @@ double cam_current_at_rest(const CamModel *m, double i, double u, double dt)
 
 void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT];
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], omega_motor;
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;
-        dx[CAM_OMEGA] = 0.0;
+        dx[CAM_OMEGA] = 0.0;   /* x[CAM_OMEGA] is 0 while stuck */
     } else {
         dx[CAM_THETA] = omega;
-        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_torque(m, omega, i, u), mode->direction,
+        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_drive_torque(m, x, omega, u), mode->direction,
                                       mode->contact != 0, m->guide_side ? mode->side : 0.0);
     }
-    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega) / m->L : 0.0;
+    omega_motor = omega;
+    if (m->compliant) {   /* the rotor on its side of the shaft (docs/model.md section 12) */
+        omega_motor = x[CAM_OMEGA_M];
+        dx[CAM_TWIST] = omega_motor - omega;
+        dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - cam_drive_torque(m, x, omega, u)) / m->J_m;
+    }
+    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
 }
 
 void cam_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
@@ -120,7 +138,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     out->s_cam = s;
     if (!engaged) {
         out->M = shaft;
-        out->J = m->J_m;
+        out->J = m->J_0;
         out->f = out->v = out->a = 0.0;
         return;
     }
@@ -130,7 +148,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     push = m->m * a - m->F_gx;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;
-    out->J = m->J_m + m->m * s1 * s1;
+    out->J = m->J_0 + m->m * s1 * s1;
     out->f = f;
     out->v = v;
     out->a = a;
@@ -260,6 +278,32 @@ static int build_program(CamModel *model, CamError *err)
     return CAM_OK;
 }
 
+/* What a compliant shaft needs (physics/drive.py's check_compliant, text for text). */
+static int check_compliant(const CamModel *model, CamError *err)
+{
+    char k[40], j[40];
+    const double *v = model->params.v;
+    cam_num(model->k_shaft, k);
+    if (!(model->J_0 > 0.0))
+        return cam_error(err, CAM_ERR_PARAMETER,
+                         "parameter 'J_cam' = %s [kg.m2]: a compliant shaft (k_shaft = %s N.m/rad) needs the inertia "
+                         "of its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2",
+                         cam_num(v[CAM_P_J_CAM], j), k);
+    if (model->formulation == CAM_FORM_PAPER)
+        return cam_error(err, CAM_ERR_PARAMETER,
+                         "parameter 'k_shaft' = %s N.m/rad: the paper's algorithm models a rigid drive-train; "
+                         "allowed with formulation 'paper': k_shaft = 0 (use formulation 'consistent')", k);
+    if (model->formulation == CAM_FORM_SPEED)
+        return cam_error(err, CAM_ERR_PARAMETER,
+                         "parameter 'k_shaft' = %s N.m/rad: the speed drive imposes the cam's speed on a rigid "
+                         "drive-train; allowed with drive 'speed': k_shaft = 0", k);
+    if (model->solver == CAM_CHOICE_SOLVER_ETDRK4)
+        return cam_error(err, CAM_ERR_PARAMETER,
+                         "parameter 'k_shaft' = %s N.m/rad: solver 'etdrk4' integrates the rigid drive's electrical "
+                         "pole; allowed with solver 'etdrk4': k_shaft = 0 (use solver 'rk45')", k);
+    return CAM_OK;
+}
+
 int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
 {
     const double *v;
@@ -280,6 +324,10 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->c_e = v[CAM_P_C_E];
     model->c_m = v[CAM_P_C_M];
     model->J_m = v[CAM_P_J_M];
+    model->k_shaft = v[CAM_P_K_SHAFT];
+    model->d_shaft = v[CAM_P_D_SHAFT];
+    model->compliant = model->k_shaft > 0.0;
+    model->J_0 = model->compliant ? v[CAM_P_J_CAM] : model->J_m + v[CAM_P_J_CAM];
     model->M_f = v[CAM_P_SHAFT_FRICTION] != 0.0 ? v[CAM_P_M_F] : 0.0;
     model->m = v[CAM_P_FOLLOWER_INERTIA] != 0.0 ? v[CAM_P_M] : 0.0;
     G = v[CAM_P_GRAVITY] != 0.0 ? v[CAM_P_G] : 0.0;
@@ -293,7 +341,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->has_current = model->L > 0.0;
     model->backlash = model->c > 0.0;
     model->guide_side = model->mu > 0.0 && model->follower;
-    model->nx = model->has_current ? 3 : 2;
+    model->nx = (model->has_current ? 3 : 2) + (model->compliant ? 2 : 0);
+    model->slots = model->compliant ? CAM_NX : CAM_NX_RIGID;
     model->formulation = (int)v[CAM_P_DRIVE] == CAM_CHOICE_DRIVE_SPEED ? CAM_FORM_SPEED
                          : (CamFormulationId)(int)v[CAM_P_FORMULATION];
     model->solver = (int)v[CAM_P_SOLVER];
@@ -302,6 +351,10 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->atol = v[CAM_P_ATOL];
     model->max_steps = (long)v[CAM_P_MAX_STEPS];
     model->feature_angle = model->profile.feature_angle;
+    if (model->compliant && (status = check_compliant(model, err)) != CAM_OK) {
+        cam_model_free(model);
+        return status;
+    }
     if (model->mu > 0.0) {
         double alpha = 0.0, theta = 0.0, locking;
         char a[40], b[40];

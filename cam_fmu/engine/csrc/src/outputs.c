@@ -8,12 +8,12 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
                  int known, double out[])
 {
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA];
-    double i = m->has_current ? x[CAM_CURRENT] : (u - m->c_e * omega) / m->R;
+    double i = m->has_current ? x[CAM_CURRENT] : (u - m->c_e * cam_motor_speed(m, x)) / m->R;
     int engaged = mode->contact != 0;
     CamLoad load;
     if (mode->stuck) {
         cam_load(m, theta, 0.0, 0.0, 0.0, engaged, &load);
-        load.M = m->c_m * i;   /* static friction takes whatever the motor applies */
+        load.M = m->compliant ? cam_drive_torque(m, x, 0.0, u) : m->c_m * i;   /* static friction takes it all */
         load.v = load.a = 0.0;
     } else {
         if (!known) {
@@ -24,6 +24,12 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
         cam_load(m, theta, omega, omega_dot, mode->direction, engaged, &load);
     }
     cam_record_outputs(&load, omega, theta, engaged ? load.s_cam - m->c * mode->contact : mode->s_free, i, u, out);
+    if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too, as a rigid drive's does */
+        out[CAM_O_J] = load.J + m->J_m;
+        out[CAM_O_THETA_M] = theta + x[CAM_TWIST];
+        out[CAM_O_OMEGA_M] = x[CAM_OMEGA_M];
+        out[CAM_O_M_SHAFT] = cam_drive_torque(m, x, mode->stuck ? 0.0 : omega, u);
+    }
 }
 
 void cam_record_outputs(const CamLoad *load, double omega, double theta, double s, double i, double voltage,
@@ -40,15 +46,27 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
     out[CAM_O_ALPHA] = load->alpha;
     out[CAM_O_S_CAM] = load->s_cam;
     out[CAM_O_VOLTAGE] = voltage;
+    out[CAM_O_THETA_M] = theta;   /* a rigid drive: the rotor turns with the cam, no shaft torque */
+    out[CAM_O_OMEGA_M] = omega;
+    out[CAM_O_M_SHAFT] = 0.0;
 }
 
-static double mechanical(const CamEnergy *e, double omega, double s, double J)
+/* E_mech [J] of published outputs: kinetic + gravity potential; compliant: the cam side's and the rotor's
+ * kinetic energy and the shaft's elastic energy k (theta_m - theta)^2 / 2 (docs/model.md section 12). */
+static double mechanical(const CamEnergy *e, const double out[])
 {
-    return 0.5 * J * omega * omega - e->F_gx * s;
+    double omega = out[CAM_O_OMEGA], twist, omega_m;
+    if (e->k_shaft == 0.0)
+        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S];
+    twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];
+    omega_m = out[CAM_O_OMEGA_M];
+    return 0.5 * (out[CAM_O_J] - e->J_m) * omega * omega + 0.5 * e->J_m * omega_m * omega_m
+           + 0.5 * e->k_shaft * twist * twist - e->F_gx * out[CAM_O_S];
 }
 
-void cam_energy_init(CamEnergy *e, const CamModel *m, double theta, double omega, double i, double s, double J)
+void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
 {
+    double i = out[CAM_O_I];
     e->c_e = m->c_e;
     e->L = m->L;
     e->R = m->R;
@@ -56,9 +74,11 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, double theta, double omega
     e->ratio = m->c_m / m->c_e;
     e->work_in = 0.0;
     e->work_abs = 0.0;
-    e->theta = theta;
+    e->k_shaft = m->compliant ? m->k_shaft : 0.0;
+    e->J_m = m->J_m;
+    e->theta = out[CAM_O_THETA_M];
     e->i = i;
-    e->e_mech0 = mechanical(e, omega, s, J);
+    e->e_mech0 = mechanical(e, out);
     e->e_mag0 = 0.5 * e->L * i * i;
 }
 
@@ -71,10 +91,10 @@ void cam_energy_step(CamEnergy *e, double u, double h, double theta, double i)
     e->i = i;
 }
 
-void cam_energy_excess(const CamEnergy *e, double omega, double s, double J, double i, double *excess,
-                       double *tolerance)
+void cam_energy_excess(const CamEnergy *e, const double out[], double *excess, double *tolerance)
 {
-    double e_mech = mechanical(e, omega, s, J);
+    double i = out[CAM_O_I];
+    double e_mech = mechanical(e, out);
     double e_mag = 0.5 * e->L * i * i;
     double lhs = (e_mech - e->e_mech0) + e->ratio * (e_mag - e->e_mag0);
     double rhs = e->ratio * e->work_in;
@@ -94,8 +114,8 @@ int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, do
     if (fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) > m->c * (1.0 + 1e-9) + 1e-12)
         return CAM_PUBLISH_CLEARANCE;
     if (budget != NULL) {
-        cam_energy_step(budget, u, h, out[CAM_O_THETA], out[CAM_O_I]);
-        cam_energy_excess(budget, out[CAM_O_OMEGA], out[CAM_O_S], out[CAM_O_J], out[CAM_O_I], &excess, &tolerance);
+        cam_energy_step(budget, u, h, out[CAM_O_THETA_M], out[CAM_O_I]);
+        cam_energy_excess(budget, out, &excess, &tolerance);
         if (excess - tolerance > 0.0)
             return CAM_PUBLISH_ENERGY;
     }

@@ -150,7 +150,7 @@ static int scheme_step(CamDrive *d, double T, double u, long budget, long *used,
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     p->M_l = (push + sigma * f) * X;
     /* step 8: eq. (4) */
-    p->J = m->J_m + m->m * X * X;
+    p->J = m->J_0 + m->m * X * X;
     p->M = m->M_f * sign(p->omega) + p->M_l;
     return CAM_OK;
 }
@@ -168,7 +168,7 @@ static int paper_init(CamDrive *d, CamError *err)
     p->theta = v[CAM_P_THETA0];
     p->omega = v[CAM_P_OMEGA0];
     p->i = m->L > 0.0 ? v[CAM_P_I0] : 0.0;
-    p->J = m->J_m;
+    p->J = m->J_0;
     p->M = v[CAM_P_OMEGA0] >= 0.0 ? m->M_f : -m->M_f;
     cam_profile_eval(&m->profile, p->theta, dd);
     p->s = dd[0];

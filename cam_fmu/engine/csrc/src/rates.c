@@ -18,10 +18,15 @@ double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x
     double d[4], J, omega = x[CAM_OMEGA], rate = 0.0;
     int engaged = mode->contact != 0;
     cam_profile_eval(&m->profile, x[CAM_THETA], d);
-    J = m->J_m + (engaged ? m->m * d[1] * d[1] : 0.0);
+    J = m->J_0 + (engaged ? m->m * d[1] * d[1] : 0.0);
     if (engaged)
         rate = (2.0 * m->m * fabs(d[1] * d[2] * omega) + fabs(omega) * sqrt(m->m * J * (d[2] * d[2] + fabs(d[1] * d[3]))))
                / J;
+    if (m->compliant) {   /* the two-mass oscillation and its damping; the motor acts on the rotor alone */
+        double inverse = 1.0 / m->J_m + 1.0 / J;
+        rate += sqrt(m->k_shaft * inverse) + m->d_shaft * inverse;
+        J = m->J_m;
+    }
     if (m->L > 0.0) {
         if (electrical)
             rate += electrical_rate(m, J);
@@ -40,5 +45,5 @@ double cam_torque_gain(const CamModel *m, const CamMode *mode, const double x[CA
 {
     double d[4];
     cam_profile_eval(&m->profile, x[CAM_THETA], d);
-    return m->c_m / (m->J_m + (mode->contact != 0 ? m->m * d[1] * d[1] : 0.0));
+    return m->c_m / (m->J_0 + (mode->contact != 0 ? m->m * d[1] * d[1] : 0.0));
 }

@@ -76,27 +76,27 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
     int i, slot, s = t->stages, idx[CAM_MAX_STAGES + 1], count;
     for (i = 1; i < s; i++) {
         count = nonzero(t->a[i], i, idx);
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             arg[slot] = combine(t->a[i], idx, count, w->k, slot, x[slot], h);
         cam_rhs(m, mode, arg, u, w->k[i]);
     }
     count = nonzero(t->b, s, idx);
     if (t->b_divisor > 0.0) {   /* x + (h / d) * (b_1 k_1 + ...): the weights' common factor first */
         double scaled = h / t->b_divisor;
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             w->x_new[slot] = x[slot] + scaled * combine(t->b, idx, count, w->k, slot, 0.0, 1.0);   /* 0 + 1 sum */
     } else {
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             w->x_new[slot] = combine(t->b, idx, count, w->k, slot, x[slot], h);
     }
     if (t->fsal) {
         cam_rhs(m, mode, w->x_new, u, w->k[s]);
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             w->f_new[slot] = w->k[s][slot];
     }
     if (method->adaptive) {   /* the error h * sum e_j k_j, the FSAL stage included */
         count = nonzero(t->e, s + (t->fsal ? 1 : 0), idx);
-        for (slot = 0; slot < CAM_NX; slot++)
+        for (slot = 0; slot < m->slots; slot++)
             w->error[slot] = combine(t->e, idx, count, w->k, slot, 0.0, h);
     }
 }
@@ -105,7 +105,9 @@ double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWo
 {
     double total = 0.0, scale, atol = m->atol, rtol = m->rtol;
     int slot;
-    for (slot = 0; slot < m->nx; slot++) {
+    for (slot = 0; slot < m->slots; slot++) {
+        if (slot == CAM_CURRENT && !m->has_current)
+            continue;   /* quasi-static: no state */
         scale = fabs(w->x_new[slot]) > fabs(x[slot]) ? fabs(w->x_new[slot]) : fabs(x[slot]);
         if (slot == CAM_THETA && TWO_PI < scale)   /* theta enters the physics mod 2 pi */
             scale = TWO_PI;

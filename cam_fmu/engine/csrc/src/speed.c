@@ -110,7 +110,7 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
     return CAM_OK;
 }
 
-/* speed.speed_drive_outputs: c_m i = J_m omega_dot + M; the voltage adds L di/dt, di/dt = omega dM/dtheta
+/* speed.speed_drive_outputs: c_m i = J_0 omega_dot + M (J_0 = J_m + J_cam); the voltage adds L di/dt, di/dt = omega dM/dtheta
  * at constant speed (central difference, 1e-6 rad). */
 static void speed_outputs(CamDrive *d, double out[])
 {
@@ -121,7 +121,7 @@ static void speed_outputs(CamDrive *d, double out[])
     int on = engaged(m, theta, st->s, omega, omega_dot);
     direction = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
     cam_load(m, theta, omega, omega_dot, direction, on, &load);
-    i = (m->J_m * omega_dot + load.M) / m->c_m;
+    i = (m->J_0 * omega_dot + load.M) / m->c_m;
     voltage = m->R * i + m->c_e * omega;
     if (m->L > 0.0 && omega != 0.0) {
         double step = 1e-6, dM;

@@ -94,6 +94,8 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
     memcpy(d->x, s + CAM_S_X, sizeof d->x);
     if (!d->model.has_current)
         d->x[CAM_CURRENT] = 0.0;
+    if (!d->model.compliant)
+        d->x[CAM_TWIST] = d->x[CAM_OMEGA_M] = 0.0;
     d->mode = mode;
     d->form_u = s[CAM_S_FORM_U];
     d->paper.theta = s[CAM_S_PAPER + 0];
@@ -113,8 +115,7 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
     d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
     if (d->have_budget) {
         const double *out = cam_drive_outputs(d);
-        cam_energy_init(&d->budget, &d->model, out[CAM_O_THETA], out[CAM_O_OMEGA], out[CAM_O_I], out[CAM_O_S],
-                        out[CAM_O_J]);
+        cam_energy_init(&d->budget, &d->model, out);
         d->budget.work_in = s[CAM_S_WORK_IN];
         d->budget.work_abs = s[CAM_S_WORK_ABS];
         d->budget.theta = s[CAM_S_BUDGET_THETA];

@@ -9,7 +9,7 @@ int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EV
 {
     int n = 0;
     if (mode->stuck) {
-        if (m->has_current)
+        if (m->has_current || m->compliant)   /* the torque on the held cam changes: a current, a shaft */
             codes[n++] = CAM_EV_BREAK_AWAY;
     } else if (m->backlash && mode->contact == 0) {
         codes[n++] = CAM_EV_STOP;
@@ -36,9 +36,8 @@ int cam_engaged_toward(const CamModel *m, const CamMode *mode, double theta, dou
     return !(mode->contact * d[1] * direction < 0.0);
 }
 
-double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double i, double u)
+double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double torque)
 {
-    double torque = cam_torque(m, 0.0, i, u);
     double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, cam_engaged_toward(m, mode, theta, 1.0), 0.0);
     double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, cam_engaged_toward(m, mode, theta, -1.0), 0.0);
     return backward > forward ? backward : forward;
@@ -46,14 +45,15 @@ double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta
 
 double cam_event_value(const CamModel *m, const CamMode *mode, int code, const double x[CAM_NX], double u)
 {
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], d[4];
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], d[4];
     if (code == CAM_EV_STOP)
         return omega * mode->direction;
     if (code == CAM_EV_SIDE)
-        return mode->side * cam_side_force(m, theta, omega, cam_torque(m, omega, i, u), mode->direction, mode->side)
+        return mode->side * cam_side_force(m, theta, omega, cam_drive_torque(m, x, omega, u), mode->direction,
+                                           mode->side)
                + CAM_SIDE_HYSTERESIS;
     if (code == CAM_EV_BREAK_AWAY)
-        return -cam_breakaway_margin(m, mode, theta, i, u);
+        return -cam_breakaway_margin(m, mode, theta, cam_drive_torque(m, x, 0.0, u));
     cam_profile_eval(&m->profile, theta, d);
     if (code == CAM_EV_ENGAGE_UP)
         return mode->s_free - (d[0] - m->c);
@@ -69,6 +69,8 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
     x[CAM_THETA] = theta0;
     x[CAM_OMEGA] = omega0;
     x[CAM_CURRENT] = m->has_current ? i0 : 0.0;
+    x[CAM_TWIST] = 0.0;   /* a compliant shaft starts relaxed, the rotor at the cam's speed */
+    x[CAM_OMEGA_M] = m->compliant ? omega0 : 0.0;
     mode->stuck = omega0 == 0.0;
     mode->direction = omega0 >= 0.0 ? 1.0 : -1.0;
     mode->contact = 1;
@@ -85,7 +87,7 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
 void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], double u)
 {
     if (m->guide_side && mode->contact != 0 && !mode->stuck) {
-        double n_r = cam_side_force(m, x[CAM_THETA], x[CAM_OMEGA], cam_torque(m, x[CAM_OMEGA], x[CAM_CURRENT], u),
+        double n_r = cam_side_force(m, x[CAM_THETA], x[CAM_OMEGA], cam_drive_torque(m, x, x[CAM_OMEGA], u),
                                     mode->direction, 0.0);
         if (fabs(n_r) > CAM_SIDE_HYSTERESIS)
             mode->side = n_r < 0.0 ? -1.0 : 1.0;
@@ -97,7 +99,7 @@ void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], d
  * toward the larger acceleration instead of waiting for the next communication step. */
 static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], double u, int at_threshold)
 {
-    double theta = x[CAM_THETA], torque = cam_torque(m, x[CAM_OMEGA], x[CAM_CURRENT], u), direction, d[4];
+    double theta = x[CAM_THETA], torque = cam_drive_torque(m, x, x[CAM_OMEGA], u), direction, d[4];
     int forward_engaged, backward_engaged, leaves = 0;
     if (!mode->stuck) {
         if (x[CAM_OMEGA] != 0.0)
@@ -116,10 +118,10 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
     if (direction == 0.0 && at_threshold) {
         double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, forward_engaged, 0.0);
         double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, backward_engaged, 0.0);
-        if (forward == backward && m->has_current) {
-            /* a tie (no shaft friction, zero torque as the current passes through 0): the shaft goes
-             * where the current is heading */
-            double rate = (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
+        if (forward == backward && (m->has_current || m->compliant)) {
+            /* a tie (no shaft friction, zero torque as the current or the twist passes through 0): the
+             * shaft goes where the torque is heading */
+            double rate = m->compliant ? x[CAM_OMEGA_M] : (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
             direction = rate > 0.0 ? 1.0 : (rate < 0.0 ? -1.0 : 0.0);
         } else {
             direction = forward >= backward ? 1.0 : -1.0;
@@ -170,10 +172,11 @@ void cam_apply_event(const CamModel *m, CamMode *mode, double x[CAM_NX], int cod
         mode->s_free = d[0] - m->c * mode->contact;
         mode->contact = 0;
         break;
-    default:   /* ENGAGE_UP, ENGAGE_DOWN: a plastic impact keeps the generalised momentum J_m omega */
+    default:   /* ENGAGE_UP, ENGAGE_DOWN: a plastic impact keeps the generalised momentum J_0 omega of the
+                * cam side (a compliant shaft's rotor is not in the impact: the shaft's torque is finite) */
         mode->contact = code == CAM_EV_ENGAGE_UP ? 1 : -1;
         cam_profile_eval(&m->profile, x[CAM_THETA], d);
-        x[CAM_OMEGA] = m->J_m * x[CAM_OMEGA] / (m->J_m + m->m * d[1] * d[1]);
+        x[CAM_OMEGA] = m->J_0 * x[CAM_OMEGA] / (m->J_0 + m->m * d[1] * d[1]);
         cam_choose_side(m, mode, x, u);
         break;
     }
