@@ -12,10 +12,14 @@ import pytest
 from cam_fmu.engine.simulator import CamError, _set_parameter, engine, raise_for
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.formulations.consistent import HybridDrive, Mode
+from cam_fmu.physics.variables import OUTPUT_NAMES
 
-D3 = ctypes.c_double * 3
+D3 = ctypes.c_double * 5  # CAM_NX: the rigid slots and a compliant shaft's two
+NO = len(OUTPUT_NAMES)
 DRIVES = [{}, {"c": 5e-4}, {"L": 1e-3}, {"gamma": 1.5707963267948966, "beta": 3.141592653589793, "mu": 0.05},
-          {"c": 1e-3, "L": 1e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0, "M_f": 0.0}]
+          {"c": 1e-3, "L": 1e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0, "M_f": 0.0},
+          {"k_shaft": 40.0, "d_shaft": 0.01, "J_cam": 2e-5},
+          {"k_shaft": 5e3, "J_cam": 1e-4, "L": 1e-3, "c": 5e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0}]
 EVENTS = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
 
 
@@ -40,7 +44,7 @@ class CModel:
                "cam_profile_rate": (ctypes.c_double, [ctypes.c_void_p, D3]),
                "cam_torque_gain": (ctypes.c_double, [ctypes.c_void_p, ctypes.c_void_p, D3]),
                "cam_outputs": (None, [ctypes.c_void_p, ctypes.c_void_p, D3, ctypes.c_double, ctypes.c_double,
-                                      ctypes.c_int, ctypes.c_double * 11])}
+                                      ctypes.c_int, ctypes.c_double * NO])}
         for name, (restype, argtypes) in sig.items():
             getattr(lib, name).restype, getattr(lib, name).argtypes = restype, argtypes
         err = CamError()
@@ -66,7 +70,8 @@ def _states(model: DriveModel, seed: int, n: int = 60):
     rng = random.Random(seed)
     for _ in range(n):
         theta = rng.uniform(-20.0, 20.0)
-        y = [theta, rng.choice([0.0, rng.uniform(-300.0, 300.0)]), rng.uniform(-3.0, 3.0)]
+        y = [theta, rng.choice([0.0, rng.uniform(-300.0, 300.0)]), rng.uniform(-3.0, 3.0), rng.uniform(-0.01, 0.01),
+             rng.uniform(-300.0, 300.0)]
         s = model.program.derivatives(theta)[0]
         contact = rng.choice([-1, 0, 1]) if model.c > 0.0 else 1
         mode = Mode(stuck=rng.random() < 0.2, direction=rng.choice([1.0, -1.0]), contact=contact,
@@ -79,7 +84,11 @@ def test_the_contract_functions_give_the_python_models_bits(params):
     model, c = DriveModel(params), CModel(params)
     hybrid, lib = HybridDrive(model), c.lib
     for k, (y, mode, u) in enumerate(_states(model, seed=len(params))):
-        x = D3(*y) if hybrid.has_current else D3(y[0], y[1], 0.0)
+        if not hybrid.has_current:
+            y[2] = 0.0
+        if mode.stuck and hybrid.compliant:  # a held cam's speed is 0 (a stop event sets it)
+            y[1] = 0.0
+        x = D3(*y) if hybrid.compliant else D3(*y[:3], 0.0, 0.0)
         yy = y[:hybrid.size]
         m = _mode(mode)
         dx = D3()
@@ -93,7 +102,7 @@ def test_the_contract_functions_give_the_python_models_bits(params):
                 == hybrid.stiffness_rate(yy, mode, bool(electrical))
         assert lib.cam_profile_rate(c.buf, x) == hybrid.profile_rate(yy)
         assert lib.cam_torque_gain(c.buf, ctypes.byref(m), x) == hybrid.torque_gain(yy, mode)
-        out = (ctypes.c_double * 11)()
+        out = (ctypes.c_double * NO)()
         lib.cam_outputs(c.buf, ctypes.byref(m), x, u, 0.0, 0, out)
         assert list(out) == list(hybrid.outputs(yy, u, mode).values())
         for name in names + ("stop",):  # the transitions, in place on copies of the same state and mode

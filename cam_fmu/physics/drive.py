@@ -67,6 +67,24 @@ def check_self_locking(program: ProgramBase, mu: float, r_b: float) -> None:
             f"(lower mu below {1.0 / math.tan(alpha):.4g} or raise r_b)")
 
 
+def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
+    """Raise ParameterError where a compliant shaft (k_shaft > 0) cannot be modelled (docs/model.md 12)."""
+    k = f"parameter 'k_shaft' = {p['k_shaft']!r} N.m/rad"
+    if not J_0 > 0.0:
+        raise ParameterError(f"parameter 'J_cam' = {p['J_cam']!r} [kg.m2]: a compliant shaft (k_shaft = "
+                             f"{p['k_shaft']!r} N.m/rad) needs the inertia of its cam side; allowed with k_shaft > 0: "
+                             "J_cam in (0, 100] kg.m2")
+    if p["drive"] == "speed":
+        raise ParameterError(f"{k}: the speed drive imposes the cam's speed on a rigid drive-train; "
+                             "allowed with drive 'speed': k_shaft = 0")
+    if p["formulation"] == "paper":
+        raise ParameterError(f"{k}: the paper's algorithm models a rigid drive-train; allowed with formulation "
+                             "'paper': k_shaft = 0 (use formulation 'consistent')")
+    if p["solver"] == "etdrk4":
+        raise ParameterError(f"{k}: solver 'etdrk4' integrates the rigid drive's electrical pole; allowed with "
+                             "solver 'etdrk4': k_shaft = 0 (use solver 'rk45')")
+
+
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
     """The cam program the parameters describe: the user's motion table, else laws and angles.
 
@@ -89,13 +107,13 @@ def build_program(p: Mapping[str, Any]) -> ProgramBase:
 class GuideTerms:
     """The coupled friction problem of docs/model.md 4.4 at one instant (SI units)."""
 
-    J: float  # kg m2, equivalent inertia J_m + m s'^2
+    J: float  # kg m2, equivalent inertia J_0 + m s'^2 (J_0: what turns with the cam)
     s1: float  # m/rad, ds/dtheta
     x0: float  # rad/s2, omega_dot without guide friction
     sigma: float  # sgn(v): the direction the friction opposes
     f: float  # N, guide friction force (0 without guide friction)
     n0: float  # N, side force N_r without friction: N_r = n0 + sigma kappa f
-    kappa: float  # (J_m / J) tan(alpha)
+    kappa: float  # (J_0 / J) tan(alpha)
 
 
 @dataclass
@@ -104,7 +122,7 @@ class LoadState:
 
     omega_dot: float  # rad/s2
     M: float  # N m, total load torque on the shaft: M_f sgn(omega) + M_l
-    J: float  # kg m2, equivalent inertia
+    J: float  # kg m2, equivalent inertia of what turns with the cam: J_0 + m s'^2
     f: float  # N, guide friction force
     v: float  # m/s, follower velocity
     a: float  # m/s2, follower acceleration
@@ -125,6 +143,12 @@ class DriveModel:
         self.c_m = p["c_m"]
         self.motor = Motor(self.R, self.L, self.c_e, self.c_m)
         self.J_m = p["J_m"]
+        # The drive-train (docs/model.md section 12): k_shaft = 0 is rigid, J_cam then adds to the rotor's
+        # J_m; k_shaft > 0 puts a torsional spring-damper between the rotor J_m and the cam side J_cam.
+        self.k_shaft = p["k_shaft"]
+        self.d_shaft = p["d_shaft"]
+        self.compliant = self.k_shaft > 0.0
+        self.J_0 = p["J_cam"] if self.compliant else self.J_m + p["J_cam"]  # kg m2, turning with the cam
         self.M_f = p["M_f"] if p["shaft_friction"] else 0.0
         self.m = p["m"] if p["follower_inertia"] else 0.0
         G = p["G"] if p["gravity"] else 0.0
@@ -138,6 +162,8 @@ class DriveModel:
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
+        if self.compliant:
+            check_compliant(p, self.J_0)
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
 
@@ -151,7 +177,7 @@ class DriveModel:
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         m = self.m
-        J = self.J_m + m * s1 * s1
+        J = self.J_0 + m * s1 * s1
         inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
         x0 = (drive - inertial * s1) / J
         if self.mu == 0.0:
@@ -159,7 +185,7 @@ class DriveModel:
         sigma = sign(s1 * direction)
         tan_a = s1 / (self.r_b + s)
         n0 = (inertial + m * s1 * x0) * tan_a + self.G_y
-        kappa = self.J_m / J * tan_a
+        kappa = self.J_0 / J * tan_a
         f = solve_guide_friction(n0, kappa, sigma, self.mu, self.N_g, side)
         return GuideTerms(J, s1, x0, sigma, f, n0, kappa)
 
@@ -168,7 +194,8 @@ class DriveModel:
         """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5.1).
 
         omega_dot = (c_m i - M_f d - (m s'' omega^2 - F_gx) s' - sigma f s') / (J_m + m s'^2).
-        ``torque`` is the motor torque c_m i [N m]; ``direction`` is sgn(omega),
+        ``torque`` is the torque that drives the cam [N m]: the motor's c_m i, or a compliant shaft's;
+        J_m reads J_0 (the inertia turning with the cam); ``direction`` is sgn(omega),
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
         False means the follower is free in the backlash gap (J = J_m, no load).
         ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
@@ -176,7 +203,7 @@ class DriveModel:
         """
         drive = torque - self.M_f * direction
         if not (engaged and self.follower):
-            return drive / self.J_m
+            return drive / self.J_0
         g = self.guide_terms(theta, omega, drive, direction, side)
         if self.mu == 0.0:
             return g.x0
@@ -207,14 +234,14 @@ class DriveModel:
         shaft = self.M_f * direction
         alpha = math.atan(tan_a)
         if not engaged:
-            return LoadState(omega_dot, shaft, self.J_m, 0.0, 0.0, 0.0, alpha, s)
+            return LoadState(omega_dot, shaft, self.J_0, 0.0, 0.0, 0.0, alpha, s)
         v = s1 * omega
         a = s2 * omega * omega + s1 * omega_dot
         sigma = sign(s1 * direction)
         push = self.m * a - self.F_gx  # N, axial force without friction
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
         M = shaft + (push + sigma * f) * s1
-        J = self.J_m + self.m * s1 * s1
+        J = self.J_0 + self.m * s1 * s1
         return LoadState(omega_dot, M, J, f, v, a, alpha, s)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True,
@@ -236,9 +263,9 @@ class DriveModel:
         return 0.0
 
     def energy(self, theta: float, omega: float, i: float, engaged: bool = True) -> float:
-        """Stored energy [J]: kinetic + gravity potential (along X) + magnetic."""
+        """Stored energy [J] of a rigid drive: kinetic + gravity potential (along X) + magnetic."""
         s, s1, _, _ = self.program.derivatives(theta)
-        J = self.J_m + (self.m * s1 * s1 if engaged else 0.0)
+        J = self.J_0 + (self.m * s1 * s1 if engaged else 0.0)
         return 0.5 * J * omega * omega - self.F_gx * s + 0.5 * self.L * i * i
 
 

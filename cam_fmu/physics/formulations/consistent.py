@@ -1,7 +1,9 @@
 """The consistent cam drive as a hybrid system: continuous states, modes, events.
 
 Continuous state y = (theta [rad], omega [rad/s]) and, when L > 0, i [A]
-(slots THETA, OMEGA, CURRENT).
+(slots THETA, OMEGA, CURRENT); a compliant shaft (k_shaft > 0, docs/model.md section 12)
+adds its twist theta_m - theta [rad] and the rotor's speed omega_m [rad/s] (slots TWIST,
+OMEGA_M; the CURRENT slot is then always there, constant with L = 0).
 Discrete mode: stuck (shaft held by static friction), direction of motion,
 backlash contact (+1: the cam drives the follower up, -1: down, 0: free in the
 gap) and the follower's position while free. The scipy reference integrates
@@ -22,7 +24,7 @@ from typing import Any
 from ..drive import DriveModel
 from ..variables import output_record
 
-THETA, OMEGA, CURRENT = 0, 1, 2  # slots of the continuous state y
+THETA, OMEGA, CURRENT, TWIST, OMEGA_M = 0, 1, 2, 3, 4  # slots of the continuous state y
 # The events of the hybrid system (docs/model.md section 10); an engine's event codes index this tuple.
 EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
 STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES
@@ -57,16 +59,17 @@ class HybridDrive:
         self.motor = model.motor
         self.has_current = model.L > 0.0
         self.backlash = model.c > 0.0
-        self.size = 3 if self.has_current else 2
+        self.compliant = model.compliant
+        self.size = 5 if self.compliant else (3 if self.has_current else 2)
         self.guide_side = model.mu > 0.0 and model.follower  # the side force's sign is an event
         # theta enters the physics mod 2 pi: its error is scaled by at most 2 pi
-        self.error_caps = (2.0 * math.pi, math.inf, math.inf)[: self.size]
+        self.error_caps = (2.0 * math.pi, math.inf, math.inf, math.inf, math.inf)[: self.size]
         self.feature_angle = model.program.feature_angle()  # rad
 
     # ------------------------------------------------------------ set-up
     def initial(self, theta0: float, omega0: float, i0: float) -> tuple[list[float], Mode]:
         """Initial state and mode (from rest: stuck until ``settle`` lets it go)."""
-        y = [theta0, omega0, i0][: self.size]
+        y = [theta0, omega0, i0 if self.has_current else 0.0, 0.0, omega0][: self.size]
         mode = Mode(stuck=omega0 == 0.0, direction=1.0 if omega0 >= 0.0 else -1.0)
         if self.backlash:
             # The paper's step 1: the follower starts where the cam is, centred in the gap.
@@ -74,15 +77,27 @@ class HybridDrive:
             mode.s_free = self.model.program.derivatives(theta0)[0]
         return y, mode
 
+    def motor_speed(self, y) -> float:
+        """The rotor's speed [rad/s]: the cam's, or omega_m beyond a compliant shaft."""
+        return y[OMEGA_M] if self.compliant else y[OMEGA]
+
     def torque(self, y, u: float) -> float:
         """Motor torque c_m i [N m]."""
         if self.has_current:
             return self.motor.c_m * y[CURRENT]
-        return self.motor.quasi_static_torque(u, y[OMEGA])
+        return self.motor.quasi_static_torque(u, self.motor_speed(y))
+
+    def drive_torque(self, y, u: float, omega: float) -> float:
+        """The torque that drives the cam [N m]: the motor's, or the compliant shaft's
+        k twist + d (omega_m - omega) with omega the cam's speed (0 while it is held)."""
+        if self.compliant:
+            model = self.model
+            return model.k_shaft * y[TWIST] + model.d_shaft * (y[OMEGA_M] - omega)
+        return self.torque(y, u)
 
     def current(self, y, u: float) -> float:
         """Armature current [A]: the state, or quasi-static with L = 0."""
-        return y[CURRENT] if self.has_current else self.motor.quasi_static_current(u, y[OMEGA])
+        return y[CURRENT] if self.has_current else self.motor.quasi_static_current(u, self.motor_speed(y))
 
     # -------------------------------------------------------- continuous
     def derivative(self, y, u: float, mode: Mode) -> tuple[float, ...]:
@@ -96,6 +111,8 @@ class HybridDrive:
         right-hand-side evaluation is one call into DriveModel.omega_dot. Build
         it again after the mode changes (an event).
         """
+        if self.compliant:
+            return self._compliant_rhs(u, mode)
         model, motor = self.model, self.motor
         c_m = motor.c_m
         current_rate, quasi_static_torque = motor.current_rate, motor.quasi_static_torque
@@ -119,8 +136,29 @@ class HybridDrive:
             return (omega, omega_dot(y[THETA], omega, quasi_static_torque(u, omega), direction, engaged, side))
         return quasi_static_current
 
+    def _compliant_rhs(self, u: float, mode: Mode):
+        """dy/dt of the two-mass drive: the cam side as the rigid drive's under the shaft's torque, the rotor
+        J_m omega_m' = c_m i - M_shaft, the twist's rate omega_m - omega (docs/model.md section 12)."""
+        model, motor, hybrid = self.model, self.motor, self
+        direction, engaged = mode.direction, mode.contact != 0
+        side = mode.side if self.guide_side else 0.0
+        stuck, has_current = mode.stuck, self.has_current
+
+        def rhs(y):
+            theta, omega, i, omega_m = y[THETA], y[OMEGA], y[CURRENT], y[OMEGA_M]
+            if stuck:
+                d_theta = d_omega = 0.0  # y[OMEGA] is 0 while stuck
+            else:
+                d_theta = omega
+                d_omega = model.omega_dot(theta, omega, hybrid.drive_torque(y, u, omega), direction, engaged, side)
+            shaft = hybrid.drive_torque(y, u, omega)
+            d_omega_m = (hybrid.torque(y, u) - shaft) / model.J_m
+            d_i = (u - model.R * i - model.c_e * omega_m) / model.L if has_current else 0.0
+            return (d_theta, d_omega, d_i, omega_m - omega, d_omega_m)
+        return rhs
+
     def stuck_state(self, y, u: float, dt: float) -> list[float]:
-        """y after dt [s] held by static friction: only i moves (exactly, toward u / R)."""
+        """y after dt [s] held by static friction, rigid drive: only i moves (exactly, toward u / R)."""
         return [y[THETA], 0.0, self.motor.current_at_rest(y[CURRENT], u, dt)]
 
     def stiffness_rate(self, y, mode: Mode, electrical: bool) -> float:
@@ -134,12 +172,16 @@ class HybridDrive:
         model = self.model
         s, s1, s2, s3 = model.program.derivatives(y[THETA])
         engaged = mode.contact != 0
-        J = model.J_m + (model.m * s1 * s1 if engaged else 0.0)
+        J = model.J_0 + (model.m * s1 * s1 if engaged else 0.0)
         omega = y[OMEGA]
         rate = 0.0
         if engaged:
             rate = (2.0 * model.m * abs(s1 * s2 * omega)
                     + abs(omega) * math.sqrt(model.m * J * (s2 * s2 + abs(s1 * s3)))) / J
+        if self.compliant:  # the two-mass oscillation and its damping; the motor acts on the rotor alone
+            inverse = 1.0 / model.J_m + 1.0 / J
+            rate += math.sqrt(model.k_shaft * inverse) + model.d_shaft * inverse
+            J = model.J_m
         if model.L > 0.0:
             if electrical:
                 rate += self.motor.electrical_rate(J)
@@ -155,7 +197,7 @@ class HybridDrive:
         """d(omega_dot)/d(i) = c_m / J [1/(A s2)] at y."""
         model = self.model
         s1 = model.program.derivatives(y[THETA])[1]
-        return model.c_m / (model.J_m + (model.m * s1 * s1 if mode.contact != 0 else 0.0))
+        return model.c_m / (model.J_0 + (model.m * s1 * s1 if mode.contact != 0 else 0.0))
 
     def first_breakpoint_passed(self, start: float, end: float) -> float | None:
         """The first profile breakpoint [rad] strictly between two angles, or None."""
@@ -163,8 +205,8 @@ class HybridDrive:
 
     # ------------------------------------------------------------ events
     def event_names(self, mode: Mode) -> tuple[str, ...]:
-        if mode.stuck:
-            return (BREAK_AWAY,) if self.has_current else ()
+        if mode.stuck:  # the torque on the held cam changes with a current or a shaft
+            return (BREAK_AWAY,) if self.has_current or self.compliant else ()
         side = (SIDE,) if self.guide_side and mode.contact != 0 else ()
         if not self.backlash:
             return (STOP,) + side
@@ -175,7 +217,7 @@ class HybridDrive:
     def event_values(self, y, u: float, mode: Mode) -> tuple[float, ...]:
         """Values of the active event functions (> 0: nothing happens)."""
         if mode.stuck:
-            if not self.has_current:
+            if not (self.has_current or self.compliant):
                 return ()
             return (-self._breakaway_margin(y, u, mode),)
         stop = y[OMEGA] * mode.direction
@@ -193,13 +235,14 @@ class HybridDrive:
     def _side_value(self, y, u: float, mode: Mode, side: float | None = None) -> float:
         """mode.side times the side force N_r [N] on that branch: > 0 while the branch holds."""
         side = mode.side if side is None else side
-        return side * self.model.side_force(y[THETA], y[OMEGA], self.torque(y, u), mode.direction, side) \
+        return side * self.model.side_force(y[THETA], y[OMEGA], self.drive_torque(y, u, y[OMEGA]), mode.direction,
+                                            side) \
             + SIDE_HYSTERESIS
 
     def _choose_side(self, y, u: float, mode: Mode) -> None:
         """The friction branch of the current state (where N_r = 0, the one it moves into)."""
         if self.guide_side and mode.contact != 0 and not mode.stuck:
-            n_r = self.model.side_force(y[THETA], y[OMEGA], self.torque(y, u), mode.direction)
+            n_r = self.model.side_force(y[THETA], y[OMEGA], self.drive_torque(y, u, y[OMEGA]), mode.direction)
             if abs(n_r) > SIDE_HYSTERESIS:
                 mode.side = -1.0 if n_r < 0.0 else 1.0
 
@@ -215,7 +258,7 @@ class HybridDrive:
 
     def _breakaway_margin(self, y, u: float, mode: Mode) -> float:
         """> 0 when the shaft would start moving from rest [rad/s2], each direction with its own engagement."""
-        model, torque = self.model, self.torque(y, u)
+        model, torque = self.model, self.drive_torque(y, u, 0.0)
         forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, self._engaged_toward(y[THETA], mode, 1.0))
         backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, self._engaged_toward(y[THETA], mode, -1.0))
         return max(forward, backward)
@@ -240,8 +283,9 @@ class HybridDrive:
         else:
             mode.contact = 1 if name == ENGAGE_UP else -1
             s1 = model.program.derivatives(y[THETA])[1]
-            # Plastic impact: generalised momentum J_m omega (+ m s' v = 0 before) is kept.
-            y[OMEGA] = model.J_m * y[OMEGA] / (model.J_m + model.m * s1 * s1)
+            # Plastic impact: generalised momentum J_0 omega (+ m s' v = 0 before) is kept; a compliant
+            # shaft's rotor is not in it (the shaft's torque is finite).
+            y[OMEGA] = model.J_0 * y[OMEGA] / (model.J_0 + model.m * s1 * s1)
             self._choose_side(y, u, mode)
 
     def settle(self, y, u: float, mode: Mode, at_threshold: bool = False) -> None:
@@ -257,7 +301,7 @@ class HybridDrive:
         instead of waiting for the next communication step.
         """
         model = self.model
-        torque = self.torque(y, u)
+        torque = self.drive_torque(y, u, y[OMEGA])
         if not mode.stuck:
             if y[OMEGA] != 0.0:
                 return
@@ -276,11 +320,11 @@ class HybridDrive:
         if direction == 0.0 and at_threshold:
             forward = model.omega_dot(y[THETA], 0.0, torque, 1.0, forward_engaged)
             backward = -model.omega_dot(y[THETA], 0.0, torque, -1.0, backward_engaged)
-            if forward == backward and self.has_current:
-                # A tie (no shaft friction, zero torque as the current passes through 0): the
-                # shaft goes where the current is heading. Taking +1 here made the reference
+            if forward == backward and (self.has_current or self.compliant):
+                # A tie (no shaft friction, zero torque as the current or the twist passes through 0):
+                # the shaft goes where the torque is heading. Taking +1 here made the reference
                 # chatter forever between the break-away and a stop at one instant.
-                rate = self.motor.current_rate(u, y[CURRENT], 0.0)
+                rate = y[OMEGA_M] if self.compliant else self.motor.current_rate(u, y[CURRENT], 0.0)
                 direction = 1.0 if rate > 0.0 else (-1.0 if rate < 0.0 else 0.0)
             else:
                 direction = 1.0 if forward >= backward else -1.0
@@ -314,12 +358,19 @@ class HybridDrive:
         engaged = mode.contact != 0
         if mode.stuck:
             load = model.load(theta, 0.0, 0.0, 0.0, engaged)
-            load.M = model.c_m * i  # static friction takes whatever the motor applies
+            # static friction takes whatever the motor (or the shaft) applies
+            load.M = self.drive_torque(y, u, 0.0) if self.compliant else model.c_m * i
             load.v = load.a = 0.0
         else:
             if omega_dot is None:
                 omega_dot = self.derivative(y, u, mode)[1]
             load = model.load(theta, omega, omega_dot, mode.direction, engaged)
         s = load.s_cam - model.c * mode.contact if engaged else mode.s_free
-        return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
-                             alpha=load.alpha, s_cam=load.s_cam, voltage=u)
+        rotor = dict(theta_m=theta, omega_m=omega, M_shaft=0.0)  # rigid: the rotor turns with the cam
+        J = load.J
+        if self.compliant:  # J counts the rotor too, as a rigid drive's does
+            J = load.J + model.J_m
+            rotor = dict(theta_m=theta + y[TWIST], omega_m=y[OMEGA_M],
+                         M_shaft=self.drive_torque(y, u, 0.0 if mode.stuck else omega))
+        return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=J, v=load.v, a=load.a,
+                             alpha=load.alpha, s_cam=load.s_cam, voltage=u, **rotor)

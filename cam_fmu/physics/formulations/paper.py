@@ -35,7 +35,7 @@ class PaperScheme:
         self.theta = theta0
         self.omega = omega0
         self.i = i0 if model.L > 0.0 else 0.0
-        self.J = model.J_m
+        self.J = model.J_0
         self.M = model.M_f if omega0 >= 0.0 else -model.M_f
         self.s = model.program.derivatives(theta0)[0]
         self.v = 0.0
@@ -109,14 +109,15 @@ class PaperScheme:
         f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g)
         self.M_l = (push + sigma * f) * X
         # Step 8: eq. (4).
-        self.J = model.J_m + model.m * X * X
+        self.J = model.J_0 + model.m * X * X
         self.M = model.M_f * sign(self.omega) + self.M_l
         return n
 
     def outputs(self) -> dict[str, float]:
         s_cam = self.model.program.derivatives(self.theta)[0]
         return output_record(omega=self.omega, theta=self.theta, s=self.s, i=self.i, M=self.M, J=self.J,
-                             v=self.v, a=self.a, alpha=self.alpha, s_cam=s_cam, voltage=self.voltage)
+                             v=self.v, a=self.a, alpha=self.alpha, s_cam=s_cam, voltage=self.voltage,
+                             theta_m=self.theta, omega_m=self.omega, M_shaft=0.0)  # a rigid drive-train
 
 
 def rk4_substeps(model: DriveModel, J: float, T: float) -> int:

@@ -12,13 +12,13 @@ from ..variables import output_record
 def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot: float, s: float, engaged: bool) -> dict[str, float]:
     """Torque, inertia, current and voltage needed for a given motion.
 
-    c_m i = J_m omega_dot + M (consistent formulation); the voltage adds
+    c_m i = J_0 omega_dot + M, J_0 = J_m + J_cam (consistent formulation); the voltage adds
     L di/dt, with di/dt = omega dM/dtheta at constant speed (central difference,
     1e-6 rad).
     """
     direction = 1.0 if omega > 0.0 else (-1.0 if omega < 0.0 else 0.0)
     load = model.load(theta, omega, omega_dot, direction, engaged)
-    i = (model.J_m * omega_dot + load.M) / model.c_m
+    i = (model.J_0 * omega_dot + load.M) / model.c_m
     voltage = model.motor.voltage(i, omega)
     if model.L > 0.0 and omega != 0.0:
         d = 1e-6
@@ -27,4 +27,5 @@ def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot
         voltage += model.L * omega * dM / model.c_m
     s_cam = model.program.derivatives(theta)[0]
     return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
-                         alpha=load.alpha, s_cam=s_cam, voltage=voltage)
+                         alpha=load.alpha, s_cam=s_cam, voltage=voltage,
+                         theta_m=theta, omega_m=omega, M_shaft=0.0)  # a rigid drive-train
