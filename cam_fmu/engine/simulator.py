@@ -23,13 +23,14 @@ __all__ = ["DriveSimulator", "run_scene"]
 N_OUTPUTS = len(OUTPUT_NAMES)
 MESSAGE_LEN = 1024
 STATE_LEN = 48
+NX, NX_RIGID = 5, 3  # cam_model.h CAM_NX, CAM_NX_RIGID: the state slots (theta, omega, i, twist, omega_m)
 # Slots of the engine's state array (cam_model.h, CAM_S_*).
 (S_VERSION, S_FORMULATION, S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF, S_H_NEXT, S_STEPS_TAKEN, S_X) = range(9)
-S_STUCK = S_X + 3
+S_STUCK = S_X + 5  # CAM_NX slots
 S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE, S_FORM_U, S_HAVE_BUDGET = range(S_STUCK + 1, S_STUCK + 7)
 S_BUDGET = S_HAVE_BUDGET + 1  # work_in, work_abs, theta, i, e_mech0, e_mag0
 BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
-STATE_VERSION = 1.0
+STATE_VERSION = 2.0  # cam_model.h CAM_STATE_VERSION
 
 
 from ..physics.formulations.consistent import EVENT_NAMES  # noqa: E402  (cam_model.h CAM_EV_*, in order)
@@ -45,8 +46,8 @@ class CamMode(ctypes.Structure):
 class CamEventRecord(ctypes.Structure):
     """cam_model.h CamEventRecord: one transition of the consistent formulation."""
 
-    _fields_ = [("code", ctypes.c_int), ("time", ctypes.c_double), ("x_before", ctypes.c_double * 3),
-                ("x_after", ctypes.c_double * 3), ("mode_before", CamMode)]
+    _fields_ = [("code", ctypes.c_int), ("time", ctypes.c_double), ("x_before", ctypes.c_double * NX),
+                ("x_after", ctypes.c_double * NX), ("mode_before", CamMode)]
 
 
 class CamError(ctypes.Structure):
@@ -206,10 +207,16 @@ class DriveSimulator:
         if self._lib.cam_drive_set_state(self._drive, raw, ctypes.byref(self._err)):
             raise_for(self._err)
 
+    def _state_slots(self) -> int:
+        """The slots of x that hold this drive's state: theta, omega (2), i (3), a compliant shaft's twist and
+        omega_m (5, i then 0 with L = 0)."""
+        nx = self._lib.cam_drive_nx(self._drive)
+        return NX if nx > NX_RIGID else nx
+
     def get_state(self) -> dict[str, Any]:
         """Complete internal state, JSON-serialisable (DriveSimulator's keys for the consistent formulation)."""
         s = self.state_array()
-        nx = self._lib.cam_drive_nx(self._drive)
+        nx = self._state_slots()
         state: dict[str, Any] = {
             "time": s[S_TIME], "u": s[S_U], "omega_ref": s[S_OMEGA_REF], "omega_dot_ref": s[S_OMEGA_DOT_REF],
             "h_next": s[S_H_NEXT], "steps_taken": int(s[S_STEPS_TAKEN]),
@@ -227,16 +234,16 @@ class DriveSimulator:
             if not math.isfinite(float(state[key])):
                 raise SimulationError(f"state entry {key!r} = {state[key]!r} is not finite")
         s = self.state_array()
-        nx = self._lib.cam_drive_nx(self._drive)
+        nx = self._state_slots()
         y = [float(v) for v in state["y"]]
         if len(y) != nx:
             raise SimulationError(f"state 'y' has length {len(y)}, this drive's state has {nx} "
-                                  "(theta, omega" + (", i)" if nx == 3 else ")"))
+                                  "(theta, omega" + {2: ")", 3: ", i)", 5: ", i, twist, omega_m)"}[nx])
         mode = state["mode"]
         s[S_TIME], s[S_U], s[S_OMEGA_REF] = float(state["time"]), float(state["u"]), float(state["omega_ref"])
         s[S_OMEGA_DOT_REF], s[S_H_NEXT] = float(state["omega_dot_ref"]), float(state["h_next"])
         s[S_STEPS_TAKEN] = float(int(state["steps_taken"]))
-        s[S_X:S_X + 3] = array("d", y + [0.0] * (3 - nx))
+        s[S_X:S_X + NX] = array("d", y + [0.0] * (NX - nx))
         s[S_STUCK] = 1.0 if mode["stuck"] else 0.0
         s[S_DIRECTION], s[S_CONTACT] = float(mode["direction"]), float(mode["contact"])
         s[S_S_FREE], s[S_SIDE], s[S_FORM_U] = float(mode["s_free"]), float(mode["side"]), float(state["u"])
@@ -254,6 +261,7 @@ class DriveSimulator:
         if lib.cam_event_record_sizeof() != ctypes.sizeof(CamEventRecord):
             raise RuntimeError("the engine's CamEventRecord differs from the binding's")
         total = lib.cam_drive_events_logged(self._drive)
+        slots = NX if lib.cam_drive_nx(self._drive) > NX_RIGID else NX_RIGID  # a compliant shaft's two slots
         out = []
         for k in range(max(0, total - 256), total):
             pointer = lib.cam_drive_event(self._drive, k)
@@ -261,8 +269,8 @@ class DriveSimulator:
                 continue
             r = pointer.contents
             mode = r.mode_before
-            out.append({"index": k, "name": EVENT_NAMES[r.code], "time": r.time, "before": list(r.x_before),
-                        "after": list(r.x_after),
+            out.append({"index": k, "name": EVENT_NAMES[r.code], "time": r.time,
+                        "before": list(r.x_before)[:slots], "after": list(r.x_after)[:slots],
                         "mode_before": {"stuck": bool(mode.stuck), "direction": mode.direction,
                                         "contact": mode.contact, "s_free": mode.s_free, "side": mode.side}})
         return out

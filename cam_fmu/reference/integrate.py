@@ -9,8 +9,9 @@ electrical pole uses Radau (implicit), otherwise DOP853.
 
 Results are a dict of numpy arrays on the output grid: time and the outputs of
 physics.variables.OUTPUTS. With ``energy=True`` four integrals are added [J]:
-E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt and
-E_guide = int f |v| dt, for the power balance.
+E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt,
+E_guide = int f |v| dt and E_damp = int d_shaft (omega_m - omega)^2 dt (a compliant
+shaft's damping), for the power balance.
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 
-ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide")
+ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 
 
 def simulate_reference(
@@ -189,7 +190,9 @@ class _Consistent:
                 i = hybrid.current(state, u_t)
                 omega = 0.0 if mode.stuck else y[1]
                 load = model.load(state[0], omega, dy[1], mode.direction, mode.contact != 0)
-                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), load.f * abs(load.v)]
+                slip = hybrid.motor_speed(state) - omega
+                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), load.f * abs(load.v),
+                       model.d_shaft * slip * slip]
             return dy
 
         return rhs
