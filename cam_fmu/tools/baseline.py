@@ -205,11 +205,14 @@ def _close(a: str, b: str) -> bool:
 
 
 # ------------------------------------------------------------------ files
+# The shipped scenes when the record was made (before the C engine replaced the Python one). Scenes added
+# since (the compliant shaft's) model what the former engine could not: they are checked against the
+# scipy reference instead (tests/test_compliant_shaft.py).
+RECORDED_SCENES = ("backlash", "inductance", "paper_fig4", "paper_fig5a", "paper_fig5b", "paper_fig6",
+                   "speed_drive", "tilted")
 def groups() -> Iterator[tuple[str, list[dict[str, Any]]]]:
     """(file stem, cases): one group per shipped scene, then 'extremes'."""
-    from ..experiments.scenes import scene_names
-
-    for name in scene_names():
+    for name in RECORDED_SCENES:
         yield name, scene_cases(name)
     yield "extremes", extremes_cases()
 

@@ -325,6 +325,8 @@ class HybridDrive:
                 # the shaft goes where the torque is heading. Taking +1 here made the reference
                 # chatter forever between the break-away and a stop at one instant.
                 rate = y[OMEGA_M] if self.compliant else self.motor.current_rate(u, y[CURRENT], 0.0)
+                if self.compliant and rate == 0.0:  # the rotor at rest too: where its acceleration takes the twist
+                    rate = self.torque(y, u) - torque
                 direction = 1.0 if rate > 0.0 else (-1.0 if rate < 0.0 else 0.0)
             else:
                 direction = 1.0 if forward >= backward else -1.0
