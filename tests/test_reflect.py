@@ -78,3 +78,44 @@ def test_the_command_writes_the_map_and_its_json(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "reflect", "paper_fig6", "--rpm", "0", "--out",
                           str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "--rpm" in bad.stderr
+
+
+SHAFT = {"k_shaft": 50.0, "d_shaft": 1e-3, "J_m": 3e-5, "J_cam": 1.41e-5}
+
+
+def _modal_frequencies(k: float, J_m: float, J_c: float) -> tuple[float, float]:
+    """The undamped frequencies [Hz] from the two-mass eigenproblem (numpy), not from the closed form: the
+    nonzero eigenvalue of M^-1 K is the resonance; clamping the rotor leaves k / J_c, the anti-resonance."""
+    stiffness = np.array([[k, -k], [-k, k]])
+    inverse_mass = np.diag([1.0 / J_m, 1.0 / J_c])
+    resonance = max(np.linalg.eigvals(inverse_mass @ stiffness).real)
+    return math.sqrt(resonance) / (2.0 * math.pi), math.sqrt(k / J_c) / (2.0 * math.pi)
+
+
+def test_a_compliant_shaft_maps_the_two_mass_frequencies_over_the_turn():
+    result = reflected_map(SHAFT, 60.0, points=720)
+    for k in range(0, 720, 37):
+        s1 = paper_profile(float(result["theta"][k]))[1]
+        J_c = SHAFT["J_cam"] + DEFAULTS["m"] * s1 * s1
+        assert result["J"][k] == pytest.approx(SHAFT["J_m"] + J_c, rel=1e-12)
+        f_r, f_a = _modal_frequencies(SHAFT["k_shaft"], SHAFT["J_m"], J_c)
+        assert result["f_r"][k] == pytest.approx(f_r, rel=1e-9)
+        assert result["f_a"][k] == pytest.approx(f_a, rel=1e-12)
+    found = summary(reflected_map(SHAFT, 60.0, points=3600), 60.0)
+    J_peak = SHAFT["J_cam"] + DEFAULTS["m"] * (2 * A) ** 2  # where s' = 2 A the follower weighs most
+    assert found["f_a_min"] == pytest.approx(math.sqrt(SHAFT["k_shaft"] / J_peak) / (2 * math.pi), rel=1e-9)
+    assert found["f_a_max"] == pytest.approx(math.sqrt(SHAFT["k_shaft"] / SHAFT["J_cam"]) / (2 * math.pi), rel=1e-12)
+    assert found["theta_f_a_min"] == found["theta_J_max"] and found["theta_f_r_max"] == found["theta_J_min"]
+    assert found["f_r_min"] == pytest.approx(_modal_frequencies(SHAFT["k_shaft"], SHAFT["J_m"], J_peak)[0], rel=1e-9)
+    # f_r / f_a = sqrt(1 + J_c / J_m) everywhere
+    assert np.allclose(result["f_r"] / result["f_a"], np.sqrt(1.0 + (result["J"] - SHAFT["J_m"]) / SHAFT["J_m"]),
+                       rtol=1e-12)
+
+
+def test_the_cli_reports_the_resonance_of_the_shipped_compliant_scene(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "cam_fmu", "reflect", "compliant_shaft", "--json", "--no-plot",
+                           "--out", str(tmp_path)], capture_output=True, text=True, check=True)
+    found = json.loads(done.stdout)
+    assert 200.0 < found["f_r_min"] < found["f_r_max"] < 370.0 and 25.0 < found["f_a_min"] < 26.0
+    header = (tmp_path / "compliant_shaft_reflect.csv").read_text().splitlines()[0]
+    assert header.endswith("f_r [Hz],f_a [Hz]")

@@ -7,7 +7,9 @@ drives and the load torque M(theta) with its inertial, gravity and friction part
 header) and DIR/<scene>_reflect.png, and prints the extremes with the angles where
 they occur; ``--json`` prints them as one JSON object instead (keys J_min, J_max
 [kg m^2], M_min, M_max [N m], f_r_min, f_r_max, f_a_min, f_a_max [Hz], each with its
-theta_<key> [rad]; the resonance keys are null: the drive-train is rigid).
+theta_<key> [rad]; the resonance keys are null when the drive-train is rigid,
+k_shaft = 0). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
+figure a third panel.
 """
 from __future__ import annotations
 
@@ -32,12 +34,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..control.reflect import COLUMNS, UNITS, reflected_map, summary
+    from ..control.reflect import UNITS, reflected_map, summary
     from ..experiments.scenes import find_scene
     from .simulate import apply_sets
 
     scene = apply_sets(find_scene(args.scene), args.set)
     result = reflected_map(scene.primary.params, args.rpm, args.points)
+    columns = list(result)
     extremes = summary(result, args.rpm)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -45,9 +48,9 @@ def run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     csv = out / f"{scene.name}_reflect.csv"
     with csv.open("w", encoding="utf-8") as f:
-        f.write(",".join(f"{name} [{UNITS[name]}]" for name in COLUMNS) + "\n")
+        f.write(",".join(f"{name} [{UNITS[name]}]" for name in columns) + "\n")
         for k in range(len(result["theta"])):
-            f.write(",".join(repr(float(result[name][k])) for name in COLUMNS) + "\n")
+            f.write(",".join(repr(float(result[name][k])) for name in columns) + "\n")
     written = [csv]
     if not args.no_plot:
         from ..plots.reflect import plot_reflected
@@ -61,7 +64,12 @@ def run(args) -> int:
         unit = "kg m^2" if key == "J" else "N m"
         print(f"{key}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} {unit} (min at "
               f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
-    print("resonance: none (the drive-train is rigid)")
+    if extremes["f_r_min"] is None:
+        print("resonance: none (the drive-train is rigid, k_shaft = 0)")
+    else:
+        for key, what in (("f_r", "resonance"), ("f_a", "anti-resonance")):
+            print(f"{what}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} Hz (min at "
+                  f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
     for path in written:
         print(path)
     sys.stdout.flush()
