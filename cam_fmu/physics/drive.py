@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import ParameterError, law_spec, resolve
+from .parameters import RIGID_ONLY, ParameterError, law_spec, resolve
 
 
 def sign(x: float) -> float:
@@ -74,15 +74,9 @@ def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
         raise ParameterError(f"parameter 'J_cam' = {p['J_cam']!r} [kg.m2]: a compliant shaft (k_shaft = "
                              f"{p['k_shaft']!r} N.m/rad) needs the inertia of its cam side; allowed with k_shaft > 0: "
                              "J_cam in (0, 100] kg.m2")
-    if p["drive"] == "speed":
-        raise ParameterError(f"{k}: the speed drive imposes the cam's speed on a rigid drive-train; "
-                             "allowed with drive 'speed': k_shaft = 0")
-    if p["formulation"] == "paper":
-        raise ParameterError(f"{k}: the paper's algorithm models a rigid drive-train; allowed with formulation "
-                             "'paper': k_shaft = 0 (use formulation 'consistent')")
-    if p["solver"] == "etdrk4":
-        raise ParameterError(f"{k}: solver 'etdrk4' integrates the rigid drive's electrical pole; allowed with "
-                             "solver 'etdrk4': k_shaft = 0 (use solver 'rk45')")
+    for (name, choice), (reason, instead) in RIGID_ONLY.items():
+        if p[name] == choice:
+            raise ParameterError(f"{k}: {reason}; allowed with {name} {choice!r}: k_shaft = 0{instead}")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:

@@ -79,6 +79,13 @@ LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table
 FORMULATIONS = ("consistent", "paper")
 DRIVES = ("voltage", "speed")
 SOLVERS = ("euler", "rk4", "rk45", "etdrk4")
+# The choices that model a rigid drive-train only: k_shaft > 0 with one of them is refused, with the reason and
+# what to use instead (docs/model.md section 12.1).
+RIGID_ONLY: dict[tuple[str, str], tuple[str, str]] = {
+    ("drive", "speed"): ("the speed drive imposes the cam's speed on a rigid drive-train", ""),
+    ("formulation", "paper"): ("the paper's algorithm models a rigid drive-train", " (use formulation 'consistent')"),
+    ("solver", "etdrk4"): ("solver 'etdrk4' integrates the rigid drive's electrical pole", " (use solver 'rk45')"),
+}
 EFFECTS = ("shaft_friction", "guide_friction", "gravity", "follower_inertia", "backlash", "inductance")
 
 _P = ParameterSpec
