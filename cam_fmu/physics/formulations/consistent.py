@@ -327,6 +327,8 @@ class HybridDrive:
                 rate = y[OMEGA_M] if self.compliant else self.motor.current_rate(u, y[CURRENT], 0.0)
                 if self.compliant and rate == 0.0:  # the rotor at rest too: where its acceleration takes the twist
                     rate = self.torque(y, u) - torque
+                if self.compliant and rate == 0.0 and self.has_current:  # no torque yet: where the current heads
+                    rate = self.motor.current_rate(u, y[CURRENT], 0.0)
                 direction = 1.0 if rate > 0.0 else (-1.0 if rate < 0.0 else 0.0)
             else:
                 direction = 1.0 if forward >= backward else -1.0

@@ -124,6 +124,8 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
             double rate = m->compliant ? x[CAM_OMEGA_M] : (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
             if (m->compliant && rate == 0.0)   /* the rotor at rest too: where its acceleration takes the twist */
                 rate = cam_torque(m, 0.0, x[CAM_CURRENT], u) - torque;
+            if (m->compliant && rate == 0.0 && m->has_current)   /* no torque yet: where the current heads */
+                rate = (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
             direction = rate > 0.0 ? 1.0 : (rate < 0.0 ? -1.0 : 0.0);
         } else {
             direction = forward >= backward ? 1.0 : -1.0;

@@ -1,0 +1,36 @@
+"""The frequency response's figure: gain and phase of u -> omega_m and u -> omega over f (Agg backend)."""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+
+def plot_bode(measured: Any, analytic: Any, title: str, path: Path) -> Path:
+    """A Bode plot of control.frequency Responses: measured as markers, the analytic response as lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    fig, (gain, phase) = plt.subplots(2, 1, figsize=(8.0, 6.4), sharex=True)
+    for name, color in (("motor", "tab:blue"), ("cam", "tab:orange")):
+        H = getattr(measured, name)
+        label = "motor speed omega_m" if name == "motor" else "cam speed omega"
+        gain.loglog(measured.f, np.abs(H), "o", color=color, markersize=3, label=f"{label} (engine)")
+        phase.semilogx(measured.f, np.degrees(np.unwrap(np.angle(H))), "o", color=color, markersize=3)
+        if analytic is not None:
+            exact = getattr(analytic, name)
+            gain.loglog(analytic.f, np.abs(exact), "-", color=color, linewidth=1.0, label=f"{label} (linearised)")
+            phase.semilogx(analytic.f, np.degrees(np.unwrap(np.angle(exact))), "-", color=color, linewidth=1.0)
+    gain.set_ylabel("|H| [(rad/s)/V]")
+    gain.grid(True, which="both", alpha=0.3)
+    gain.legend(fontsize=8)
+    phase.set_ylabel("phase [deg]")
+    phase.set_xlabel("frequency [Hz]")
+    phase.grid(True, which="both", alpha=0.3)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
