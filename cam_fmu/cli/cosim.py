@@ -115,7 +115,10 @@ def run(args) -> int:
         ctrl = pi.resolve(sysk.components["controller"].parameters) if "controller" in sysk.components else None
         stop = args.stop_time if args.stop_time is not None else sysk.stop_time
         bar = _progress(f"{label or system.name}")
-        result = simulate_system(sysk, stop, args.step_size, progress=bar)
+        cam = sysk.components.get("cam")
+        compliant = cam is not None and float(cam.parameters.get("k_shaft", 0.0)) > 0.0
+        record = ["cam.omega", "cam.omega_m"] if compliant else None  # both sides of the shaft
+        result = simulate_system(sysk, stop, args.step_size, record=record, progress=bar)
         stem = label.replace("=", "").replace(" ", "_").replace("+", "_")
         name = system.name if not label else f"{system.name}__{stem}"
         path = write_csv(result, out / f"{name}.csv")
@@ -134,7 +137,11 @@ def run(args) -> int:
             for key, value in ripples.items():
                 fh.write(f"{key},{value:.6g}\n")
         print(out / f"{system.name}_ripple.csv")
-    if not args.no_plot and ripples and all("controller.u" in r for r in runs.values()):
+    if not args.no_plot and runs and all("cam.omega_m" in r for r in runs.values()):
+        from ..plots.speed_loop import plot_two_speeds
+        print(plot_two_speeds(runs, out / f"{system.name}.png",
+                              title=f"{system.name}: PI loop around a compliant shaft (engine: cam-fmu cosim)"))
+    elif not args.no_plot and ripples and all("controller.u" in r for r in runs.values()):
         from ..plots.speed_loop import plot_speed_loop
         print(plot_speed_loop(runs, setpoints, ripples, out / f"{system.name}.png",
                               title=f"{system.name}: PI speed loop around cam.fmu (engine: cam-fmu cosim)"))

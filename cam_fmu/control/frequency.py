@@ -70,7 +70,7 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
         raise ValueError(f"theta0 = {theta0!r} rad: gravity's stiffness there is k_g = -F_gx s'' = {k_g:.4g} N m/rad "
                          "< 0, the cam would fall away from a standstill (choose an angle where k_g >= 0, or "
                          "another mounting)")
-    u0 = model.R * (-model.F_gx * s1) / model.c_m
+    u0 = model.R * (-model.F_gx * s1) / model.c_m + 0.0  # + 0.0: no -0 V in a report
     if model.L > 0.0:
         p["i0"] = u0 / model.R
     return p, u0

@@ -88,17 +88,22 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
 
 
 def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
-    """The speed-loop SSP: ``path`` as given (it must exist), or models/speed_loop.ssp, rebuilt when
-    missing or older than one of its FMUs (which ensure_fmu rebuilds when stale) or than ssp.py (its writer)."""
-    if path is not None:
-        path = Path(path)
-        if not path.is_file():
-            raise FmuFileError(f"SSP file {str(path)!r} does not exist")
-        return path
-    from ..fmu.build import MODELS, SSP_NAME, build_ssp
+    """A shipped SSP: ``path`` as given (it must exist; a shipped system's name, e.g. compliant_loop, names
+    models/<name>.ssp), or models/speed_loop.ssp, rebuilt when missing or older than one of its FMUs (which
+    ensure_fmu rebuilds when stale) or than ssp.py (its writer)."""
+    from ..fmu.build import MODELS, SSP_NAME, SSP_NAMES, build_ssp
 
-    fmus = {name: ensure_fmu(None, log, name) for name in MODELS}
-    path = default_model_path(SSP_NAME, ".ssp")
+    name = SSP_NAME
+    if path is not None:
+        if str(path) in SSP_NAMES and not Path(path).is_file():
+            name = str(path)
+        else:
+            path = Path(path)
+            if not path.is_file():
+                raise FmuFileError(f"SSP file {str(path)!r} does not exist (shipped systems: {', '.join(SSP_NAMES)})")
+            return path
+    fmus = {model: ensure_fmu(None, log, model) for model in MODELS}
+    path = default_model_path(name, ".ssp")
     from . import ssp as writer
 
     inputs = [*fmus.values(), Path(writer.__file__)]
@@ -106,7 +111,7 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
         return path
     if log is not None:
         log(f"# writing {path}")
-    return build_ssp(path, fmus["cam"], fmus["pi_speed"])
+    return build_ssp(path, fmus["cam"], fmus["pi_speed"], name)
 
 
 def check_cam_variables(path: str | Path, option: str = "--fmu") -> Path:

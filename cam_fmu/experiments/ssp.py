@@ -285,14 +285,17 @@ def extract_ssp(path: str | Path, dest: str | Path) -> Path:
 def speed_loop_system(cam_parameters: Mapping[str, Any] | None = None,
                       controller_parameters: Mapping[str, Any] | None = None,
                       stop_time: float = 2.0, step_size: float = 1e-3,
-                      feedforward_connections: bool = True) -> System:
-    """models/speed_loop.ssp: pi_speed.fmu (instance 'controller') closing a speed loop around cam.fmu ('cam')."""
-    connections = [Connection("controller", "u", "cam", "u"), Connection("cam", "omega", "controller", "omega_meas")]
+                      feedforward_connections: bool = True, name: str = "speed_loop",
+                      measured: str = "omega") -> System:
+    """models/speed_loop.ssp: pi_speed.fmu (instance 'controller') closing a speed loop around cam.fmu ('cam'),
+    on the speed ``measured`` ('omega': the cam's; 'omega_m': the rotor's, beyond a compliant shaft)."""
+    connections = [Connection("controller", "u", "cam", "u"), Connection("cam", measured, "controller", "omega_meas")]
     if feedforward_connections:
         connections += [Connection("cam", "M", "controller", "M_load"), Connection("cam", "J", "controller", "J_load")]
-    cam_out = sorted({c.start_connector for c in connections if c.start_element == "cam"}, key=["omega", "M", "J"].index)
+    cam_out = sorted({c.start_connector for c in connections if c.start_element == "cam"},
+                     key=["omega", "omega_m", "M", "J"].index)
     ctrl_in = [c.end_connector for c in connections if c.end_element == "controller"]
-    return System("speed_loop", {
+    return System(name, {
         "cam": Component("cam", "resources/cam.fmu", inputs=["u"], outputs=cam_out,
                          parameters=dict(cam_parameters or {})),
         "controller": Component("controller", "resources/pi_speed.fmu", inputs=ctrl_in, outputs=["u"],
@@ -302,3 +305,15 @@ def speed_loop_system(cam_parameters: Mapping[str, Any] | None = None,
 
 SPEED_LOOP_CAM = {"gamma": 3.141592653589793}  # horizontal mounting, as the paper's fig. 6
 SPEED_LOOP_CONTROLLER: dict[str, Any] = {}  # the controller's defaults (control.pi.PARAMETERS)
+
+
+def compliant_loop_system() -> System:
+    """models/compliant_loop.ssp: the PI loop on the cam's speed (an encoder on the cam shaft) around the
+    compliant_shaft scene's drive (resonance 207-363 Hz), sampled at 5 kHz; its gains (kp 0.5 V/(rad/s),
+    ki 5 V/rad) keep the loop's bandwidth below the anti-resonance (docs/control.md section 5)."""
+    from .scenes import find_scene
+
+    scene = find_scene("compliant_shaft")
+    cam = {**scene.parameters, **scene.runs[0].overrides}
+    return speed_loop_system(cam, {"omega_set": 3.0, "kp": 0.5, "ki": 5.0}, stop_time=2.0, step_size=2e-4,
+                             feedforward_connections=False, name="compliant_loop", measured="omega")

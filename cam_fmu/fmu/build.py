@@ -1,6 +1,6 @@
 """Build the project's models: cam.fmu, pi_speed.fmu (FMI 2.0 co-simulation) and speed_loop.ssp.
 
-    python build_fmu.py                          # -> models/cam.fmu, models/pi_speed.fmu, models/speed_loop.ssp
+    python build_fmu.py                          # -> models/cam.fmu, pi_speed.fmu, speed_loop.ssp, compliant_loop.ssp
     python -m cam_fmu.fmu.build --dest /tmp/x/cam.fmu
     python -m cam_fmu.fmu.build --model pi_speed --dest /tmp/x/pi_speed.fmu
 
@@ -22,6 +22,7 @@ from . import engine_fmu, python_fmu
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 MODELS = ("cam", *python_fmu.MODELS)  # every FMU the project builds
 SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
+SSP_NAMES = (SSP_NAME, "compliant_loop")  # and the loop on the cam's speed around a compliant shaft
 
 
 class BuildError(RuntimeError):
@@ -57,11 +58,14 @@ def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Pa
         raise BuildError(str(exc)) from None
 
 
-def build_ssp(dest: Path, cam: Path, pi_speed: Path) -> Path:
-    """models/speed_loop.ssp from the two built FMUs (experiments.ssp.speed_loop_system)."""
-    from ..experiments.ssp import SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER, speed_loop_system, write_ssp
+def build_ssp(dest: Path, cam: Path, pi_speed: Path, name: str = SSP_NAME) -> Path:
+    """models/<name>.ssp (one of SSP_NAMES) from the two built FMUs (experiments.ssp)."""
+    from ..experiments.ssp import (SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER, compliant_loop_system, speed_loop_system,
+                                   write_ssp)
 
-    system = speed_loop_system(SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER)
+    if name not in SSP_NAMES:
+        raise BuildError(f"system {name!r}: allowed {', '.join(map(repr, SSP_NAMES))}")
+    system = speed_loop_system(SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER) if name == SSP_NAME else compliant_loop_system()
     return write_ssp(system, {"cam": cam, "controller": pi_speed}, dest)
 
 
@@ -71,7 +75,7 @@ def main(argv: List[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="build_fmu.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dest", type=Path, default=None,
                         help="build one FMU (--model, default cam) into this file; without --dest: "
-                             "cam.fmu, pi_speed.fmu and speed_loop.ssp into models/ in a source checkout "
+                             "cam.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a source checkout "
                              "(else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
     parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules of a Python FMU")
@@ -84,7 +88,8 @@ def main(argv: List[str] | None = None) -> int:
         built = {name: build(default_model_path(name), name, args.verbose, args.package_dir) for name in MODELS}
         for path in built.values():
             print(path)
-        print(build_ssp(default_model_path(SSP_NAME, ".ssp"), built["cam"], built["pi_speed"]))
+        for name in SSP_NAMES:
+            print(build_ssp(default_model_path(name, ".ssp"), built["cam"], built["pi_speed"], name))
     except (BuildError, RuntimeError) as exc:  # RuntimeError: native.NativeBuildError (no C compiler ...)
         print(f"build_fmu: error: {exc}", file=sys.stderr)
         return 1

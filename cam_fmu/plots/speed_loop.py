@@ -48,3 +48,28 @@ def plot_speed_loop(runs: Mapping[str, Mapping[str, np.ndarray]], omega_set: Map
     if title:
         fig.suptitle(title, fontsize=10)
     return save_figure(plt, fig, path)
+
+
+def plot_two_speeds(runs: Mapping[str, Mapping[str, np.ndarray]], path: str | Path, title: str = "") -> Path:
+    """A loop around a compliant shaft: the rotor's speed omega_m and the cam's omega over time, one panel per
+    run (the columns 'cam.omega_m', 'cam.omega'), and the last 0.1 s of each magnified beside it."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(runs), 2, figsize=(12, 3.2 * len(runs)), squeeze=False,
+                             gridspec_kw={"width_ratios": [2, 1]})
+    for row, (label, r) in enumerate(runs.items()):
+        t = r["time"]
+        tail = t >= t[-1] - 0.1
+        for ax, mask in ((axes[row, 0], slice(None)), (axes[row, 1], tail)):
+            ax.plot(t[mask], r["cam.omega_m"][mask], color="tab:blue", linewidth=0.8, label="motor omega_m")
+            ax.plot(t[mask], r["cam.omega"][mask], color="tab:orange", linewidth=0.8, label="cam omega")
+            ax.grid(True, alpha=0.4)
+        axes[row, 0].set_ylabel(f"{label}\n[rad/s]")
+        axes[row, 1].set_title("last 0.1 s", fontsize=8)
+    axes[0, 0].legend(fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle(title)
+    return save_figure(plt, fig, path)
