@@ -11,7 +11,8 @@ import sys
 import numpy as np
 import pytest
 
-from cam_fmu.control.frequency import analytic_response, linear_model, measured_response
+from cam_fmu.control.frequency import analytic_response, linear_model
+from cam_fmu.experiments.frequency import measured_response
 from cam_fmu.control.reflect import two_mass_frequencies
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.physics.drive import DriveModel

@@ -40,7 +40,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import numpy as np
 
-    from ..control.frequency import analytic_response, measured_response
+    from ..control.frequency import analytic_response
+    from ..experiments.frequency import measured_response
     from ..experiments.scenes import find_scene
     from .simulate import apply_sets
 
