@@ -84,6 +84,9 @@ def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, fact
         peak = max(np.max(np.abs(r["omega"])), 1e-12)
         assert err_theta < theta_tol, f"{name}/{run.label}: theta error {err_theta:.3g} rad"
         assert err_omega < omega_rel * peak + 1e-12, f"{name}/{run.label}: omega error {err_omega:.3g} rad/s"
+        if run.params["k_shaft"] > 0.0:  # a compliant shaft: the rotor's side too, to the same tolerances
+            assert np.max(np.abs(f["theta_m"] - r["theta_m"])) < theta_tol, f"{name}/{run.label}: theta_m"
+            assert np.max(np.abs(f["omega_m"] - r["omega_m"])) < omega_rel * peak + 1e-12, f"{name}/{run.label}"
         for out in ("s", "i", "M", "J"):
             assert np.all(np.isfinite(f[out])), f"{name}/{run.label}: {out} not finite"
         if run.params["drive"] == "speed" or run.params["formulation"] == "paper":

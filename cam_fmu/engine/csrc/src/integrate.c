@@ -286,7 +286,14 @@ int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err
     CamMode mode = d->mode;
     long logged = d->events_logged;
     int status;
-    memset(&it, 0, sizeof it);
+    /* what the loop reads before writing: the flags, and the slots a rigid drive's steps leave alone (they are
+     * copied into d->x whole); zeroing the whole integrator cost a rigid run 0.6 % of its instructions */
+    it.n_events = it.have_before = it.hit = it.exponential = 0;
+    memset(it.x_end, 0, sizeof it.x_end);
+    memset(it.x_hit, 0, sizeof it.x_hit);
+    memset(it.work.x_new, 0, sizeof it.work.x_new);
+    memset(it.work.f_new, 0, sizeof it.work.f_new);
+    memset(it.f_end, 0, sizeof it.f_end);
     it.method = cam_method(d->model.solver);
     if (it.method == NULL)
         return cam_error(err, CAM_ERR_SIMULATION, "solver choice %d is not available in the engine", d->model.solver);

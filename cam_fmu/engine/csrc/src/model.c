@@ -105,24 +105,41 @@ double cam_current_at_rest(const CamModel *m, double i, double u, double dt)
     return target + (i - target) * exp(-dt * m->R / m->L);
 }
 
-void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
+/* dx/dt of the two-mass drive (docs/model.md section 12): the cam side as the rigid drive's under the shaft's
+ * torque, the rotor J_m omega_m' = c_m i - M_shaft, the twist's rate omega_m - omega. */
+static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], omega_motor;
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], omega_motor = x[CAM_OMEGA_M];
+    double shaft = cam_drive_torque(m, x, omega, u);   /* x[CAM_OMEGA] is 0 while stuck */
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;
-        dx[CAM_OMEGA] = 0.0;   /* x[CAM_OMEGA] is 0 while stuck */
+        dx[CAM_OMEGA] = 0.0;
     } else {
         dx[CAM_THETA] = omega;
-        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_drive_torque(m, x, omega, u), mode->direction,
+        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, shaft, mode->direction, mode->contact != 0,
+                                      m->guide_side ? mode->side : 0.0);
+    }
+    dx[CAM_TWIST] = omega_motor - omega;
+    dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - shaft) / m->J_m;
+    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
+}
+
+void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
+{
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT];
+    if (m->compliant) {
+        compliant_rhs(m, mode, x, u, dx);
+        return;
+    }
+    if (mode->stuck) {
+        dx[CAM_THETA] = 0.0;
+        dx[CAM_OMEGA] = 0.0;
+    } else {
+        dx[CAM_THETA] = omega;
+        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_torque(m, omega, i, u), mode->direction,
                                       mode->contact != 0, m->guide_side ? mode->side : 0.0);
     }
-    omega_motor = omega;
-    if (m->compliant) {   /* the rotor on its side of the shaft (docs/model.md section 12) */
-        omega_motor = x[CAM_OMEGA_M];
-        dx[CAM_TWIST] = omega_motor - omega;
-        dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - cam_drive_torque(m, x, omega, u)) / m->J_m;
-    }
-    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
+    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega) / m->L : 0.0;
 }
 
 void cam_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,

@@ -68,37 +68,48 @@ static double combine(const double *coef, const int *idx, int count, double (*k)
     return x + h * sum;
 }
 
-void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u,
-                 double h, CamStepWork *w)
+/* The step over the first n slots: inlined twice below with n a constant (CAM_NX_RIGID, CAM_NX), so that a rigid
+ * drive's loops unroll over its three slots as they did before the compliant shaft's two existed. */
+static inline void rk_step_slots(const CamMethod *method, const CamModel *m, const CamMode *mode,
+                                 const double x[CAM_NX], double u, double h, CamStepWork *w, const int n)
 {
     const CamTableau *t = method->tableau;
     double arg[CAM_NX];
     int i, slot, s = t->stages, idx[CAM_MAX_STAGES + 1], count;
     for (i = 1; i < s; i++) {
         count = nonzero(t->a[i], i, idx);
-        for (slot = 0; slot < m->slots; slot++)
+        for (slot = 0; slot < n; slot++)
             arg[slot] = combine(t->a[i], idx, count, w->k, slot, x[slot], h);
         cam_rhs(m, mode, arg, u, w->k[i]);
     }
     count = nonzero(t->b, s, idx);
     if (t->b_divisor > 0.0) {   /* x + (h / d) * (b_1 k_1 + ...): the weights' common factor first */
         double scaled = h / t->b_divisor;
-        for (slot = 0; slot < m->slots; slot++)
+        for (slot = 0; slot < n; slot++)
             w->x_new[slot] = x[slot] + scaled * combine(t->b, idx, count, w->k, slot, 0.0, 1.0);   /* 0 + 1 sum */
     } else {
-        for (slot = 0; slot < m->slots; slot++)
+        for (slot = 0; slot < n; slot++)
             w->x_new[slot] = combine(t->b, idx, count, w->k, slot, x[slot], h);
     }
     if (t->fsal) {
         cam_rhs(m, mode, w->x_new, u, w->k[s]);
-        for (slot = 0; slot < m->slots; slot++)
+        for (slot = 0; slot < n; slot++)
             w->f_new[slot] = w->k[s][slot];
     }
     if (method->adaptive) {   /* the error h * sum e_j k_j, the FSAL stage included */
         count = nonzero(t->e, s + (t->fsal ? 1 : 0), idx);
-        for (slot = 0; slot < m->slots; slot++)
+        for (slot = 0; slot < n; slot++)
             w->error[slot] = combine(t->e, idx, count, w->k, slot, 0.0, h);
     }
+}
+
+void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u,
+                 double h, CamStepWork *w)
+{
+    if (m->compliant)
+        rk_step_slots(method, m, mode, x, u, h, w, CAM_NX);
+    else
+        rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_RIGID);
 }
 
 double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w)
