@@ -149,3 +149,17 @@ def test_what_a_compliant_shaft_cannot_do_is_refused_with_the_same_words_in_both
     assert str(py_error.value) == str(c_error.value)
     for word in words:
         assert word in str(c_error.value)
+
+
+def test_the_energy_guard_counts_the_shaft_and_stops_a_solver_that_makes_energy():
+    """Explicit Euler grows every undamped oscillation, the shaft's too: the guard, whose account holds the rotor's
+    kinetic and the shaft's elastic energy (docs/model.md 12.2), stops the run with its message; rk4 at the same
+    step stays within the bound and near rk45's answer."""
+    scene = find_scene("compliant_shaft")
+    params = dict(scene.parameters, **scene.runs[0].overrides)
+    with pytest.raises(Exception, match="energy was created") as error:
+        _run(dict(params, solver="euler", h_max=1e-4), 0.5, 1e-3, 3.5)
+    assert type(error.value).__name__ == "SimulationError" and "solver 'euler'" in str(error.value)
+    rk4 = _run(dict(params, solver="rk4", h_max=1e-4), 0.5, 1e-3, 3.5)
+    rk45 = _run(params, 0.5, 1e-3, 3.5)
+    assert np.max(np.abs(rk4[:, COL["theta"]] - rk45[:, COL["theta"]])) < 1e-4
