@@ -50,14 +50,22 @@ def _same(c_line: list[str], python_line: list[str]) -> bool:
 
 def _check(lines: dict[str, list[str]]) -> None:
     for name in ("fig6", "backlash", "inductance", "tilted", "table", "paper", "speed", "euler", "rk4", "etdrk4",
-                 "stiff-pole"):
+                 "stiff-pole", "compliant", "compliant-backlash", "stick-slip"):
         assert lines[name][0] == "0", (name, lines[name])
         assert lines[f"{name}-resumed"] == ["0", "same"], name
     assert _same(lines["fig6"], _python_line({}, 2000))
     assert _same(lines["backlash"], _python_line({"c": 5e-4}, 2000))
     assert _same(lines["paper"], _python_line({"formulation": "paper"}, 2000))
     assert _same(lines["etdrk4"], _python_line({"c": 5e-4, "solver": "etdrk4", "h_max": 1e-4, "L": 1e-3}, 1000))
-    expected = {"bad-table": "1", "bad-R": "1", "unknown": "1", "bad-solver": "1", "max-steps": "3",
+    shaft = {"J_m": 3e-5, "J_cam": 1.41e-5, "k_shaft": 50.0, "d_shaft": 1e-3}
+    assert _same(lines["compliant"], _python_line(shaft, 2000))
+    stick_slip = {"J_m": 3e-5, "J_cam": 1.41e-5, "k_shaft": 0.5, "M_f": 0.02, "follower_inertia": False,
+                  "gravity": False, "guide_friction": False}
+    sim = DriveSimulator(stick_slip)
+    for k in range(600):
+        sim.do_step(k * 1e-3, 1e-3, 2.9, 1.0)
+    assert [float.fromhex(v) for v in lines["stick-slip"][1:3]] == [sim.outputs()["theta"], sim.outputs()["omega"]]
+    expected = {"no-J_cam": "1", "bad-table": "1", "bad-R": "1", "unknown": "1", "bad-solver": "1", "max-steps": "3",
                 "bad-step": "2", "bad-input": "2", "bad-state": "2", "bad-contact": "2", "bad-nan": "2"}
     assert {name: lines[name][0] for name in expected} == expected
     assert " ".join(lines["bad-R"][1:]) == "parameter 'R' = 0.0 [Ohm] is outside the allowed range [0.001, 10000] Ohm"

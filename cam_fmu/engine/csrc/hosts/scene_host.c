@@ -102,6 +102,32 @@ int main(void)
     scene("stiff-pole", &p, 3.5, 1e-2, 100);
     cam_params_free(&p);
 
+    cam_params_defaults(&p);   /* a compliant shaft: the two-mass drive, with backlash and L; stick-slip */
+    set(&p, "J_m", 3e-5, &err);
+    set(&p, "J_cam", 1.41e-5, &err);
+    set(&p, "k_shaft", 50.0, &err);
+    set(&p, "d_shaft", 1e-3, &err);
+    scene("compliant", &p, 3.5, 1e-3, 2000);
+    set(&p, "c", 5e-4, &err);
+    set(&p, "L", 1e-3, &err);
+    scene("compliant-backlash", &p, 3.5, 1e-3, 1000);
+    cam_params_free(&p);
+    cam_params_defaults(&p);
+    set(&p, "J_m", 3e-5, &err);
+    set(&p, "J_cam", 1.41e-5, &err);
+    set(&p, "k_shaft", 0.5, &err);
+    set(&p, "M_f", 0.02, &err);
+    set(&p, "follower_inertia", 0.0, &err);
+    set(&p, "gravity", 0.0, &err);
+    set(&p, "guide_friction", 0.0, &err);
+    scene("stick-slip", &p, 2.9, 1e-3, 600);
+    set(&p, "J_cam", 0.0, &err);
+    status = cam_drive_init(&d, &p, &err);
+    printf("no-J_cam %d %s\n", status, err.message);
+    if (status == CAM_OK)
+        cam_drive_free(&d);
+    cam_params_free(&p);
+
     cam_params_defaults(&p);   /* a motion table: the parser and the table's curve */
     set_text(&p, "motion_table", "angle_deg,lift_mm\n0,0\n90,40\n180,60\n270,20\n360,0\n", &err);
     set(&p, "mu", 0.0, &err);
