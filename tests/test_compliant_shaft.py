@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from cam_fmu.engine.simulator import DriveSimulator
+from cam_fmu.errors import StepRejected
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.experiments.signals import constant
@@ -163,3 +164,19 @@ def test_the_energy_guard_counts_the_shaft_and_stops_a_solver_that_makes_energy(
     rk4 = _run(dict(params, solver="rk4", h_max=1e-4), 0.5, 1e-3, 3.5)
     rk45 = _run(params, 0.5, 1e-3, 3.5)
     assert np.max(np.abs(rk4[:, COL["theta"]] - rk45[:, COL["theta"]])) < 1e-4
+
+
+@pytest.mark.parametrize("override, cause", [
+    (dict(k_shaft=1e9, J_cam=1e-9), "the compliant shaft's rate"),
+    (dict(k_shaft=1.0, d_shaft=1e6, J_cam=1e-5), "the compliant shaft's rate"),
+    (dict(k_shaft=1.0, J_cam=1e-5, L=1e-7), "the electrical pole R/L = 1.9e+08 1/s is integrated explicitly"),
+])
+def test_a_shaft_too_stiff_for_the_steps_is_refused_naming_the_cause(override, cause):
+    """rk45 on an extreme shaft (or, with a shaft, a tiny L) cannot finish a step within max_steps: the step is
+    refused (fmi2Discard, the state as before) with the cause and what to change, never an answer."""
+    sim = DriveSimulator(override)
+    with pytest.raises(StepRejected) as error:
+        for k in range(10):
+            sim.do_step(k * 1e-3, 1e-3, u=3.5)
+    assert "max_steps" in str(error.value) and cause in str(error.value)
+    assert "k_shaft = 0" in str(error.value) or "L = 0" in str(error.value)

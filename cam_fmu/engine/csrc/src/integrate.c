@@ -33,6 +33,26 @@ static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
     it->method->step(it->method, &d->model, &d->mode, d->x, u, h, &it->work);
 }
 
+/* A compliant drive's likely cause of many small steps, into buf ("" when the shaft is rigid): the shaft's rate
+ * against the lightest cam side, or the electrical pole, which rk45 then takes explicitly (docs/model.md 12.1). */
+static void compliant_cause(const CamModel *m, char *buf, size_t len)
+{
+    double inverse, shaft, pole;
+    buf[0] = '\0';
+    if (!m->compliant)
+        return;
+    inverse = 1.0 / m->J_m + 1.0 / m->J_0;
+    shaft = sqrt(m->k_shaft * inverse) + m->d_shaft * inverse;
+    pole = m->has_current ? m->R / m->L : 0.0;
+    if (pole > shaft)
+        snprintf(buf, len, "; with a compliant shaft the electrical pole R/L = %.3g 1/s is integrated explicitly "
+                 "(set L = 0 if it does not matter)", pole);
+    else
+        snprintf(buf, len, "; the compliant shaft's rate sqrt(k_shaft (1/J_m + 1/J_cam)) + d_shaft (1/J_m + 1/J_cam) "
+                 "= %.3g 1/s asks for steps of about %.3g s (soften the shaft or lower d_shaft, raise J_cam, or make it "
+                 "rigid: k_shaft = 0)", shaft, 1.0 / shaft);
+}
+
 int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt_out,
                       CamError *err)
 {
@@ -72,7 +92,8 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
         t = 0.9 * pow(norm, it->method->tableau->error_exponent);
         dt *= t > 0.1 ? t : 0.1;
         if (dt < floor_) {
-            char a[32], b[32], c[32], e[32];
+            char a[32], b[32], c[32], e[32], cause[300];
+            compliant_cause(m, cause, sizeof cause);
             snprintf(a, sizeof a, "%g", m->rtol);
             snprintf(b, sizeof b, "%g", m->atol);
             snprintf(c, sizeof c, "%g", floor_);
@@ -81,7 +102,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
             return cam_error(err, CAM_ERR_REJECTED,
                             "solver 'rk45' cannot meet rtol = %s, atol = %s: its step fell below %s s (1e-12 of "
                             "the communication step) at t = %s s: loosen rtol/atol, or check the inputs and "
-                            "parameters for a near-singular drive", a, b, c, e);
+                            "parameters for a near-singular drive%s", a, b, c, e, cause);
         }
     }
 }
@@ -179,7 +200,8 @@ static double first_event(CamDrive *d, CamIntegrator *it, double dt)
 static int max_steps_error(const CamDrive *d, const CamMethod *method, double time, double h, CamError *err)
 {
     const CamModel *m = &d->model;
-    char advice[256];
+    char advice[256], cause[300];
+    compliant_cause(m, cause, sizeof cause);
     if (h > m->h_max * (double)m->max_steps)  /* h_max alone makes the count impossible: say so */
         snprintf(advice, sizeof advice, "h_max = %g s caps every internal step, so this communication step "
                  "needs at least %.4g of them: raise h_max or max_steps, or shorten the communication step",
@@ -190,7 +212,8 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
         snprintf(advice, sizeof advice, "raise max_steps or h_max (now %g s), or shorten the communication step; "
                  "'%s' takes steps no longer than its stability limit", m->h_max, method->name);
     return cam_error(err, CAM_ERR_REJECTED, "solver '%s' needed more than max_steps = %ld internal steps in one "
-                    "communication step of %g s at t = %g s: %s", method->name, m->max_steps, h, time, advice);
+                    "communication step of %g s at t = %g s: %s%s", method->name, m->max_steps, h, time, advice,
+                    cause);
 }
 
 /* The loop of one communication step (the state saved by the caller). */
