@@ -42,7 +42,7 @@ const CamTableau cam_rk4 = {
 const CamTableau cam_euler = {1, {{0.0}}, {1.0}, {0.0}, 0, {0.0}, 0.0, 0.0};
 
 /* The nonzero coefficients of one row: their indices into idx, returning how many. */
-static int nonzero(const double *coef, int n, int idx[CAM_MAX_STAGES + 1])
+static inline int nonzero(const double *coef, int n, int idx[CAM_MAX_STAGES + 1])
 {
     int j, count = 0;
     for (j = 0; j < n; j++)
@@ -53,7 +53,7 @@ static int nonzero(const double *coef, int n, int idx[CAM_MAX_STAGES + 1])
 
 /* x + h * sum_j coef[j] k[j][slot] over the nonzero coefficients idx[0..count-1], left to right (a single
  * one as x + (h coef) k; see the file's comment). */
-static double combine(const double *coef, const int *idx, int count, double (*k)[CAM_NX], int slot, double x,
+static inline double combine(const double *coef, const int *idx, int count, double (*k)[CAM_NX], int slot, double x,
                       double h)
 {
     double sum;
