@@ -91,7 +91,7 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
     """A shipped SSP: ``path`` as given (it must exist; a shipped system's name, e.g. compliant_loop, names
     models/<name>.ssp), or models/speed_loop.ssp, rebuilt when missing or older than one of its FMUs (which
     ensure_fmu rebuilds when stale) or than ssp.py (its writer)."""
-    from ..fmu.build import MODELS, SSP_NAME, SSP_NAMES, build_ssp
+    from ..fmu.build import SSP_NAME, SSP_NAMES, build_ssp
 
     name = SSP_NAME
     if path is not None:
@@ -102,7 +102,7 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
             if not path.is_file():
                 raise FmuFileError(f"SSP file {str(path)!r} does not exist (shipped systems: {', '.join(SSP_NAMES)})")
             return path
-    fmus = {model: ensure_fmu(None, log, model) for model in MODELS}
+    fmus = {model: ensure_fmu(None, log, model) for model in ("cam", "pi_speed")}  # the loop's two FMUs
     path = default_model_path(name, ".ssp")
     from . import ssp as writer
 

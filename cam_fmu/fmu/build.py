@@ -20,7 +20,8 @@ from typing import List
 from . import engine_fmu, python_fmu
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
-MODELS = ("cam", *python_fmu.MODELS)  # every FMU the project builds
+ENGINE_MODELS = {"cam": 2, "cam3": 3}  # the C engine's FMUs and their FMI versions
+MODELS = (*ENGINE_MODELS, *python_fmu.MODELS)  # every FMU the project builds
 SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
 SSP_NAMES = (SSP_NAME, "compliant_loop")  # and the loop on the cam's speed around a compliant shaft
 
@@ -31,7 +32,7 @@ class BuildError(RuntimeError):
 
 def sources(model: str = "cam") -> list[Path]:
     """Every file whose content ends up in (or shapes) the FMU of ``model``."""
-    if model == "cam":
+    if model in ENGINE_MODELS:
         return engine_fmu.sources()
     return python_fmu.sources(model=model)
 
@@ -51,8 +52,8 @@ def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Pa
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
     try:
-        if model == "cam":
-            return engine_fmu.build(dest)
+        if model in ENGINE_MODELS:
+            return engine_fmu.build(dest, fmi_version=ENGINE_MODELS[model])
         return python_fmu.build(dest, model, package_dir=package_dir, verbose=verbose)
     except (engine_fmu.FmuBuildError, python_fmu.BuildError) as exc:
         raise BuildError(str(exc)) from None

@@ -28,13 +28,20 @@ from typing import Sequence
 
 from ..engine import build as engine_build
 from ..engine import codegen
-from . import model_description
+from . import model_description, model_description3
 
 MODEL_IDENTIFIER = "cam"
 DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
                "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
 FMI = engine_build.CSRC / "fmi"
-GLUE = (FMI / "instance.c", FMI / "fmi2_cs.c")  # the instance layer and the FMI 2.0 glue
+# The FMI glue of each version: the instance layer, the glue both share, the version's own file; its
+# official headers; its platform folders (FMI 3.0 names them by architecture and OS).
+GLUE = {2: (FMI / "instance.c", FMI / "glue.c", FMI / "fmi2_cs.c"),
+        3: (FMI / "instance.c", FMI / "glue.c", FMI / "fmi3_cs.c")}
+HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+           3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
+PLATFORM_DIRS = {2: {"linux64": "linux64", "win64": "win64"}, 3: {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}
+FMU_NAMES = {2: "cam.fmu", 3: "cam3.fmu"}
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
 BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
 # win64: Debian's MinGW-w64 cross compiler; libgcc linked in, so the DLL needs only Windows' own
@@ -52,7 +59,8 @@ def sources() -> list[Path]:
     """Every file whose content shapes cam.fmu: the engine's C, the FMI glue, the generators and the tables."""
     package = engine_build.HERE.parent
     return [*engine_build.source_files(), *sorted(FMI.glob("*.[ch]")), Path(__file__), Path(model_description.__file__),
-            Path(codegen.__file__), Path(engine_build.__file__), package / "physics" / "parameters.py",
+            Path(model_description3.__file__), Path(codegen.__file__), Path(engine_build.__file__),
+            package / "physics" / "parameters.py",
             package / "physics" / "variables.py"]
 
 
@@ -69,11 +77,12 @@ def engine_guid() -> str:
     return model_description.guid(model_description.variable_rows(), engine_build.digest())
 
 
-def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = ()) -> Path:
-    """Compile the engine, the instance layer and the FMI 2.0 glue into the shared library ``dest``."""
+def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = (),
+                   fmi_version: int = 2) -> Path:
+    """Compile the engine, the instance layer and the FMI glue of ``fmi_version`` into the shared library ``dest``."""
     try:
         return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DCAM_GUID="{guid}"', *extra_flags), compiler,
-                                            extra_sources=GLUE, include=(engine_build.fmi_headers(),))
+                                            extra_sources=GLUE[fmi_version], include=(engine_build.fmi_headers(),))
     except engine_build.EngineBuildError as exc:
         raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
 
@@ -83,11 +92,13 @@ def win64_compiler() -> str | None:
     return shutil.which(WIN64_COMPILER)
 
 
-def build(dest: Path, win64: bool | None = None) -> Path:
-    """Build cam.fmu at ``dest`` (a path ending in .fmu) and return it.
+def build(dest: Path, win64: bool | None = None, fmi_version: int = 2) -> Path:
+    """Build cam.fmu (``fmi_version`` 2) or cam3.fmu (3) at ``dest`` (a path ending in .fmu) and return it.
 
     ``win64``: True requires the win64 binary (FmuBuildError without the cross compiler), False
     leaves it out, None (the default) adds it when the cross compiler is installed."""
+    if fmi_version not in GLUE:
+        raise FmuBuildError(f"fmi_version {fmi_version!r}: allowed 2 or 3")
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
         raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
@@ -99,17 +110,23 @@ def build(dest: Path, win64: bool | None = None) -> Path:
     guid = engine_guid()
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         root = Path(tmp)
-        compile_binary(root / "fmu" / "binaries" / "linux64" / f"{MODEL_IDENTIFIER}.so", guid)
+        folders = PLATFORM_DIRS[fmi_version]
+        compile_binary(root / "fmu" / "binaries" / folders["linux64"] / f"{MODEL_IDENTIFIER}.so", guid,
+                       fmi_version=fmi_version)
         if cross:
-            compile_binary(root / "fmu" / "binaries" / "win64" / f"{MODEL_IDENTIFIER}.dll", guid, cross, WIN64_FLAGS)
-        xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
-                                            default_experiment(), DESCRIPTION, rows)
+            compile_binary(root / "fmu" / "binaries" / folders["win64"] / f"{MODEL_IDENTIFIER}.dll", guid, cross,
+                           WIN64_FLAGS, fmi_version)
+        if fmi_version == 2:
+            xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
+                                                default_experiment(), DESCRIPTION, rows)
+        else:
+            xml = model_description3.model_description(MODEL_IDENTIFIER, guid, rows, default_experiment(),
+                                                       DESCRIPTION)
         (root / "fmu" / "modelDescription.xml").write_bytes(xml)
         sources = root / "fmu" / "sources"
         generated = codegen.write(sources)  # the generated table, beside the hand-written sources
-        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *FMI.glob("*.[ch]"),
-                     *(engine_build.fmi_headers() / f"fmi2{name}.h" for name in ("Functions", "FunctionTypes",
-                                                                                   "TypesPlatform"))]:
+        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *GLUE[fmi_version],
+                     *FMI.glob("*.h"), *(engine_build.fmi_headers() / name for name in HEADERS[fmi_version])]:
             shutil.copyfile(path, sources / path.name)
         (sources / "guid.h").write_text(f'#define CAM_GUID "{guid}"\n')
         del generated

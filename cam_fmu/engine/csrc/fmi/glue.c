@@ -1,0 +1,401 @@
+/* The co-simulation glue both FMI versions share (glue.h): state machine, logging, variable access,
+ * steps and saved states over the instance layer (cam_instance.h). No FMI header, no globals. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "glue.h"
+
+#define MESSAGE_MAX 1024              /* a log line is cut here (a 20 MB bad value is not echoed whole) */
+#define STATE_MAGIC 0x43414d53u       /* 'CAMS': a serialised cam.fmu state */
+#define STATE_HEADER 16               /* magic, format, payload size (8 bytes) */
+#define STATE_FORMAT 1u
+/* |currentCommunicationPoint - the FMU's time| allowed: rounding of a host's summed steps */
+#define TIME_SLACK(t) (1e-9 * (fabs(t) > 1.0 ? fabs(t) : 1.0))
+
+int glue_init(Glue *g, const char *name, int logging_on, const char *version)
+{
+    g->name = malloc(strlen(name) + 1);
+    g->drive = cam_instance_new();
+    if (!g->name || !g->drive) {
+        free(g->name);
+        cam_instance_free(g->drive);
+        g->name = NULL;
+        g->drive = NULL;
+        return 0;
+    }
+    strcpy(g->name, name);
+    g->logging_on = logging_on ? 1 : 0;
+    g->state = GLUE_INSTANTIATED;
+    g->start_time = g->last_successful_time = 0.0;
+    g->version = version;
+    return 1;
+}
+
+void glue_free(Glue *g)
+{
+    g->magic = 0;
+    cam_instance_free(g->drive);
+    free(g->name);
+    g->drive = NULL;
+    g->name = NULL;
+}
+
+static const char *state_name(GlueState s)
+{
+    switch (s) {
+    case GLUE_INSTANTIATED: return "instantiated";
+    case GLUE_INITIALIZATION: return "initialization mode";
+    case GLUE_STEP_COMPLETE: return "step mode";
+    case GLUE_STEP_FAILED: return "step mode after Discard";
+    case GLUE_ERROR_STATE: return "error (after Error: Reset or SetFMUState to go on)";
+    case GLUE_TERMINATED: return "terminated";
+    }
+    return "unknown";
+}
+
+void glue_log(const Glue *g, int status, const char *category, const char *format, ...)
+{
+    char text[MESSAGE_MAX], escaped[2 * MESSAGE_MAX];
+    size_t k, n = 0;
+    va_list args;
+    if (!g->emit || (status == GLUE_OK && !g->logging_on))
+        return;
+    va_start(args, format);
+    vsnprintf(text, sizeof text, format, args);
+    va_end(args);
+    if (strlen(text) == sizeof text - 1)
+        memcpy(text + sizeof text - 5, "...", 4);
+    for (k = 0; text[k] && n + 2 < sizeof escaped; k++) {
+        if (text[k] == '%')
+            escaped[n++] = '%';
+        escaped[n++] = text[k];
+    }
+    escaped[n] = '\0';
+    g->emit(g->host, status, category, escaped);
+}
+
+int glue_fail(const Glue *g, const char *call, const char *text)
+{
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, text);
+    return GLUE_ERROR;
+}
+
+int glue_allowed(const Glue *g, int states, const char *call)
+{
+    if (g->state & states)
+        return 1;
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: not allowed in state '%s'", call, state_name(g->state));
+    return 0;
+}
+
+int glue_drive_status(Glue *g, int status, const char *call)
+{
+    if (status == CAM_OK)
+        return GLUE_OK;
+    if (status == CAM_ERR_REJECTED) {
+        glue_log(g, GLUE_DISCARD, "logStatusDiscard", "%s: %s", call, cam_instance_message(g->drive));
+        g->state = GLUE_STEP_FAILED;
+        return GLUE_DISCARD;
+    }
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_instance_message(g->drive));
+    g->state = GLUE_ERROR_STATE;
+    return GLUE_ERROR;
+}
+
+/* ------------------------------------------------------------------ life cycle */
+
+int glue_setup(Glue *g, double start_time, int stop_defined, double stop_time, const char *call)
+{
+    char text[200];
+    if (!isfinite(start_time) || fabs(start_time) > 1e15 || (stop_defined && !(isfinite(stop_time)
+                                                                               && stop_time >= start_time))) {
+        snprintf(text, sizeof text, "startTime = %.17g s must be finite within [-1e15, 1e15] s and "
+                 "stopTime = %.17g s finite and >= startTime", start_time, stop_time);
+        return glue_fail(g, call, text);
+    }
+    g->start_time = start_time;
+    return GLUE_OK;
+}
+
+int glue_enter_initialization(Glue *g, const char *call)
+{
+    if (!glue_allowed(g, GLUE_INSTANTIATED, call))
+        return GLUE_ERROR;
+    g->state = GLUE_INITIALIZATION;
+    return GLUE_OK;
+}
+
+int glue_exit_initialization(Glue *g, const char *call)
+{
+    int status;
+    if (!glue_allowed(g, GLUE_INITIALIZATION, call))
+        return GLUE_ERROR;
+    status = glue_drive_status(g, cam_instance_initialize(g->drive, g->start_time), call);
+    if (status == GLUE_OK) {
+        g->state = GLUE_STEP_COMPLETE;
+        g->last_successful_time = g->start_time;
+    }
+    return status;
+}
+
+int glue_terminate(Glue *g, const char *call)
+{
+    if (!glue_allowed(g, GLUE_STEP_COMPLETE | GLUE_STEP_FAILED | GLUE_ERROR_STATE, call))
+        return GLUE_ERROR;
+    g->state = GLUE_TERMINATED;
+    return GLUE_OK;
+}
+
+void glue_reset(Glue *g)
+{
+    cam_instance_reset(g->drive);
+    g->state = GLUE_INSTANTIATED;
+    g->start_time = g->last_successful_time = 0.0;
+}
+
+/* ------------------------------------------------------------------ variables */
+
+static int check_references(const Glue *g, const unsigned vr[], size_t nvr, const void *value, CamKind type,
+                            const char *call)
+{
+    char text[300];
+    size_t k;
+    CamKind kind;
+    const char *name;
+    if (nvr == 0)
+        return 1;
+    if (!vr || !value) {
+        glue_fail(g, call, "the value reference and value arrays must not be NULL");
+        return 0;
+    }
+    for (k = 0; k < nvr; k++) {
+        if (!cam_instance_variable(vr[k], &kind, &name)) {
+            snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %d)", vr[k],
+                     CAM_VR_PARAMS + CAM_N_PARAMS - 1);
+            glue_fail(g, call, text);
+            return 0;
+        }
+        if (kind != type) {
+            snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s", name, vr[k],
+                     cam_kind_name(kind), cam_kind_name(type));
+            glue_fail(g, call, text);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+int glue_get_reals(Glue *g, const unsigned vr[], size_t nvr, double value[], const char *call)
+{
+    size_t k;
+    if (value)
+        for (k = 0; k < nvr; k++)
+            value[k] = 0.0;
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_REAL, call))
+        return GLUE_ERROR;
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_get_real(g->drive, vr[k], &value[k]) != CAM_OK)
+            return glue_fail(g, call, cam_instance_message(g->drive));
+    return GLUE_OK;
+}
+
+int glue_get_booleans(Glue *g, const unsigned vr[], size_t nvr, int value[], const char *call)
+{
+    size_t k;
+    if (value)
+        for (k = 0; k < nvr; k++)
+            value[k] = 0;
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_BOOLEAN, call))
+        return GLUE_ERROR;
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_get_boolean(g->drive, vr[k], &value[k]) != CAM_OK)
+            return glue_fail(g, call, cam_instance_message(g->drive));
+    return GLUE_OK;
+}
+
+int glue_get_strings(Glue *g, const unsigned vr[], size_t nvr, const char *value[], const char *call)
+{
+    size_t k;
+    if (value)
+        for (k = 0; k < nvr; k++)
+            value[k] = "";
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_STRING, call))
+        return GLUE_ERROR;
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_get_string(g->drive, vr[k], &value[k]) != CAM_OK) {
+            value[k] = "";
+            return glue_fail(g, call, cam_instance_message(g->drive));
+        }
+    return GLUE_OK;
+}
+
+int glue_set_reals(Glue *g, const unsigned vr[], size_t nvr, const double value[], const char *call)
+{
+    char text[MESSAGE_MAX];
+    size_t k;
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_REAL, call))
+        return GLUE_ERROR;
+    for (k = 0; k < nvr; k++)   /* all or nothing: every value is checked before one is written */
+        if (cam_instance_check_real(g->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
+            return glue_fail(g, call, text);
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_set_real(g->drive, vr[k], value[k]) != CAM_OK)
+            return glue_fail(g, call, cam_instance_message(g->drive));
+    return GLUE_OK;
+}
+
+int glue_set_booleans(Glue *g, const unsigned vr[], size_t nvr, const int value[], const char *call)
+{
+    size_t k;
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_BOOLEAN, call))
+        return GLUE_ERROR;
+    if (nvr > 0 && cam_instance_initialized(g->drive))   /* booleans are parameters */
+        return glue_fail(g, call, "parameters are fixed after initialisation (Reset first)");
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_set_boolean(g->drive, vr[k], value[k] != 0) != CAM_OK)
+            return glue_fail(g, call, cam_instance_message(g->drive));
+    return GLUE_OK;
+}
+
+int glue_set_strings(Glue *g, const unsigned vr[], size_t nvr, const char *const value[], const char *call)
+{
+    size_t k, size;
+    unsigned char *saved;
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_STRING, call))
+        return GLUE_ERROR;
+    for (k = 0; k < nvr; k++)
+        if (!value[k])
+            return glue_fail(g, call, "a string value must not be NULL");
+    /* strings are checked as they are set: a multi-value set is undone on refusal by saving first */
+    size = cam_instance_state_size(g->drive);
+    saved = malloc(size ? size : 1);
+    if (!saved || cam_instance_save(g->drive, saved, size) != CAM_OK) {
+        free(saved);
+        return glue_fail(g, call, "out of memory");
+    }
+    for (k = 0; k < nvr; k++)
+        if (cam_instance_set_string(g->drive, vr[k], value[k], strlen(value[k])) != CAM_OK) {
+            int status = glue_fail(g, call, cam_instance_message(g->drive));
+            cam_instance_restore(g->drive, saved, size);
+            free(saved);
+            return status;
+        }
+    free(saved);
+    return GLUE_OK;
+}
+
+/* ------------------------------------------------------------------ stepping */
+
+int glue_do_step(Glue *g, double t, double h, const char *call)
+{
+    char text[300];
+    double now;
+    int status;
+    if (!glue_allowed(g, GLUE_STEP_COMPLETE, call))
+        return GLUE_ERROR;
+    now = cam_instance_time(g->drive);
+    if (!isfinite(t) || fabs(t - now) > TIME_SLACK(now)) {
+        snprintf(text, sizeof text, "currentCommunicationPoint = %.17g s is not where the FMU is, t = %.17g s "
+                 "(allowed difference %.3g s)", t, now, TIME_SLACK(now));
+        return glue_fail(g, call, text);
+    }
+    if (!(h > 0.0) || !isfinite(h)) {
+        snprintf(text, sizeof text, "communicationStepSize = %.17g s: allowed a finite value > 0", h);
+        return glue_fail(g, call, text);
+    }
+    status = glue_drive_status(g, cam_instance_step(g->drive, now, h), call);
+    if (status == GLUE_OK)
+        g->last_successful_time = cam_instance_time(g->drive);
+    return status;
+}
+
+/* ------------------------------------------------------------------ FMU states */
+
+GlueSaved *glue_save(Glue *g)
+{
+    size_t size = cam_instance_state_size(g->drive);
+    GlueSaved *saved = malloc(sizeof *saved + size);
+    if (!saved)
+        return NULL;
+    saved->size = size;
+    if (cam_instance_save(g->drive, saved->bytes, size) != CAM_OK) {
+        free(saved);
+        return NULL;
+    }
+    return saved;
+}
+
+int glue_restore(Glue *g, const GlueSaved *saved, const char *call)
+{
+    if (!saved)
+        return glue_fail(g, call, "the FMU state must not be NULL");
+    /* the instance's state follows the drive's: an initialised one goes to step mode */
+    if (cam_instance_restore(g->drive, saved->bytes, saved->size) != CAM_OK)
+        return glue_fail(g, call, cam_instance_message(g->drive));
+    if (cam_instance_initialized(g->drive)) {
+        g->state = GLUE_STEP_COMPLETE;
+        g->last_successful_time = cam_instance_time(g->drive);
+    } else {
+        g->state = GLUE_INSTANTIATED;
+    }
+    return GLUE_OK;
+}
+
+size_t glue_serialized_size(const GlueSaved *saved)
+{
+    return STATE_HEADER + saved->size;
+}
+
+static void put_u32(unsigned char *p, unsigned long v)
+{
+    int k;
+    for (k = 0; k < 4; k++)
+        p[k] = (unsigned char)(v >> (8 * k));
+}
+
+static unsigned long get_u32(const unsigned char *p)
+{
+    unsigned long v = 0;
+    int k;
+    for (k = 3; k >= 0; k--)
+        v = (v << 8) | p[k];
+    return v;
+}
+
+int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t size, const char *call)
+{
+    if (!saved || !out)
+        return glue_fail(g, call, "the FMU state and the buffer must not be NULL");
+    if (size < STATE_HEADER + saved->size)
+        return glue_fail(g, call, "the buffer is smaller than the serialised state's size");
+    put_u32(out, STATE_MAGIC);
+    put_u32(out + 4, STATE_FORMAT);
+    put_u32(out + 8, (unsigned long)(saved->size & 0xffffffffu));
+    put_u32(out + 12, 0);
+    memcpy(out + STATE_HEADER, saved->bytes, saved->size);
+    return GLUE_OK;
+}
+
+int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call)
+{
+    GlueSaved *made;
+    size_t payload;
+    if (!in || !saved)
+        return glue_fail(g, call, "the arguments must not be NULL");
+    if (size < STATE_HEADER || get_u32(in) != STATE_MAGIC || get_u32(in + 4) != STATE_FORMAT)
+        return glue_fail(g, call, "these bytes are not a serialised cam.fmu state (format 1)");
+    payload = get_u32(in + 8);
+    if (payload != size - STATE_HEADER)
+        return glue_fail(g, call, "the serialised state is truncated or has trailing bytes");
+    made = malloc(sizeof *made + payload);
+    if (!made)
+        return glue_fail(g, call, "out of memory");
+    made->size = payload;
+    memcpy(made->bytes, in + STATE_HEADER, payload);
+    free(*saved);
+    *saved = made;
+    return GLUE_OK;
+}

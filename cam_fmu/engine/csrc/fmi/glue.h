@@ -1,0 +1,98 @@
+/* What the FMI 2.0 and FMI 3.0 co-simulation glues of cam.fmu share, FMI-version neutral: the instance's
+ * state machine, logging with its message rules, the checks of value references, the variable access,
+ * the communication step and the saved states (csrc/fmi/fmi2_cs.c and fmi3_cs.c are thin over it).
+ *
+ * Statuses are the FMI numbering both versions share: OK 0, Warning 1, Discard 2, Error 3, Fatal 4.
+ * Every call name in a message is the version's own ("fmi2GetReal", "fmi3GetFloat64"): the glue passes it.
+ * Rules: docs/fmu.md "Errors" (a refused request writes nothing; get arrays are filled with safe values
+ * first; a model error puts the instance into the error state; Discard leaves the state as before).
+ */
+#ifndef CAM_GLUE_H
+#define CAM_GLUE_H
+
+#include <stddef.h>
+
+#include "cam_instance.h"
+
+enum { GLUE_OK = 0, GLUE_WARNING = 1, GLUE_DISCARD = 2, GLUE_ERROR = 3 };
+
+typedef enum {
+    GLUE_INSTANTIATED = 1 << 0,
+    GLUE_INITIALIZATION = 1 << 1,
+    GLUE_STEP_COMPLETE = 1 << 2,
+    GLUE_STEP_FAILED = 1 << 3,   /* after Discard */
+    GLUE_ERROR_STATE = 1 << 4,   /* after Error */
+    GLUE_TERMINATED = 1 << 5
+} GlueState;
+
+#define GLUE_GET_STATES (GLUE_INITIALIZATION | GLUE_STEP_COMPLETE | GLUE_STEP_FAILED | GLUE_ERROR_STATE \
+                         | GLUE_TERMINATED)
+#define GLUE_SET_STATES (GLUE_INSTANTIATED | GLUE_INITIALIZATION | GLUE_STEP_COMPLETE)
+
+/* The host's logger as the glue calls it: status, category, and the message (already cut and with every
+ * '%' doubled, so printf-style hosts and hosts that cannot see varargs both show it). */
+typedef void (*GlueEmit)(void *host, int status, const char *category, const char *message);
+
+typedef struct {
+    unsigned magic;               /* the version's magic while alive, 0 once freed */
+    CamInstance *drive;
+    GlueEmit emit;                /* NULL: no logger */
+    void *host;                   /* what emit gets back (the version's instance) */
+    char *name;
+    int logging_on;
+    GlueState state;
+    double start_time;            /* s */
+    double last_successful_time;  /* s */
+    const char *version;          /* "fmi2" or "fmi3": names calls and statuses in state names */
+} Glue;
+
+/* A saved state: the instance layer's bytes. */
+typedef struct {
+    size_t size;
+    unsigned char bytes[];
+} GlueSaved;
+
+/* Set up g (name copied, a new drive); 0 when out of memory (then nothing is left allocated). */
+int glue_init(Glue *g, const char *name, int logging_on, const char *version);
+void glue_free(Glue *g);
+
+void glue_log(const Glue *g, int status, const char *category, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+/* A refused request: Error with "call: text"; nothing of the request was done. */
+int glue_fail(const Glue *g, const char *call, const char *text);
+/* 1 when the instance's state is one of states, else logs the refusal and returns 0. */
+int glue_allowed(const Glue *g, int states, const char *call);
+/* The drive's verdict on initialisation or a step: OK, Discard (state STEP_FAILED) or Error (ERROR_STATE). */
+int glue_drive_status(Glue *g, int status, const char *call);
+
+/* The life cycle. */
+int glue_setup(Glue *g, double start_time, int stop_defined, double stop_time, const char *call);
+int glue_enter_initialization(Glue *g, const char *call);
+int glue_exit_initialization(Glue *g, const char *call);
+int glue_terminate(Glue *g, const char *call);
+void glue_reset(Glue *g);
+
+/* Variables: nvr references of one kind; the get calls fill value with safe values before any check. */
+int glue_get_reals(Glue *g, const unsigned vr[], size_t nvr, double value[], const char *call);
+int glue_get_booleans(Glue *g, const unsigned vr[], size_t nvr, int value[], const char *call);
+int glue_get_strings(Glue *g, const unsigned vr[], size_t nvr, const char *value[], const char *call);
+int glue_set_reals(Glue *g, const unsigned vr[], size_t nvr, const double value[], const char *call);
+int glue_set_booleans(Glue *g, const unsigned vr[], size_t nvr, const int value[], const char *call);
+int glue_set_strings(Glue *g, const unsigned vr[], size_t nvr, const char *const value[], const char *call);
+
+/* A communication step from t (where the FMU is, to rounding) over h [s]. */
+int glue_do_step(Glue *g, double t, double h, const char *call);
+
+/* FMU states: save (NULL when out of memory), restore, serialise (header + bytes) and back. */
+GlueSaved *glue_save(Glue *g);
+int glue_restore(Glue *g, const GlueSaved *saved, const char *call);
+size_t glue_serialized_size(const GlueSaved *saved);
+int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t size, const char *call);
+/* A new saved state from serialised bytes into *saved (a former one freed); Error with a message if they are
+ * not a serialised cam.fmu state. */
+int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call);
+
+#endif

@@ -1,0 +1,93 @@
+"""cam3.fmu's modelDescription.xml (FMI 3.0 co-simulation), from the same variable table as cam.fmu's.
+
+Build time only. One source for names, value references, units, ranges and defaults
+(``model_description.variable_rows``, generated from physics/parameters.py and variables.py), the
+same unit definitions, log categories and default experiment; what FMI 3.0 adds is used where it
+helps a user: display units (rpm for rad/s, deg for rad) that a tool can show instead of SI, and the
+instantiation token checked by the binary. No event mode, no early return, no clocks, no arrays:
+the drive is a fixed set of scalars stepped synchronously (docs/fmu.md, "cam3.fmu").
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, List, Tuple
+from xml.dom.minidom import parseString
+from xml.etree import ElementTree as ET
+
+from .model_description import BASE_UNIT_ORDER, BASE_UNITS, LOG_CATEGORIES, _fmt
+
+# Display units: (name, factor) with display value = factor * SI value.
+DISPLAY_UNITS: Dict[str, Tuple[str, float]] = {"rad/s": ("rpm", 60.0 / (2.0 * math.pi)), "rad": ("deg", 180.0 / math.pi)}
+TYPES = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}
+
+
+def model_description(model_identifier: str, token: str, rows: List[Dict[str, Any]], experiment: tuple,
+                      description: str) -> bytes:
+    """The FMI 3.0 model description of ``rows`` (value reference = row index), pretty-printed UTF-8."""
+    root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=model_identifier,
+                      instantiationToken=token, description=description, generationTool="cam_fmu",
+                      variableNamingConvention="flat")
+    ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,
+                  canHandleVariableCommunicationStepSize="true", canGetAndSetFMUState="true",
+                  canSerializeFMUState="true", providesDirectionalDerivatives="false",
+                  providesAdjointDerivatives="false", hasEventMode="false",
+                  canReturnEarlyAfterIntermediateUpdate="false", providesIntermediateUpdate="false",
+                  needsCompletedIntegratorStep="false", maxOutputDerivativeOrder="0")
+    units = ET.SubElement(root, "UnitDefinitions")
+    for unit in sorted({row["unit"] for row in rows if row["unit"]}):
+        element = ET.SubElement(units, "Unit", name=unit)
+        exponents = BASE_UNITS.get(unit)
+        if exponents is not None:
+            ET.SubElement(element, "BaseUnit", {k: str(exponents[k]) for k in BASE_UNIT_ORDER if exponents.get(k)})
+        if unit in DISPLAY_UNITS:
+            name, factor = DISPLAY_UNITS[unit]
+            ET.SubElement(element, "DisplayUnit", name=name, factor=repr(factor))
+    categories = ET.SubElement(root, "LogCategories")
+    for name, text in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=text.replace("fmi2", "fmi3"))
+    start, stop, step = experiment
+    ET.SubElement(root, "DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
+                  stepSize=_fmt(float(step)))
+    variables = ET.SubElement(root, "ModelVariables")
+    # the independent variable FMI 3.0 asks for, after the table (value reference TIME_VR = len(rows))
+    ET.SubElement(variables, "Float64", name="time", valueReference=str(len(rows)), causality="independent",
+                  variability="continuous", unit="s", description="simulation time")
+    for vr, row in enumerate(rows):
+        variables.append(_variable(vr, row))
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = [vr for vr, row in enumerate(rows) if row["causality"] == "output"]
+    for vr in outputs:
+        ET.SubElement(structure, "Output", valueReference=str(vr))
+    for vr in outputs:
+        ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
+    return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+def _variable(vr: int, row: Dict[str, Any]) -> ET.Element:
+    attrs = {"name": row["name"], "valueReference": str(vr), "description": row["description"],
+             "causality": row["causality"], "variability": row["variability"]}
+    if row["initial"] and row["causality"] != "input":
+        attrs["initial"] = row["initial"]
+    kind = TYPES[row["type"]]
+    if kind == "Float64":
+        if row["unit"]:
+            attrs["unit"] = row["unit"]
+            if row["unit"] in DISPLAY_UNITS:
+                attrs["displayUnit"] = DISPLAY_UNITS[row["unit"]][0]
+        for key in ("min", "max"):
+            if row[key] is not None and math.isfinite(row[key]):
+                attrs[key] = repr(float(row[key]))
+        if row["start"] is not None:
+            attrs["start"] = repr(float(row["start"]))
+        return ET.Element(kind, attrs)
+    if kind == "Boolean":
+        if row["start"] is not None:
+            attrs["start"] = "true" if row["start"] else "false"
+        return ET.Element(kind, attrs)
+    element = ET.Element(kind, attrs)
+    if row["start"] is not None:
+        ET.SubElement(element, "Start", value=str(row["start"]))
+    return element
+
+
+__all__ = ["DISPLAY_UNITS", "model_description"]
