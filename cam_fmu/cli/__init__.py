@@ -27,6 +27,7 @@ SUBCOMMANDS: tuple[str, ...] = (
     "cosim",      # run an SSP (the speed loop) on the project's co-simulation master
     "sweep",      # parameter sweeps of a scene on dask.distributed
     "reflect",    # the inertia and load torque the motor sees over one turn
+    "cross_check",  # the FMI Cross-Check folders of the shipped FMUs, validated by fmpy
 )
 
 
