@@ -296,3 +296,30 @@ def test_bad_input_is_one_line_exit_2(engine_fmu_path, tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert err.startswith("cam-fmu cross-check: error: ") and message in err and "\n" not in err, err
     assert not (tmp_path / "out").exists()  # refused before anything was written
+
+
+def test_an_interface_added_to_the_model_description_gets_its_folders(engine_fmu_path, tmp_path):
+    """Model exchange (another helper's work) is found from the model description alone: a copy of cam.fmu
+    whose modelDescription.xml also declares it gets cs and me folders for each binary, and the me
+    folder's _ref.opt (StepSize 0: a variable-step solver) passes fmpy's reader."""
+    from cam_fmu.tools.cross_check import entries
+    from cam_fmu.tools.cross_check.experiment import fig6_experiment, opt_lines
+
+    dest = tmp_path / "cam.fmu"
+    with zipfile.ZipFile(engine_fmu_path) as zin, zipfile.ZipFile(dest, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                text = data.decode()
+                assert text.count("<CoSimulation ") == 1
+                data = text.replace("<CoSimulation ", '<ModelExchange modelIdentifier="cam"/>\n  <CoSimulation ').encode()
+            zout.writestr(item, data)
+    assert read_model_description(str(dest)).modelExchange is not None
+    found = {(e.fmi_version, e.fmi_type, e.platform) for e in entries(dest)}
+    platforms = {p for _, _, p in _offers(engine_fmu_path)}
+    assert "linux64" in platforms
+    assert found == _offers(dest) == {("2.0", t, p) for t in ("cs", "me") for p in platforms}
+    opt = tmp_path / "me_ref.opt"
+    opt.write_text("\n".join(opt_lines(fig6_experiment(), "me")) + "\n")
+    opts = read_ref_opt_file(str(opt))
+    assert opts["StepSize"] == 0.0 and opts["OutputIntervalLength"] == 1e-3 and opts["StopTime"] == 2.5
