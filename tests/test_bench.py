@@ -117,12 +117,16 @@ def test_floor_ratio_is_one_and_models_cost_more(quick):
     floor = next(r for r in rows if r["kind"] == "floor")
     assert _num(floor, "cost_ratio") == 1.0
     assert _num(floor, "us_per_step") == _num(floor, "floor_us_per_step")
+    ratios = []
     for r in rows:
         if r["kind"] == "fmu":  # each FMU run has its own floor, measured alternately with it
             assert _num(r, "floor_us_per_step") > 0.0
             assert math.isclose(_num(r, "cost_ratio"), _num(r, "us_per_step") / _num(r, "floor_us_per_step"),
                                 rel_tol=1e-9)
-            assert _num(r, "cost_ratio") > 1.0, r  # integrating a drive is more than returning True
+            ratios.append(_num(r, "cost_ratio"))
+    # integrating a drive is more than returning True: over the runs, not run by run. cam.fmu costs about
+    # 1.1x the floor, so on a shared machine one run's ratio fell to 0.75 (CI, 2026-11-25) and 0.94.
+    assert len(ratios) >= 5 and sorted(ratios)[len(ratios) // 2] > 1.0, ratios
 
 
 def test_rk45_error_falls_as_rtol_tightens(quick):
