@@ -3,6 +3,7 @@
 Same engine, same instance layer and glue rules: only csrc/fmi/fmi3_cs.c and the model description differ."""
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 import subprocess
@@ -190,3 +191,38 @@ def test_a_c_host_runs_it_clean_under_valgrind(cam3, unzipped, tmp_path):
     summary = valgrind_summary(log)
     assert summary["summaries"] >= 1 and summary["errors"] == 0, summary["excerpt"]
     assert "definitely lost" not in log.read_text() or "definitely lost: 0 bytes" in log.read_text()
+
+
+def test_the_windows_binary_runs_under_wine_as_the_linux_one_does(cam3, unzipped, tmp_path):
+    """host3.c cross-compiled with MinGW-w64 loads binaries/x86_64-windows/cam.dll under wine (both required
+    tools): the same statuses as on linux, a state restored to the bit, and theta after 0.2 s with backlash equal
+    to the linux binary's to 1e-12 relative (measured: equal to the bit)."""
+    from cam_fmu.engine.build import fmi_headers
+    from cam_fmu.fmu import engine_fmu
+    from native_support import require
+
+    wine = Path("/usr/lib/wine/wine64")
+    assert wine.is_file(), f"{wine} is missing: setup.sh installs Debian's wine64 package"
+    source = Path(__file__).resolve().parent / "native_host" / "host3.c"
+    exe, host = tmp_path / "host3.exe", tmp_path / "host3"
+    for compiler, out, extra in ((require(engine_fmu.WIN64_COMPILER), exe, ["-static"]), (require("gcc"), host, ["-ldl"])):
+        done = subprocess.run([compiler, "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", f"-I{fmi_headers()}",
+                               str(source), "-o", str(out), *extra], capture_output=True, text=True)
+        assert done.returncode == 0, done.stderr
+    md = read_model_description(str(cam3))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    args = [md.guid, str(vr["theta"]), str(vr["u"]), str(vr["c"]), "1"]
+    runs = {}
+    for platform, cmd in (("windows", [str(wine), str(exe), str(unzipped / "binaries" / "x86_64-windows" / "cam.dll")]),
+                          ("linux", [str(host), str(unzipped / "binaries" / "x86_64-linux" / "cam.so")])):
+        run = subprocess.run([*cmd, *args], capture_output=True, text=True, timeout=600,
+                             env={**os.environ, "WINEDEBUG": "-all"})
+        assert run.returncode == 0, (platform, run.stderr[-2000:])
+        runs[platform] = [line for line in run.stdout.splitlines() if not line.startswith("log ")]
+    assert [line.split()[0] for line in runs["windows"]] == [line.split()[0] for line in runs["linux"]]
+    restored = {p: next(line for line in lines if line.startswith("restored ")).split() for p, lines in runs.items()}
+    assert restored["windows"][1] == restored["linux"][1] == "same"
+    theta_w, theta_l = float.fromhex(restored["windows"][2]), float.fromhex(restored["linux"][2])
+    assert theta_l > 0.5 and abs(theta_w - theta_l) <= 1e-12 * theta_l
+    for status in ("set-c 0", "init 0", "nan-input 3", "wrong-time 3", "null-get 3", "terminate 0 reset 0"):
+        assert status in runs["windows"], status

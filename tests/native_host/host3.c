@@ -1,19 +1,33 @@
-/* An FMI 3.0 co-simulation host for cam3.fmu's binary, in C (tests/test_fmi3_c_host.py runs it under valgrind):
- * instance cycles with a parameter, initialisation, steps, FMU states (get, serialise, deserialise, restore),
- * refused calls (a NaN input, a step at the wrong time, calls on NULL) and a Discard; one line per result.
+/* An FMI 3.0 co-simulation host for cam3.fmu's binary, in C (tests/test_fmi3.py runs it under valgrind on
+ * x86_64-linux, and cross-compiled with MinGW-w64 under wine on x86_64-windows): instance cycles with a
+ * parameter, initialisation, steps, FMU states (get, serialise, deserialise, restore) and refused calls (a NaN
+ * input, a step at the wrong time, a call on NULL); one line per result.
  *
  *     host3 BINARY TOKEN THETA_VR U_VR C_VR CYCLES
  */
-#include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
+#ifdef _WIN32
+#include <windows.h>
+#define LIBRARY HMODULE
+#define OPEN(path) LoadLibraryA(path)
+#define CLOSE(lib) FreeLibrary(lib)
+/* a function pointer from GetProcAddress through an object pointer's bytes, as below */
+#define SYMBOL(lib, name) ((void *)GetProcAddress(lib, name))
+#else
+#include <dlfcn.h>
+#define LIBRARY void *
+#define OPEN(path) dlopen(path, RTLD_NOW | RTLD_LOCAL)
+#define CLOSE(lib) dlclose(lib)
+#define SYMBOL(lib, name) dlsym(lib, name)
+#endif
 
 #include "fmi3Functions.h"
 
 /* POSIX: a function pointer from dlsym through an object pointer's bytes */
 #define LOAD(name)          \
     name##TYPE *name;       \
-    *(void **)(&name) = dlsym(lib, #name)
+    *(void **)(&name) = SYMBOL(lib, #name)
 
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
     (void)env;
@@ -21,16 +35,16 @@ static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String ca
 }
 
 int main(int argc, char **argv) {
-    void *lib;
+    LIBRARY lib;
     fmi3ValueReference theta_vr, u_vr, c_vr;
     int cycles, k, n;
     if (argc != 7) {
         fprintf(stderr, "usage: host3 BINARY TOKEN THETA_VR U_VR C_VR CYCLES\n");
         return 2;
     }
-    lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+    lib = OPEN(argv[1]);
     if (!lib) {
-        fprintf(stderr, "%s\n", dlerror());
+        fprintf(stderr, "cannot load %s\n", argv[1]);
         return 2;
     }
     theta_vr = (fmi3ValueReference)atoi(argv[3]);
@@ -101,6 +115,6 @@ int main(int argc, char **argv) {
             fmi3FreeInstance(c);
         }
     }
-    dlclose(lib);
+    CLOSE(lib);
     return 0;
 }
