@@ -226,3 +226,18 @@ def test_the_windows_binary_runs_under_wine_as_the_linux_one_does(cam3, unzipped
     assert theta_l > 0.5 and abs(theta_w - theta_l) <= 1e-12 * theta_l
     for status in ("set-c 0", "init 0", "nan-input 3", "wrong-time 3", "null-get 3", "terminate 0 reset 0"):
         assert status in runs["windows"], status
+
+
+def test_the_binary_exports_exactly_the_functions_of_fmi3(unzipped):
+    """Every function fmi3Functions.h names (an importer may look up any of them), and nothing else."""
+    import re
+
+    from cam_fmu.engine.build import fmi_headers
+
+    header = (fmi_headers() / "fmi3Functions.h").read_text()
+    required = set(re.findall(r"^#define (fmi3\w+) ", header, flags=re.M)) - {"fmi3Version"}
+    nm = subprocess.run(["nm", "-D", "--defined-only", str(unzipped / "binaries" / "x86_64-linux" / "cam.so")],
+                        capture_output=True, text=True)
+    assert nm.returncode == 0, nm.stderr
+    exported = {line.split()[-1] for line in nm.stdout.splitlines() if line.strip()}
+    assert len(required) == 75 and exported == required
