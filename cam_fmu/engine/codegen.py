@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 from ..kinematics.presets import PRESETS
-from ..physics.parameters import PARAMETERS, ParameterSpec
+from ..physics.parameters import PARAMETERS, RIGID_ONLY, ParameterSpec
 from ..physics.variables import INPUT_RANGES, INPUTS, OUTPUTS
 
 HEADER = "cam_params.h"
@@ -113,6 +113,13 @@ def header_text() -> str:
         "const CamVariableSpec *cam_output_spec(int index);",
         "/* The split points T1..T6 of preset law ``choice`` (< CAM_N_PRESETS), else NULL. */",
         "const double *cam_preset_T(int choice);", "",
+        "/* The choices that model a rigid drive-train only (physics.parameters.RIGID_ONLY): parameter, choice,",
+        " * why k_shaft > 0 is refused with it, and what to use instead. */",
+        "typedef struct {", "    int param;                  /* CAM_P_* */", "    int choice;                 /* its CAM_CHOICE_* */",
+        "    const char *reason;", "    const char *instead;", "} CamRigidOnly;", "",
+        f"#define CAM_N_RIGID_ONLY {len(RIGID_ONLY)}",
+        "/* The k-th rigid-only choice (k < CAM_N_RIGID_ONLY), else NULL. */",
+        "const CamRigidOnly *cam_rigid_only(int k);", "",
         "#endif", "",
     ]
     return "\n".join(lines)
@@ -147,8 +154,14 @@ def source_text() -> str:
     lines += ["};", "", "static const double PRESET_T[CAM_N_PRESETS][6] = {"]
     for name, T in PRESETS.items():
         lines.append(f"    {{{', '.join(c_double(t) for t in T)}}},  /* {name} */")
+    lines += ["};", "", "static const CamRigidOnly RIGID[CAM_N_RIGID_ONLY] = {"]
+    for (name, choice), (reason, instead) in RIGID_ONLY.items():
+        lines.append(f"    {{CAM_P_{c_name(name)}, CAM_CHOICE_{c_name(name)}_{c_name(choice)}, {c_string(reason)}, "
+                     f"{c_string(instead)}}},")
     lines += [
         "};", "",
+        "const CamRigidOnly *cam_rigid_only(int k)",
+        "{", "    return k >= 0 && k < CAM_N_RIGID_ONLY ? &RIGID[k] : NULL;", "}", "",
         "const CamParamSpec *cam_param_spec(int index)",
         "{", "    return index >= 0 && index < CAM_N_PARAMS ? &PARAMS[index] : NULL;", "}", "",
         "const CamVariableSpec *cam_input_spec(int index)",

@@ -32,6 +32,7 @@ OUTPUTS_PER_HOLD = 8
 SETTLE_PERIODS = 20  # periods before the measurement, at least
 MEASURE_PERIODS = 10  # periods in the fit
 
+
 def _harmonic(t: np.ndarray, y: np.ndarray, w: float) -> complex:
     """The complex amplitude Y of y ~ a + Re(Y e^(j w t)) fitted by least squares [unit of y]. Over whole periods
     of samples equally spaced, the harmonics of the staircase (64 k +- 1) are orthogonal to it; a trend term

@@ -37,12 +37,11 @@ static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
  * against the lightest cam side, or the electrical pole, which rk45 then takes explicitly (docs/model.md 12.1). */
 static void compliant_cause(const CamModel *m, char *buf, size_t len)
 {
-    double inverse, shaft, pole;
+    double shaft, pole;
     buf[0] = '\0';
     if (!m->compliant)
         return;
-    inverse = 1.0 / m->J_m + 1.0 / m->J_0;
-    shaft = sqrt(m->k_shaft * inverse) + m->d_shaft * inverse;
+    shaft = cam_shaft_rate(m, m->J_0);
     pole = m->has_current ? m->R / m->L : 0.0;
     if (pole > shaft)
         snprintf(buf, len, "; with a compliant shaft the electrical pole R/L = %.3g 1/s is integrated explicitly "

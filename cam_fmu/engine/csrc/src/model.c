@@ -295,29 +295,27 @@ static int build_program(CamModel *model, CamError *err)
     return CAM_OK;
 }
 
-/* What a compliant shaft needs (physics/drive.py's check_compliant, text for text). */
+/* What a compliant shaft needs (physics/drive.py's check_compliant, text for text): a cam side with inertia,
+ * and none of the rigid-only choices (the generated table of physics.parameters.RIGID_ONLY). */
 static int check_compliant(const CamModel *model, CamError *err)
 {
     char k[40], j[40];
     const double *v = model->params.v;
+    int n;
     cam_num(model->k_shaft, k);
     if (!(model->J_0 > 0.0))
         return cam_error(err, CAM_ERR_PARAMETER,
                          "parameter 'J_cam' = %s [kg.m2]: a compliant shaft (k_shaft = %s N.m/rad) needs the inertia "
                          "of its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2",
                          cam_num(v[CAM_P_J_CAM], j), k);
-    if (model->formulation == CAM_FORM_PAPER)
-        return cam_error(err, CAM_ERR_PARAMETER,
-                         "parameter 'k_shaft' = %s N.m/rad: the paper's algorithm models a rigid drive-train; "
-                         "allowed with formulation 'paper': k_shaft = 0 (use formulation 'consistent')", k);
-    if (model->formulation == CAM_FORM_SPEED)
-        return cam_error(err, CAM_ERR_PARAMETER,
-                         "parameter 'k_shaft' = %s N.m/rad: the speed drive imposes the cam's speed on a rigid "
-                         "drive-train; allowed with drive 'speed': k_shaft = 0", k);
-    if (model->solver == CAM_CHOICE_SOLVER_ETDRK4)
-        return cam_error(err, CAM_ERR_PARAMETER,
-                         "parameter 'k_shaft' = %s N.m/rad: solver 'etdrk4' integrates the rigid drive's electrical "
-                         "pole; allowed with solver 'etdrk4': k_shaft = 0 (use solver 'rk45')", k);
+    for (n = 0; n < CAM_N_RIGID_ONLY; n++) {
+        const CamRigidOnly *r = cam_rigid_only(n);
+        const CamParamSpec *spec = cam_param_spec(r->param);
+        if ((int)v[r->param] == r->choice)
+            return cam_error(err, CAM_ERR_PARAMETER,
+                             "parameter 'k_shaft' = %s N.m/rad: %s; allowed with %s '%s': k_shaft = 0%s", k,
+                             r->reason, spec->name, spec->choices[r->choice], r->instead);
+    }
     return CAM_OK;
 }
 

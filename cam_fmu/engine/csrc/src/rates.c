@@ -23,8 +23,7 @@ double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x
         rate = (2.0 * m->m * fabs(d[1] * d[2] * omega) + fabs(omega) * sqrt(m->m * J * (d[2] * d[2] + fabs(d[1] * d[3]))))
                / J;
     if (m->compliant) {   /* the two-mass oscillation and its damping; the motor acts on the rotor alone */
-        double inverse = 1.0 / m->J_m + 1.0 / J;
-        rate += sqrt(m->k_shaft * inverse) + m->d_shaft * inverse;
+        rate += cam_shaft_rate(m, J);
         J = m->J_m;
     }
     if (m->L > 0.0) {
@@ -34,6 +33,12 @@ double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x
         rate += electrical_rate(m, J);
     }
     return rate;
+}
+
+double cam_shaft_rate(const CamModel *m, double J)
+{
+    double inverse = 1.0 / m->J_m + 1.0 / J;
+    return sqrt(m->k_shaft * inverse) + m->d_shaft * inverse;
 }
 
 double cam_profile_rate(const CamModel *m, const double x[CAM_NX])
