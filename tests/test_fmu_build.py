@@ -77,7 +77,10 @@ def test_model_description_complete(md_root):
     structure = md_root.find("ModelStructure")
     listed = {int(u.get("index")) for u in structure.find("Outputs")}
     initial = {int(u.get("index")) for u in structure.find("InitialUnknowns")}
-    assert listed == initial == {index_of[n] for n in outputs}
+    assert listed == {index_of[n] for n in outputs}
+    # Model Exchange: the states and their derivatives are initial unknowns too (calculated)
+    states = {n for n, v in by_name.items() if v.get("causality") == "local"}
+    assert initial == listed | {index_of[n] for n in states} and len(states) == 10
     assert by_name["omega"].find("Real").get("unit") == "rad/s"
 
 

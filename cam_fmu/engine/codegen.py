@@ -20,7 +20,7 @@ from pathlib import Path
 
 from ..kinematics.presets import PRESETS
 from ..physics.parameters import PARAMETERS, RIGID_ONLY, ParameterSpec
-from ..physics.variables import INPUT_RANGES, INPUTS, OUTPUTS
+from ..physics.variables import EVENT_INDICATORS, INPUT_RANGES, INPUTS, OUTPUTS, STATES
 
 HEADER = "cam_params.h"
 SOURCE = "cam_params.c"
@@ -76,6 +76,10 @@ def header_text() -> str:
         "#define CAM_VR_INPUTS 0            /* value reference of the first input */",
         f"#define CAM_VR_OUTPUTS {n_in}            /* of the first output */",
         f"#define CAM_VR_PARAMS {n_in + n_out}            /* of the first parameter */",
+        f"#define CAM_N_STATES {len(STATES)}   /* Model Exchange's continuous states (= CAM_NX) */",
+        f"#define CAM_VR_STATES {n_in + n_out + len(PARAMETERS)}   /* of the first state, after the parameters */",
+        f"#define CAM_VR_DERIVATIVES {n_in + n_out + len(PARAMETERS) + len(STATES)}   /* of der(first state) */",
+        f"#define CAM_N_EVENT_INDICATORS {EVENT_INDICATORS}   /* Model Exchange's event indicators */",
         "", "typedef enum { CAM_KIND_REAL = 0, CAM_KIND_BOOLEAN = 1, CAM_KIND_STRING = 2 } CamKind;", "",
         "enum {",
     ]
@@ -111,6 +115,9 @@ def header_text() -> str:
         "const CamParamSpec *cam_param_spec(int index);",
         "const CamVariableSpec *cam_input_spec(int index);",
         "const CamVariableSpec *cam_output_spec(int index);",
+        "/* The continuous states and their derivatives by slot (0..CAM_N_STATES-1); NULL out of range. */",
+        "const CamVariableSpec *cam_state_spec(int index);",
+        "const CamVariableSpec *cam_derivative_spec(int index);",
         "/* The split points T1..T6 of preset law ``choice`` (< CAM_N_PRESETS), else NULL. */",
         "const double *cam_preset_T(int choice);", "",
         "/* The choices that model a rigid drive-train only (physics.parameters.RIGID_ONLY): parameter, choice,",
@@ -151,6 +158,15 @@ def source_text() -> str:
     for k, (name, unit, desc) in enumerate(OUTPUTS):
         lines.append(f"    {{{c_string(name)}, {c_string(unit)}, {c_string(desc)}, {n_in + k}u, 0.0, "
                      "(-HUGE_VAL), HUGE_VAL},")
+    first = n_in + n_out + len(PARAMETERS)
+    lines += ["};", "", "static const CamVariableSpec STATE_SPECS[CAM_N_STATES] = {"]
+    for k, (name, unit, _rate, desc) in enumerate(STATES):
+        lines.append(f"    {{{c_string(name)}, {c_string(unit)}, {c_string(desc)}, {first + k}u, 0.0, "
+                     "(-HUGE_VAL), HUGE_VAL},")
+    lines += ["};", "", "static const CamVariableSpec DERIVATIVE_SPECS[CAM_N_STATES] = {"]
+    for k, (name, _unit, rate, _desc) in enumerate(STATES):
+        lines.append(f"    {{{c_string(f'der({name})')}, {c_string(rate)}, {c_string(f'derivative of {name}')}, "
+                     f"{first + len(STATES) + k}u, 0.0, (-HUGE_VAL), HUGE_VAL}},")
     lines += ["};", "", "static const double PRESET_T[CAM_N_PRESETS][6] = {"]
     for name, T in PRESETS.items():
         lines.append(f"    {{{', '.join(c_double(t) for t in T)}}},  /* {name} */")
@@ -168,6 +184,10 @@ def source_text() -> str:
         "{", "    return index >= 0 && index < CAM_N_INPUTS ? &INPUT_SPECS[index] : NULL;", "}", "",
         "const CamVariableSpec *cam_output_spec(int index)",
         "{", "    return index >= 0 && index < CAM_N_OUTPUTS ? &OUTPUT_SPECS[index] : NULL;", "}", "",
+        "const CamVariableSpec *cam_state_spec(int index)",
+        "{", "    return index >= 0 && index < CAM_N_STATES ? &STATE_SPECS[index] : NULL;", "}", "",
+        "const CamVariableSpec *cam_derivative_spec(int index)",
+        "{", "    return index >= 0 && index < CAM_N_STATES ? &DERIVATIVE_SPECS[index] : NULL;", "}", "",
         "const double *cam_preset_T(int choice)",
         "{", "    return choice >= 0 && choice < CAM_N_PRESETS ? PRESET_T[choice] : NULL;", "}", "",
     ]

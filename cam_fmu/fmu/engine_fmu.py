@@ -7,7 +7,8 @@ Build time only. Steps:
 2. The generated headers (``engine.codegen``: the variable and parameter tables of
    ``physics/parameters.py`` and ``physics/variables.py``) in a temporary folder.
 3. The binary: every engine source (``engine/csrc/src/*.c``) and the FMI 2.0
-   glue (``engine/csrc/fmi/fmi2_cs.c``) compiled into one shared library with the
+   glue (``engine/csrc/fmi/fmi2.c`` and ``fmi2_me.c`` over ``glue.c``, ``glue_me.c``,
+   ``exchange.c`` and ``instance.c``) compiled into one shared library with the
    official FMI headers (fmpy's copy), only the FMI functions exported, linked
    with libc and libm only: ``binaries/linux64/cam.so``; with the MinGW-w64 cross
    compiler also ``binaries/win64/cam.dll`` (Windows' own KERNEL32 and msvcrt only).
@@ -34,10 +35,12 @@ MODEL_IDENTIFIER = "cam"
 DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
                "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
 FMI = engine_build.CSRC / "fmi"
-# The FMI glue of each version: the instance layer, the glue both share, the version's own file; its
-# official headers; its platform folders (FMI 3.0 names them by architecture and OS).
-GLUE = {2: (FMI / "instance.c", FMI / "glue.c", FMI / "fmi2_cs.c"),
-        3: (FMI / "instance.c", FMI / "glue.c", FMI / "fmi3_cs.c")}
+# The FMI glue of each version: the instance layer, the Model Exchange layer, the glue both share, the
+# version's own files (FMI 2.0: co-simulation and Model Exchange; FMI 3.0: co-simulation); its official
+# headers; its platform folders (FMI 3.0 names them by architecture and OS).
+SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "glue.c", FMI / "glue_me.c")
+GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
+        3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 PLATFORM_DIRS = {2: {"linux64": "linux64", "win64": "win64"}, 3: {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}

@@ -25,7 +25,8 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 from ..physics import parameters
-from ..physics.variables import INPUT_RANGES, INPUTS, OUTPUTS
+from ..physics.variables import (EVENT_INDICATORS, FEEDTHROUGH, FEEDTHROUGH_INPUTS, INPUT_RANGES, INPUTS, OUTPUTS,
+                                 STATES)
 
 # SI base-unit exponents of the units used by the model (FMI 2.0 BaseUnit attributes).
 BASE_UNITS: Dict[str, Dict[str, int]] = {
@@ -49,6 +50,7 @@ BASE_UNITS: Dict[str, Dict[str, int]] = {
     "rad": {"rad": 1},
     "rad/s": {"rad": 1, "s": -1},
     "rad/s2": {"rad": 1, "s": -2},
+    "A/s": {"A": 1, "s": -1},
     "1": {},
 }
 BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
@@ -66,7 +68,21 @@ def variable_rows() -> List[Dict[str, Any]]:
         rows.append(dict(name=name, type="Real", causality="output", variability="continuous",
                          initial="calculated", unit=unit, start=None, min=None, max=None, description=desc,
                          allowed="(output)"))
-    return rows + parameter_rows(parameters.PARAMETERS)
+    return rows + parameter_rows(parameters.PARAMETERS) + state_rows()
+
+
+def state_rows() -> List[Dict[str, Any]]:
+    """Model Exchange's continuous states, then their derivatives (appended: the co-simulation value
+    references before them stay): local, calculated, read-only."""
+    rows: List[Dict[str, Any]] = []
+    for name, unit, _rate, desc in STATES:
+        rows.append(dict(name=name, type="Real", causality="local", variability="continuous", initial="calculated",
+                         unit=unit, start=None, min=None, max=None, description=desc, allowed="(state)"))
+    for name, _unit, rate, _desc in STATES:
+        rows.append(dict(name=f"der({name})", type="Real", causality="local", variability="continuous",
+                         initial="calculated", unit=rate, start=None, min=None, max=None,
+                         description=f"derivative of {name}", allowed="(derivative)", derivative=name))
+    return rows
 
 
 def parameter_rows(specs) -> List[Dict[str, Any]]:
@@ -178,23 +194,39 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
             typed.set("max", _fmt(float(row["max"])))
         if row["start"] is not None:
             typed.set("start", _fmt(float(row["start"]) if row["type"] == "Real" else row["start"]))
+        if row.get("derivative"):  # a state derivative names its state by index (states come first)
+            typed.set("derivative", str(index_of[row["derivative"]]))
     missing = set(rows) - set(index_of)
     if missing:
         raise ValueError(f"variables missing from the FMU: {sorted(missing)}")
 
     # ModelStructure: every output in Outputs and InitialUnknowns (all are 'calculated').
-    # Outputs: dependencies="" - no direct feedthrough: a new input (u, omega_ref) changes no output
-    # before the next fmi2DoStep, so a master need not iterate a loop closed around cam.fmu.
+    # Outputs: in co-simulation a new input (u, omega_ref) changes no output before the next fmi2DoStep;
+    # in Model Exchange the outputs follow the host's state and inputs at once, and those of
+    # variables.FEEDTHROUGH (i, M, a, voltage) depend on u directly. One model description serves both:
+    # they list u (Model Exchange's truth, and safe for a co-simulation master), the others list nothing,
+    # so a master need not iterate a loop closed around cam.fmu through omega, theta or s.
     # InitialUnknowns: no dependencies attribute (= may depend on every input and parameter), which
     # is the truth: the initial i and voltage follow the inputs set before initialisation.
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
+    # Derivatives (Model Exchange): every state's derivative, no dependencies attribute (= on all).
+    # InitialUnknowns also hold the states and derivatives, computed from the parameters and inputs.
     outputs = [name for name, row in rows.items() if row["causality"] == "output"]
+    derivatives = [name for name, row in rows.items() if row.get("derivative")]
+    states = [row["derivative"] for row in rows.values() if row.get("derivative")]
     out_node = ET.SubElement(structure, "Outputs")
-    init_node = ET.SubElement(structure, "InitialUnknowns")
+    feedthrough = " ".join(str(index_of[name]) for name in FEEDTHROUGH_INPUTS if name in index_of)
     for name in sorted(outputs, key=index_of.get):
-        ET.SubElement(out_node, "Unknown", index=str(index_of[name]), dependencies="")
+        ET.SubElement(out_node, "Unknown", index=str(index_of[name]),
+                      dependencies=feedthrough if name in FEEDTHROUGH and derivatives else "")
+    if derivatives:
+        der_node = ET.SubElement(structure, "Derivatives")
+        for name in sorted(derivatives, key=index_of.get):
+            ET.SubElement(der_node, "Unknown", index=str(index_of[name]))
+    init_node = ET.SubElement(structure, "InitialUnknowns")
+    for name in sorted(outputs + states + derivatives, key=index_of.get):
         ET.SubElement(init_node, "Unknown", index=str(index_of[name]))
 
     text = ET.tostring(root, encoding="UTF-8")
@@ -221,10 +253,17 @@ def guid(rows: List[Dict[str, Any]], engine_digest: str) -> str:
 
 
 def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]]) -> bytes:
-    """A co-simulation modelDescription.xml with every variable of ``rows`` (value reference = row
+    """A modelDescription.xml (Model Exchange and co-simulation) with every variable of ``rows`` (value reference = row
     index) and the capabilities of the C binary; ``postprocess`` completes it."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=model_identifier, guid=model_guid,
-                      generationTool="cam_fmu", variableNamingConvention="flat", numberOfEventIndicators="0")
+                      generationTool="cam_fmu", variableNamingConvention="flat",
+                      numberOfEventIndicators=str(EVENT_INDICATORS))
+    # Model Exchange beside co-simulation, one binary (csrc/fmi/fmi2.c over exchange.c): the host's
+    # solver integrates the consistent formulation's states (docs/fmu.md, "Model Exchange").
+    ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, needsExecutionTool="false",
+                  completedIntegratorStepNotNeeded="false", canBeInstantiatedOnlyOncePerProcess="false",
+                  canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
+                  canSerializeFMUstate="true", providesDirectionalDerivative="false")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier, needsExecutionTool="false",
                   canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
                   canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",

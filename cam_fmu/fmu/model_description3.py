@@ -23,7 +23,12 @@ TYPES = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}
 
 def model_description(model_identifier: str, token: str, rows: List[Dict[str, Any]], experiment: tuple,
                       description: str) -> bytes:
-    """The FMI 3.0 model description of ``rows`` (value reference = row index), pretty-printed UTF-8."""
+    """The FMI 3.0 model description of ``rows`` (value reference = row index), pretty-printed UTF-8.
+
+    Co-simulation only: Model Exchange's state and derivative rows (cam.fmu's, at the table's end) are left
+    out, and 'time' takes the value reference after them (TIME_VR in csrc/fmi/fmi3_cs.c)."""
+    time_vr = len(rows)
+    rows = [row for row in rows if row["allowed"] not in ("(state)", "(derivative)")]
     root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=model_identifier,
                       instantiationToken=token, description=description, generationTool="cam_fmu",
                       variableNamingConvention="flat")
@@ -49,8 +54,8 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
     ET.SubElement(root, "DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
                   stepSize=_fmt(float(step)))
     variables = ET.SubElement(root, "ModelVariables")
-    # the independent variable FMI 3.0 asks for, after the table (value reference TIME_VR = len(rows))
-    ET.SubElement(variables, "Float64", name="time", valueReference=str(len(rows)), causality="independent",
+    # the independent variable FMI 3.0 asks for, after the whole table (value reference TIME_VR)
+    ET.SubElement(variables, "Float64", name="time", valueReference=str(time_vr), causality="independent",
                   variability="continuous", unit="s", description="simulation time")
     for vr, row in enumerate(rows):
         variables.append(_variable(vr, row))

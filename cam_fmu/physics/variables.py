@@ -55,3 +55,23 @@ def check_input(name: str, value: float) -> float:
 def output_record(**values: Any) -> dict[str, float]:
     """Every output, in table order, from keyword values (a missing one is a KeyError)."""
     return {name: values[name] for name in OUTPUT_NAMES}
+
+# The engine's continuous state x[CAM_NX] (cam_model.h's slots, in order): Model Exchange's states,
+# each with its derivative variable ``der(<name>)``; value references after the parameters (the
+# co-simulation references above stay where they were). The C build checks the count against CAM_NX.
+# A rigid drive carries the first three only: the last two are then held (derivative 0).
+STATES: tuple[tuple[str, str, str, str], ...] = (
+    ("x_theta", "rad", "rad/s", "continuous state: the cam angle (= output theta)"),
+    ("x_omega", "rad/s", "rad/s2", "continuous state: the cam speed (= output omega)"),
+    ("x_i", "A", "A/s", "continuous state: the armature current (held at 0 when L = 0: i is then quasi-static)"),
+    ("x_twist", "rad", "rad/s", "continuous state: the shaft's twist theta_m - theta (held at 0 when k_shaft = 0)"),
+    ("x_omega_m", "rad/s", "rad/s2", "continuous state: the motor's speed (held when k_shaft = 0: omega_m = omega)"),
+)
+# The outputs that depend directly on an input at a fixed state in Model Exchange, and those inputs: the
+# quasi-static current (L = 0) and the voltage follow u, the load torque and the follower's acceleration
+# follow the cam's acceleration, hence u (tests/test_engine_fmu_me.py measures it both ways).
+FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage")
+FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
+# Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
+# next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).
+EVENT_INDICATORS = 4

@@ -1,4 +1,4 @@
-/* FMI 3.0 co-simulation glue of cam3.fmu over the shared glue (glue.h), as fmi2_cs.c is for FMI 2.0.
+/* FMI 3.0 co-simulation glue of cam3.fmu over the shared glue (glue.h), as fmi2.c is for FMI 2.0.
  *
  * The same engine, instance layer and rules (docs/fmu.md "Errors"); what FMI 3.0 changes is here: the
  * instantiation token, fmi3DoStep's out-arguments (lastSuccessfulTime where the FMU stands after a Discard),
@@ -135,7 +135,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         return NULL;
     }
     S = calloc(1, sizeof *S);
-    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi3")) {
+    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi3", 0)) {
         free(S);
         refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s", "fmi3InstantiateCoSimulation",
                              "out of memory");
@@ -144,6 +144,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     S->logger = logMessage;
     S->environment = instanceEnvironment;
     S->glue.emit = logMessage ? emit : NULL;
+    S->glue.vr_end = CAM_VR_STATES;   /* Model Exchange's states are cam.fmu's, not described here */
     S->glue.host = S;
     S->glue.magic = INSTANCE_MAGIC;
     return S;
@@ -196,8 +197,8 @@ static int scalar_count(fmi3Instance c, size_t nvr, size_t nValues, const char *
     return 0;
 }
 
-/* The independent variable 'time' [s], after the table (model_description3.py). */
-#define TIME_VR ((fmi3ValueReference)(CAM_VR_PARAMS + CAM_N_PARAMS))
+/* The independent variable 'time' [s], after the whole table (model_description3.py). */
+#define TIME_VR ((fmi3ValueReference)CAM_VR_END)
 
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues) {

@@ -1,5 +1,6 @@
-/* The co-simulation glue both FMI versions share (glue.h): state machine, logging, variable access,
- * steps and saved states over the instance layer (cam_instance.h). No FMI header, no globals. */
+/* The glue both FMI versions share (glue.h): state machine, logging, variable access, steps and saved
+ * states over the instance layer (cam_instance.h); Model Exchange's calls are glue_me.c's. No FMI header,
+ * no globals. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -15,7 +16,7 @@
 /* |currentCommunicationPoint - the FMU's time| allowed: rounding of a host's summed steps */
 #define TIME_SLACK(t) (1e-9 * (fabs(t) > 1.0 ? fabs(t) : 1.0))
 
-int glue_init(Glue *g, const char *name, int logging_on, const char *version)
+int glue_init(Glue *g, const char *name, int logging_on, const char *version, int exchange)
 {
     g->name = malloc(strlen(name) + 1);
     g->drive = cam_instance_new();
@@ -31,6 +32,9 @@ int glue_init(Glue *g, const char *name, int logging_on, const char *version)
     g->state = GLUE_INSTANTIATED;
     g->start_time = g->last_successful_time = 0.0;
     g->version = version;
+    g->vr_end = CAM_VR_END;
+    g->exchange = exchange ? 1 : 0;
+    cam_exchange_init(&g->me, g->drive);
     return 1;
 }
 
@@ -52,6 +56,8 @@ static const char *state_name(GlueState s)
     case GLUE_STEP_FAILED: return "step mode after Discard";
     case GLUE_ERROR_STATE: return "error (after Error: Reset or SetFMUState to go on)";
     case GLUE_TERMINATED: return "terminated";
+    case GLUE_EVENT_MODE: return "event mode";
+    case GLUE_CONTINUOUS_TIME_MODE: return "continuous-time mode";
     }
     return "unknown";
 }
@@ -134,6 +140,16 @@ int glue_exit_initialization(Glue *g, const char *call)
     if (!glue_allowed(g, GLUE_INITIALIZATION, call))
         return GLUE_ERROR;
     status = glue_drive_status(g, cam_instance_initialize(g->drive, g->start_time), call);
+    if (status == GLUE_OK && g->exchange) {   /* Model Exchange starts in event mode */
+        if (cam_exchange_attach(&g->me) != CAM_OK) {
+            glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_exchange_message(&g->me));
+            g->state = GLUE_ERROR_STATE;
+            return GLUE_ERROR;
+        }
+        g->state = GLUE_EVENT_MODE;
+        g->last_successful_time = g->start_time;
+        return GLUE_OK;
+    }
     if (status == GLUE_OK) {
         g->state = GLUE_STEP_COMPLETE;
         g->last_successful_time = g->start_time;
@@ -143,7 +159,7 @@ int glue_exit_initialization(Glue *g, const char *call)
 
 int glue_terminate(Glue *g, const char *call)
 {
-    if (!glue_allowed(g, GLUE_STEP_COMPLETE | GLUE_STEP_FAILED | GLUE_ERROR_STATE, call))
+    if (!glue_allowed(g, GLUE_STEP_COMPLETE | GLUE_STEP_FAILED | GLUE_ERROR_STATE | GLUE_ME_STATES, call))
         return GLUE_ERROR;
     g->state = GLUE_TERMINATED;
     return GLUE_OK;
@@ -152,6 +168,7 @@ int glue_terminate(Glue *g, const char *call)
 void glue_reset(Glue *g)
 {
     cam_instance_reset(g->drive);
+    cam_exchange_init(&g->me, g->drive);
     g->state = GLUE_INSTANTIATED;
     g->start_time = g->last_successful_time = 0.0;
 }
@@ -172,9 +189,9 @@ static int check_references(const Glue *g, const unsigned vr[], size_t nvr, cons
         return 0;
     }
     for (k = 0; k < nvr; k++) {
-        if (!cam_instance_variable(vr[k], &kind, &name)) {
-            snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %d)", vr[k],
-                     CAM_VR_PARAMS + CAM_N_PARAMS - 1);
+        if (vr[k] >= g->vr_end || !cam_instance_variable(vr[k], &kind, &name)) {
+            snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %u)", vr[k],
+                     g->vr_end - 1);
             glue_fail(g, call, text);
             return 0;
         }
@@ -196,6 +213,8 @@ int glue_get_reals(Glue *g, const unsigned vr[], size_t nvr, double value[], con
             value[k] = 0.0;
     if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_REAL, call))
         return GLUE_ERROR;
+    if (g->state & GLUE_ME_STATES)
+        cam_exchange_sync(&g->me);   /* outputs at the host's state and inputs */
     for (k = 0; k < nvr; k++)
         if (cam_instance_get_real(g->drive, vr[k], &value[k]) != CAM_OK)
             return glue_fail(g, call, cam_instance_message(g->drive));
@@ -318,20 +337,56 @@ GlueSaved *glue_save(Glue *g)
 {
     size_t size = cam_instance_state_size(g->drive);
     GlueSaved *saved = malloc(sizeof *saved + size);
+    int me = (g->state & GLUE_ME_STATES) != 0;
     if (!saved)
         return NULL;
     saved->size = size;
-    if (cam_instance_save(g->drive, saved->bytes, size) != CAM_OK) {
+    saved->mode = me ? (unsigned)g->state : 0u;
+    if ((me ? cam_exchange_save(&g->me, saved->bytes, size) : cam_instance_save(g->drive, saved->bytes, size))
+        != CAM_OK) {
         free(saved);
         return NULL;
     }
     return saved;
 }
 
+/* Model Exchange: the restored drive must be one Model Exchange runs, else the state before is put back. */
+static int restore_exchange(Glue *g, const GlueSaved *saved, const char *call)
+{
+    GlueSaved *before = glue_save(g);
+    int status;
+    if (!before)
+        return glue_fail(g, call, "out of memory");
+    if (cam_instance_restore(g->drive, saved->bytes, saved->size) != CAM_OK) {
+        free(before);
+        return glue_fail(g, call, cam_instance_message(g->drive));
+    }
+    if (!cam_instance_initialized(g->drive)) {
+        free(before);
+        g->state = GLUE_INSTANTIATED;
+        return GLUE_OK;
+    }
+    if (cam_exchange_attach(&g->me) != CAM_OK) {
+        status = glue_fail(g, call, cam_exchange_message(&g->me));
+        cam_instance_restore(g->drive, before->bytes, before->size);
+        if (cam_instance_initialized(g->drive))
+            cam_exchange_attach(&g->me);
+        free(before);
+        return status;
+    }
+    free(before);
+    /* the mode it was saved in; a co-simulation state enters event mode (the host then iterates) */
+    g->state = saved->mode == GLUE_CONTINUOUS_TIME_MODE ? GLUE_CONTINUOUS_TIME_MODE : GLUE_EVENT_MODE;
+    g->last_successful_time = cam_instance_time(g->drive);
+    return GLUE_OK;
+}
+
 int glue_restore(Glue *g, const GlueSaved *saved, const char *call)
 {
     if (!saved)
         return glue_fail(g, call, "the FMU state must not be NULL");
+    if (g->exchange)
+        return restore_exchange(g, saved, call);
     /* the instance's state follows the drive's: an initialised one goes to step mode */
     if (cam_instance_restore(g->drive, saved->bytes, saved->size) != CAM_OK)
         return glue_fail(g, call, cam_instance_message(g->drive));
@@ -374,7 +429,7 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
     put_u32(out, STATE_MAGIC);
     put_u32(out + 4, STATE_FORMAT);
     put_u32(out + 8, (unsigned long)(saved->size & 0xffffffffu));
-    put_u32(out + 12, 0);
+    put_u32(out + 12, saved->mode);
     memcpy(out + STATE_HEADER, saved->bytes, saved->size);
     return GLUE_OK;
 }
@@ -383,6 +438,7 @@ int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **
 {
     GlueSaved *made;
     size_t payload;
+    unsigned mode;
     if (!in || !saved)
         return glue_fail(g, call, "the arguments must not be NULL");
     if (size < STATE_HEADER || get_u32(in) != STATE_MAGIC || get_u32(in + 4) != STATE_FORMAT)
@@ -390,10 +446,14 @@ int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **
     payload = get_u32(in + 8);
     if (payload != size - STATE_HEADER)
         return glue_fail(g, call, "the serialised state is truncated or has trailing bytes");
+    mode = (unsigned)get_u32(in + 12);
+    if (mode != 0u && mode != GLUE_EVENT_MODE && mode != GLUE_CONTINUOUS_TIME_MODE)
+        return glue_fail(g, call, "the serialised state's mode word is not a mode of cam.fmu");
     made = malloc(sizeof *made + payload);
     if (!made)
         return glue_fail(g, call, "out of memory");
     made->size = payload;
+    made->mode = mode;
     memcpy(made->bytes, in + STATE_HEADER, payload);
     free(*saved);
     *saved = made;

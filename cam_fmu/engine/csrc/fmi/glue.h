@@ -1,6 +1,7 @@
-/* What the FMI 2.0 and FMI 3.0 co-simulation glues of cam.fmu share, FMI-version neutral: the instance's
- * state machine, logging with its message rules, the checks of value references, the variable access,
- * the communication step and the saved states (csrc/fmi/fmi2_cs.c and fmi3_cs.c are thin over it).
+/* What the FMI 2.0 and FMI 3.0 glues of cam.fmu share, FMI-version neutral: the instance's state machine,
+ * logging with its message rules, the checks of value references, the variable access, the communication
+ * step, Model Exchange's calls (glue_me.c, over exchange.h) and the saved states (csrc/fmi/fmi2.c,
+ * fmi2_me.c and fmi3_cs.c are thin over it).
  *
  * Statuses are the FMI numbering both versions share: OK 0, Warning 1, Discard 2, Error 3, Fatal 4.
  * Every call name in a message is the version's own ("fmi2GetReal", "fmi3GetFloat64"): the glue passes it.
@@ -13,6 +14,7 @@
 #include <stddef.h>
 
 #include "cam_instance.h"
+#include "exchange.h"
 
 enum { GLUE_OK = 0, GLUE_WARNING = 1, GLUE_DISCARD = 2, GLUE_ERROR = 3 };
 
@@ -22,12 +24,15 @@ typedef enum {
     GLUE_STEP_COMPLETE = 1 << 2,
     GLUE_STEP_FAILED = 1 << 3,   /* after Discard */
     GLUE_ERROR_STATE = 1 << 4,   /* after Error */
-    GLUE_TERMINATED = 1 << 5
+    GLUE_TERMINATED = 1 << 5,
+    GLUE_EVENT_MODE = 1 << 6,    /* Model Exchange */
+    GLUE_CONTINUOUS_TIME_MODE = 1 << 7
 } GlueState;
 
+#define GLUE_ME_STATES (GLUE_EVENT_MODE | GLUE_CONTINUOUS_TIME_MODE)
 #define GLUE_GET_STATES (GLUE_INITIALIZATION | GLUE_STEP_COMPLETE | GLUE_STEP_FAILED | GLUE_ERROR_STATE \
-                         | GLUE_TERMINATED)
-#define GLUE_SET_STATES (GLUE_INSTANTIATED | GLUE_INITIALIZATION | GLUE_STEP_COMPLETE)
+                         | GLUE_TERMINATED | GLUE_ME_STATES)
+#define GLUE_SET_STATES (GLUE_INSTANTIATED | GLUE_INITIALIZATION | GLUE_STEP_COMPLETE | GLUE_ME_STATES)
 
 /* The host's logger as the glue calls it: status, category, and the message (already cut and with every
  * '%' doubled, so printf-style hosts and hosts that cannot see varargs both show it). */
@@ -44,16 +49,21 @@ typedef struct {
     double start_time;            /* s */
     double last_successful_time;  /* s */
     const char *version;          /* "fmi2" or "fmi3": names calls and statuses in state names */
+    unsigned vr_end;              /* one past the last value reference the version describes */
+    int exchange;                 /* a Model Exchange instance: me runs the drive */
+    CamExchange me;
 } Glue;
 
-/* A saved state: the instance layer's bytes. */
+/* A saved state: the instance layer's bytes, and the Model Exchange mode it was saved in (0: co-simulation). */
 typedef struct {
     size_t size;
+    unsigned mode;
     unsigned char bytes[];
 } GlueSaved;
 
-/* Set up g (name copied, a new drive); 0 when out of memory (then nothing is left allocated). */
-int glue_init(Glue *g, const char *name, int logging_on, const char *version);
+/* Set up g (name copied, a new drive; exchange: a Model Exchange instance); 0 when out of memory (then
+ * nothing is left allocated). Every variable of the table is addressable (vr_end CAM_VR_END). */
+int glue_init(Glue *g, const char *name, int logging_on, const char *version, int exchange);
 void glue_free(Glue *g);
 
 void glue_log(const Glue *g, int status, const char *category, const char *format, ...)
@@ -94,5 +104,20 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
 /* A new saved state from serialised bytes into *saved (a former one freed); Error with a message if they are
  * not a serialised cam.fmu state. */
 int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call);
+
+/* Model Exchange (glue_me.c): each call checks the instance is one, in one of states, and attached. */
+int glue_me_allowed(Glue *g, int states, int attached, const char *call);
+int glue_enter_event_mode(Glue *g, const char *call);
+/* One event update; *needed: call again; *values_changed: the states jumped. */
+int glue_new_discrete_states(Glue *g, int *needed, int *values_changed, const char *call);
+int glue_enter_continuous_time_mode(Glue *g, const char *call);
+/* The guards at a completed integrator step; *enter_event: the host must enter event mode; on error
+ * *terminate is set and the instance is in the error state. */
+int glue_completed_integrator_step(Glue *g, int *enter_event, int *terminate, const char *call);
+int glue_set_time(Glue *g, double time, const char *call);
+int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char *call);
+/* The read calls: values zeroed first; which: states, derivatives, event indicators or nominals. */
+typedef enum { GLUE_READ_STATES, GLUE_READ_DERIVATIVES, GLUE_READ_INDICATORS, GLUE_READ_NOMINALS } GlueRead;
+int glue_me_read(Glue *g, GlueRead which, double values[], size_t n, const char *call);
 
 #endif

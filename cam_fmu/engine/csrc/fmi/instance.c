@@ -20,6 +20,7 @@ struct CamInstance {
     double start_time;                  /* s */
     int preview_valid;                  /* preview holds the outputs of params and inputs */
     double preview[CAM_N_OUTPUTS];      /* outputs before initialisation */
+    double preview_x[CAM_NX], preview_dx[CAM_NX];   /* the states and derivatives then */
     char message[CAM_MESSAGE_LEN];
 };
 
@@ -51,6 +52,12 @@ int cam_instance_variable(unsigned vr, CamKind *kind, const char **name)
         const CamParamSpec *s = cam_param_spec((int)(vr - CAM_VR_PARAMS));
         *kind = s->kind;
         *name = s->name;
+        return 1;
+    }
+    if (vr < (unsigned)CAM_VR_END) {
+        *kind = CAM_KIND_REAL;
+        *name = vr < (unsigned)CAM_VR_DERIVATIVES ? cam_state_spec((int)(vr - CAM_VR_STATES))->name
+                                                  : cam_derivative_spec((int)(vr - CAM_VR_DERIVATIVES))->name;
         return 1;
     }
     return 0;
@@ -109,6 +116,16 @@ int cam_instance_initialized(const CamInstance *d)
     return d->initialized;
 }
 
+CamDrive *cam_instance_drive(CamInstance *d)
+{
+    return d->initialized ? &d->drive : NULL;
+}
+
+const double *cam_instance_inputs(const CamInstance *d)
+{
+    return d->inputs;
+}
+
 double cam_instance_time(const CamInstance *d)
 {
     return d->initialized ? d->drive.time : d->start_time;
@@ -133,6 +150,9 @@ static int check_real(const CamInstance *d, unsigned vr, double value, CamError 
     }
     if (vr < CAM_VR_PARAMS)
         return cam_error(err, CAM_ERR_SIMULATION, "variable '%s' is an output: it cannot be set", name);
+    if (vr >= (unsigned)CAM_VR_STATES)
+        return cam_error(err, CAM_ERR_SIMULATION, "variable '%s' is a continuous state or its derivative: it "
+                         "cannot be set (Model Exchange sets the states with fmi2SetContinuousStates)", name);
     if (d->initialized)
         return cam_error(err, CAM_ERR_SIMULATION,
                          "parameter '%s' is fixed after initialisation (fmi2Reset, then set it)", name);
@@ -185,6 +205,9 @@ static const double *preview(CamInstance *d)
         return NULL;
     }
     memcpy(d->preview, cam_drive_outputs(&scratch), sizeof d->preview);
+    memcpy(d->preview_x, scratch.x, sizeof d->preview_x);
+    memset(d->preview_dx, 0, sizeof d->preview_dx);   /* a rigid drive's shaft slots are held */
+    cam_rhs(&scratch.model, &scratch.mode, scratch.x, scratch.form_u, d->preview_dx);
     cam_drive_free(&scratch);
     d->preview_valid = 1;
     return d->preview;
@@ -193,6 +216,34 @@ static const double *preview(CamInstance *d)
 const double *cam_instance_outputs(CamInstance *d)
 {
     return d->initialized ? cam_drive_outputs(&d->drive) : preview(d);
+}
+
+/* A continuous state or its derivative (vr >= CAM_VR_STATES): of the consistent formulation only. */
+static int state_value(CamInstance *d, unsigned vr, double *value)
+{
+    int derivative = vr >= (unsigned)CAM_VR_DERIVATIVES;
+    int k = (int)(vr - (derivative ? CAM_VR_DERIVATIVES : CAM_VR_STATES));
+    const char *name = derivative ? cam_derivative_spec(k)->name : cam_state_spec(k)->name;
+    double dx[CAM_NX] = {0.0, 0.0, 0.0, 0.0, 0.0};   /* a rigid drive's shaft slots are held */
+    if ((int)d->params.v[CAM_P_FORMULATION] != CAM_CHOICE_FORMULATION_CONSISTENT
+        || (int)d->params.v[CAM_P_DRIVE] != CAM_CHOICE_DRIVE_VOLTAGE) {
+        snprintf(d->message, sizeof d->message, "variable '%s' belongs to the consistent formulation under "
+                 "drive 'voltage' (the Model Exchange model); this drive has no such state: read the outputs", name);
+        return CAM_ERR_SIMULATION;
+    }
+    if (!d->initialized) {
+        if (!cam_instance_outputs(d))
+            return CAM_ERR_PARAMETER; /* the message says which parameter prevents them */
+        *value = derivative ? d->preview_dx[k] : d->preview_x[k];
+        return CAM_OK;
+    }
+    if (!derivative) {
+        *value = d->drive.x[k];
+        return CAM_OK;
+    }
+    cam_rhs(&d->drive.model, &d->drive.mode, d->drive.x, d->drive.form_u, dx);
+    *value = dx[k];
+    return CAM_OK;
 }
 
 int cam_instance_get_real(CamInstance *d, unsigned vr, double *value)
@@ -209,8 +260,10 @@ int cam_instance_get_real(CamInstance *d, unsigned vr, double *value)
         if (!out)
             return CAM_ERR_PARAMETER; /* the message says which parameter prevents them */
         *value = out[vr - CAM_VR_OUTPUTS];
-    } else {
+    } else if (vr < (unsigned)CAM_VR_STATES) {
         *value = d->params.v[vr - CAM_VR_PARAMS];
+    } else {
+        return state_value(d, vr, value);
     }
     return CAM_OK;
 }

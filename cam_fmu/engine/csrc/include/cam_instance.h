@@ -4,7 +4,8 @@
  *
  * Value references are those of the generated table (cam_params.h, generated from
  * cam_fmu/physics/parameters.py and variables.py): the inputs, then the outputs, then the
- * parameters, in table order, from 0.
+ * parameters, in table order, from 0; then the continuous states x[CAM_NX] and their derivatives
+ * (Model Exchange's; read-only, of the consistent formulation).
  *
  * Every function that can refuse returns a CamStatus other than CAM_OK (CAM_ERR_REJECTED for a step
  * the solver cannot complete at this size: fmi2Discard) and leaves its message, which names the variable or setting and its
@@ -18,6 +19,10 @@
 #include "cam_model.h"
 
 typedef struct CamInstance CamInstance;
+
+/* physics/variables.py's STATES name every slot of cam_model.h's x[CAM_NX] (a compile error if not) */
+typedef char cam_states_name_every_slot[CAM_N_STATES == CAM_NX ? 1 : -1];
+#define CAM_VR_END (CAM_VR_DERIVATIVES + CAM_N_STATES)   /* one past the last value reference */
 
 /* The kind and name of value reference vr; 0 if vr is no variable. */
 int cam_instance_variable(unsigned vr, CamKind *kind, const char **name);
@@ -53,6 +58,11 @@ int cam_instance_initialized(const CamInstance *d);
  * CAM_DISCARD: the state is as before the step (restore or retry a shorter step). */
 int cam_instance_step(CamInstance *d, double t, double h);
 double cam_instance_time(const CamInstance *d);
+
+/* For the Model Exchange layer (exchange.h): the drive (NULL before initialisation) and the inputs
+ * as the host set them last (CAM_N_INPUTS, CAM_I_* order). */
+CamDrive *cam_instance_drive(CamInstance *d);
+const double *cam_instance_inputs(const CamInstance *d);
 
 /* The outputs in table order (cam_variables.h), current for the state and inputs. */
 const double *cam_instance_outputs(CamInstance *d);

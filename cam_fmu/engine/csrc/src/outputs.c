@@ -84,7 +84,11 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
 
 void cam_energy_step(CamEnergy *e, double u, double h, double theta, double i)
 {
-    double w = u * (u * h - e->c_e * (theta - e->theta) - e->L * (i - e->i)) / e->R;
+    cam_energy_book(e, u * (u * h - e->c_e * (theta - e->theta) - e->L * (i - e->i)) / e->R, theta, i);
+}
+
+void cam_energy_book(CamEnergy *e, double w, double theta, double i)
+{
     e->work_in += w;
     e->work_abs += fabs(w);
     e->theta = theta;

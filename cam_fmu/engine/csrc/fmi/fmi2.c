@@ -1,8 +1,9 @@
-/* FMI 2.0 co-simulation glue of cam.fmu over the drive's instance API (cam_instance.h).
+/* FMI 2.0 glue of cam.fmu, common and co-simulation functions, over the drive's instance API
+ * (cam_instance.h); Model Exchange's functions are fmi2_me.c's.
  *
  * Thin by design: the FMI 2.0 calls over the shared glue (glue.h: the state machine, argument checks, logging,
- * variable access, steps and FMU states, which fmi3_cs.c shares). Everything the drive does is behind
- * cam_instance_*.
+ * variable access, steps, Model Exchange and FMU states, which fmi3_cs.c shares). Everything the drive does
+ * is behind cam_instance_* and cam_exchange_*.
  * Compiled into the FMU's binary with the engine (csrc/src/ *.c) and the official FMI 2.0 headers
  * (those fmpy ships); CAM_GUID is defined at build time from the model description.
  *
@@ -24,33 +25,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi2Functions.h"
-#include "glue.h"
+#include "fmi2_glue.h"
 
 #ifndef CAM_GUID
 #error "CAM_GUID must be defined by the build (the model description's guid)"
 #endif
-
-#define INSTANCE_MAGIC 0x63616d32u   /* 'cam2': a pointer a host passes is checked to be an instance */
-
-typedef struct {
-    Glue glue;
-    fmi2CallbackLogger logger;
-    fmi2ComponentEnvironment environment;
-} Instance;
 
 static void emit(void *host, int status, const char *category, const char *message) {
     Instance *S = host;
     S->logger(S->environment, S->glue.name, (fmi2Status)status, category, message);
 }
 
-/* The instance behind a component a host passes, or NULL (NULL, freed, or not an instance). */
-static Instance *instance(fmi2Component c) {
+Instance *instance(fmi2Component c) {
     Instance *S = c;
     return S && S->glue.magic == INSTANCE_MAGIC ? S : NULL;
 }
-
-#define GLUE(c) (&instance(c)->glue)
 
 /* ------------------------------------------------------------------ common functions */
 
@@ -73,9 +62,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         glue_log(&probe.glue, GLUE_ERROR, "logStatusError", "fmi2Instantiate: instanceName must not be empty");
         return NULL;
     }
-    if (fmuType != fmi2CoSimulation) {
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
         glue_log(&probe.glue, GLUE_ERROR, "logStatusError",
-                 "fmi2Instantiate: cam.fmu is a co-simulation FMU (fmuType fmi2CoSimulation)");
+                 "fmi2Instantiate: fmuType %d: cam.fmu is fmi2ModelExchange (0) or fmi2CoSimulation (1)",
+                 (int)fmuType);
         return NULL;
     }
     if (!fmuGUID || strcmp(fmuGUID, CAM_GUID) != 0) {
@@ -85,7 +75,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     S = calloc(1, sizeof *S);
-    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi2")) {
+    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi2", fmuType == fmi2ModelExchange)) {
         free(S);
         glue_log(&probe.glue, GLUE_ERROR, "logStatusError", "fmi2Instantiate: out of memory");
         return NULL;

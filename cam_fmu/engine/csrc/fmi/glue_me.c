@@ -1,0 +1,125 @@
+/* Model Exchange's calls of the shared glue (glue.h), FMI-version neutral: the state machine of event and
+ * continuous-time mode and the argument checks over the Model Exchange layer (exchange.h). No FMI header,
+ * no globals. */
+#include <stddef.h>
+
+#include "glue.h"
+
+#define READ_STATES (GLUE_ME_STATES | GLUE_TERMINATED | GLUE_ERROR_STATE)
+
+int glue_me_allowed(Glue *g, int states, int attached, const char *call)
+{
+    if (!g->exchange) {
+        glue_fail(g, call, "a Model Exchange function: this instance is a co-simulation one (step it with DoStep)");
+        return 0;
+    }
+    if (!glue_allowed(g, states, call))
+        return 0;
+    if (attached && !g->me.drive) {
+        glue_fail(g, call, "the drive was not initialised for Model Exchange (ExitInitializationMode failed)");
+        return 0;
+    }
+    return 1;
+}
+
+/* An error of the model (energy created, an event not handled, an event iteration that does not settle):
+ * Error and the error state. */
+static int model_error(Glue *g, const char *call)
+{
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_exchange_message(&g->me));
+    g->state = GLUE_ERROR_STATE;
+    return GLUE_ERROR;
+}
+
+int glue_enter_event_mode(Glue *g, const char *call)
+{
+    if (!glue_me_allowed(g, GLUE_ME_STATES, 1, call))
+        return GLUE_ERROR;
+    cam_exchange_enter_event_mode(&g->me);
+    g->state = GLUE_EVENT_MODE;
+    return GLUE_OK;
+}
+
+int glue_new_discrete_states(Glue *g, int *needed, int *values_changed, const char *call)
+{
+    CamExchangeEvent fired;
+    *needed = *values_changed = 0;
+    if (!glue_me_allowed(g, GLUE_EVENT_MODE, 1, call))
+        return GLUE_ERROR;
+    if (cam_exchange_event_update(&g->me, &fired, values_changed, needed) != CAM_OK)
+        return model_error(g, call);
+    if (fired.code >= 0)
+        glue_log(g, GLUE_OK, "logEvents", "t = %.17g s: event '%s' at theta = %.17g rad, omega %.17g -> %.17g rad/s",
+                 fired.time, cam_exchange_event_name(fired.code), fired.x_before[CAM_THETA],
+                 fired.x_before[CAM_OMEGA], fired.x_after[CAM_OMEGA]);
+    return GLUE_OK;
+}
+
+int glue_enter_continuous_time_mode(Glue *g, const char *call)
+{
+    if (!glue_me_allowed(g, GLUE_EVENT_MODE, 1, call))
+        return GLUE_ERROR;
+    cam_exchange_enter_continuous(&g->me);
+    g->state = GLUE_CONTINUOUS_TIME_MODE;
+    return GLUE_OK;
+}
+
+int glue_completed_integrator_step(Glue *g, int *enter_event, int *terminate, const char *call)
+{
+    *enter_event = *terminate = 0;
+    if (!glue_me_allowed(g, GLUE_CONTINUOUS_TIME_MODE, 1, call))
+        return GLUE_ERROR;
+    if (cam_exchange_completed_step(&g->me, enter_event) != CAM_OK) {
+        *terminate = 1;
+        return model_error(g, call);
+    }
+    g->last_successful_time = cam_instance_time(g->drive);
+    return GLUE_OK;
+}
+
+int glue_set_time(Glue *g, double time, const char *call)
+{
+    if (!glue_me_allowed(g, GLUE_ME_STATES, 1, call))
+        return GLUE_ERROR;
+    if (cam_exchange_set_time(&g->me, time) != CAM_OK)
+        return glue_fail(g, call, cam_exchange_message(&g->me));
+    return GLUE_OK;
+}
+
+int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char *call)
+{
+    if (!glue_me_allowed(g, GLUE_CONTINUOUS_TIME_MODE, 1, call))
+        return GLUE_ERROR;
+    if (!x)
+        return glue_fail(g, call, "x must not be NULL");
+    if (cam_exchange_set_states(&g->me, x, nx) != CAM_OK)
+        return glue_fail(g, call, cam_exchange_message(&g->me));
+    return GLUE_OK;
+}
+
+int glue_me_read(Glue *g, GlueRead which, double values[], size_t n, const char *call)
+{
+    size_t k;
+    int status, nominals = which == GLUE_READ_NOMINALS;
+    if (values)
+        for (k = 0; k < n; k++)
+            values[k] = 0.0;
+    /* the nominals need no drive: a host may ask for them before initialisation */
+    if (!glue_me_allowed(g, nominals ? GLUE_INSTANTIATED | GLUE_INITIALIZATION | READ_STATES : READ_STATES,
+                         !nominals, call))
+        return GLUE_ERROR;
+    if (!values && n > 0)
+        return glue_fail(g, call, "the array must not be NULL");
+    switch (which) {
+    case GLUE_READ_STATES: status = cam_exchange_get_states(&g->me, values, n); break;
+    case GLUE_READ_DERIVATIVES: status = cam_exchange_derivatives(&g->me, values, n); break;
+    case GLUE_READ_INDICATORS: status = cam_exchange_indicators(&g->me, values, n); break;
+    default: status = cam_exchange_nominals(&g->me, values, n); break;
+    }
+    if (status != CAM_OK) {
+        for (k = 0; values && k < n; k++)
+            values[k] = 0.0;
+        return glue_fail(g, call, cam_exchange_message(&g->me));
+    }
+    return GLUE_OK;
+}
