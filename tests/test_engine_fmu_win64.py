@@ -101,3 +101,22 @@ def test_win64_state_round_trip_is_exact(hosts, fmu_dir):
     again = _run(hosts, fmu_dir, "win64", "inst", "init", "step", "100", "0.001", "save", "serial", "restore",
                  "step", "100", "0.001", "getr", outputs, "free")
     assert _values(lines) == _values(again)  # restored from the serialised state: the same bits
+
+
+def test_both_binaries_export_exactly_the_functions_of_fmi2(fmu_dir):
+    """Co-simulation and Model Exchange: every function fmi2Functions.h names, in cam.so and in cam.dll alike,
+    and nothing else (the engine's own functions stay hidden)."""
+    import re
+
+    header = (fmi_headers() / "fmi2Functions.h").read_text()
+    required = set(re.findall(r"^#define (fmi2\w+)\s+fmi2FullName", header, flags=re.M))
+    nm = subprocess.run([require("nm"), "-D", "--defined-only", str(fmu_dir / "binaries" / "linux64" / "cam.so")],
+                        capture_output=True, text=True)
+    linux = {line.split()[-1] for line in nm.stdout.splitlines() if line.strip()}
+    table = subprocess.run([require("x86_64-w64-mingw32-objdump"), "-p", str(fmu_dir / "binaries" / "win64" / "cam.dll")],
+                           capture_output=True, text=True).stdout
+    export_table = table[table.index("[Ordinal/Name Pointer] Table"):]
+    windows = set(re.findall(r"\]\s+(fmi2\w+)", export_table))
+    assert len(required) == 44 and {"fmi2GetDerivatives", "fmi2DoStep"} <= required
+    assert linux == required and windows == required
+    assert "cam_" not in export_table
