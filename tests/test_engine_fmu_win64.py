@@ -120,3 +120,34 @@ def test_both_binaries_export_exactly_the_functions_of_fmi2(fmu_dir):
     assert len(required) == 44 and {"fmi2GetDerivatives", "fmi2DoStep"} <= required
     assert linux == required and windows == required
     assert "cam_" not in export_table
+
+
+def test_model_exchange_runs_under_wine_as_on_linux(fmu_dir, tmp_path):
+    """tests/engine_c/me_host.c built to load the FMI functions from the binary (-DME_HOST_DYNAMIC): explicit
+    Euler with event handling over the backlash scene, a saved state, the refusals, on cam.dll under wine and on
+    cam.so; the same events, the same statuses, the final state to 1e-12 relative."""
+    from test_engine_fmu_me_host import BACKLASH, HOST, STEP, STOP, VR
+
+    flags = ["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-DME_HOST_DYNAMIC", f"-I{fmi_headers()}"]
+    builds = {"linux64": [require("gcc"), *flags, "-o", str(tmp_path / "me_host"), str(HOST), "-ldl", "-lm"],
+              "win64": [require(engine_fmu.WIN64_COMPILER), *flags, "-static", "-o", str(tmp_path / "me_host.exe"),
+                        str(HOST)]}
+    results = {}
+    for platform, cmd in builds.items():
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+        library = fmu_dir / "binaries" / platform / ("cam.dll" if platform == "win64" else "cam.so")
+        env = {"PATH": "/usr/bin:/bin", "CAM_FMU_LIBRARY": str(library), "CAM_FORMULATION_VR": str(VR["formulation"])}
+        run = [str(tmp_path / "me_host")] if platform == "linux64" else [str(WINE), str(tmp_path / "me_host.exe")]
+        if platform == "win64":
+            env.update(WINEDEBUG="-all", HOME=os.environ.get("HOME", "/root"))
+        proc = subprocess.run([*run, _guid(fmu_dir), str(STEP), str(STOP), *BACKLASH], capture_output=True, text=True,
+                              env=env, timeout=600)
+        assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+        results[platform] = {line.split()[0]: line.split()[1:] for line in proc.stdout.splitlines()}
+    linux, windows = results["linux64"], results["win64"]
+    assert int(linux["events"][0]) >= 3 and windows["events"] == linux["events"]
+    assert windows["refused"] == linux["refused"] == ["3", "3", "3", "3"] and windows["paper"] == ["3"]
+    for w, l in zip(map(float, windows["final"]), map(float, linux["final"])):
+        assert abs(w - l) <= 1e-12 * max(abs(l), 1e-300) or w == l
+    assert float(linux["final"][1]) > 1.0  # rad: the cam turned

@@ -6,13 +6,105 @@
  *   (environment CAM_FORMULATION_VR: the value reference of 'formulation', for the paper's refusal)
  *
  * Prints "events N", "final t theta omega i", the refusals' statuses; exit 0 unless a call the
- * host expects to pass fails. Built with -fsanitize=address,undefined or run under valgrind. */
+ * host expects to pass fails. Built with -fsanitize=address,undefined or run under valgrind.
+ *
+ * Linked with the FMI functions (the engine's sources), or, built with -DME_HOST_DYNAMIC, loading them
+ * from an FMU's binary as an importer does: the library's path in the environment variable
+ * CAM_FMU_LIBRARY, dlopen on linux and LoadLibrary on Windows (cam.dll under wine). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
+
+#ifdef ME_HOST_DYNAMIC
+#ifdef _WIN32
+#include <windows.h>
+#define OPEN(path) ((void *)LoadLibraryA(path))
+#define SYMBOL(lib, name) ((void *)GetProcAddress((HMODULE)(lib), name))
+#else
+#include <dlfcn.h>
+#define OPEN(path) dlopen(path, RTLD_NOW | RTLD_LOCAL)
+#define SYMBOL(lib, name) dlsym(lib, name)
+#endif
+/* The functions this host calls, looked up by their standard names. */
+#define FMI_CALLS(X) X(Instantiate) X(FreeInstance) X(SetupExperiment) X(EnterInitializationMode) \
+    X(ExitInitializationMode) X(Terminate) X(SetReal) X(SetBoolean) X(SetString) X(DoStep) X(EnterEventMode) \
+    X(NewDiscreteStates) X(EnterContinuousTimeMode) X(CompletedIntegratorStep) X(SetTime) X(SetContinuousStates) \
+    X(GetContinuousStates) X(GetDerivatives) X(GetEventIndicators) X(GetFMUstate) X(SetFMUstate) X(FreeFMUstate) \
+    X(SerializedFMUstateSize) X(SerializeFMUstate) X(DeSerializeFMUstate)
+#define POINTER(name) fmi2##name##TYPE *name;
+static struct { FMI_CALLS(POINTER) } fmi;   /* a test host's one table, filled once by load() */
+#define LOOKUP(name) ok = ok && (*(void **)&fmi.name = SYMBOL(lib, "fmi2" #name)) != NULL;
+
+static int load(void)
+{
+    const char *path = getenv("CAM_FMU_LIBRARY");
+    void *lib = path ? OPEN(path) : NULL;
+    int ok = lib != NULL;
+    FMI_CALLS(LOOKUP)
+    if (!ok)
+        fprintf(stderr, "cannot load the FMI functions from CAM_FMU_LIBRARY = %s\n", path ? path : "(unset)");
+    return ok;
+}
+
+#undef fmi2Instantiate
+#define fmi2Instantiate fmi.Instantiate
+#undef fmi2FreeInstance
+#define fmi2FreeInstance fmi.FreeInstance
+#undef fmi2SetupExperiment
+#define fmi2SetupExperiment fmi.SetupExperiment
+#undef fmi2EnterInitializationMode
+#define fmi2EnterInitializationMode fmi.EnterInitializationMode
+#undef fmi2ExitInitializationMode
+#define fmi2ExitInitializationMode fmi.ExitInitializationMode
+#undef fmi2Terminate
+#define fmi2Terminate fmi.Terminate
+#undef fmi2SetReal
+#define fmi2SetReal fmi.SetReal
+#undef fmi2SetBoolean
+#define fmi2SetBoolean fmi.SetBoolean
+#undef fmi2SetString
+#define fmi2SetString fmi.SetString
+#undef fmi2DoStep
+#define fmi2DoStep fmi.DoStep
+#undef fmi2EnterEventMode
+#define fmi2EnterEventMode fmi.EnterEventMode
+#undef fmi2NewDiscreteStates
+#define fmi2NewDiscreteStates fmi.NewDiscreteStates
+#undef fmi2EnterContinuousTimeMode
+#define fmi2EnterContinuousTimeMode fmi.EnterContinuousTimeMode
+#undef fmi2CompletedIntegratorStep
+#define fmi2CompletedIntegratorStep fmi.CompletedIntegratorStep
+#undef fmi2SetTime
+#define fmi2SetTime fmi.SetTime
+#undef fmi2SetContinuousStates
+#define fmi2SetContinuousStates fmi.SetContinuousStates
+#undef fmi2GetContinuousStates
+#define fmi2GetContinuousStates fmi.GetContinuousStates
+#undef fmi2GetDerivatives
+#define fmi2GetDerivatives fmi.GetDerivatives
+#undef fmi2GetEventIndicators
+#define fmi2GetEventIndicators fmi.GetEventIndicators
+#undef fmi2GetFMUstate
+#define fmi2GetFMUstate fmi.GetFMUstate
+#undef fmi2SetFMUstate
+#define fmi2SetFMUstate fmi.SetFMUstate
+#undef fmi2FreeFMUstate
+#define fmi2FreeFMUstate fmi.FreeFMUstate
+#undef fmi2SerializedFMUstateSize
+#define fmi2SerializedFMUstateSize fmi.SerializedFMUstateSize
+#undef fmi2SerializeFMUstate
+#define fmi2SerializeFMUstate fmi.SerializeFMUstate
+#undef fmi2DeSerializeFMUstate
+#define fmi2DeSerializeFMUstate fmi.DeSerializeFMUstate
+#else
+static int load(void)
+{
+    return 1;
+}
+#endif
 
 #define NX 5   /* the engine's slots; a rigid drive holds the shaft's two */
 #define NZ 4
@@ -142,6 +234,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: me_host GUID STEP STOP [vr=value ...]\n");
         return 2;
     }
+    if (!load())
+        return 2;
     if (!run(argv[1], strtod(argv[2], NULL), strtod(argv[3], NULL), argc - 4, argv + 4))
         return 1;
     /* the paper formulation: refused at initialisation, the instance in the error state */
