@@ -190,6 +190,29 @@ def test_the_declared_direct_feedthrough_is_what_the_outputs_do(engine_fmu_path)
     cs.freeInstance()
 
 
+@pytest.mark.parametrize("interval", [1e-4, 1e-3])
+def test_a_ramped_input_breaks_the_shaft_away_where_the_torque_reaches_the_friction(engine_fmu_path, interval):
+    """u ramps at 3.5 V/s from rest (L = 0, horizontal): static friction holds the cam until c_m u / R = M_f,
+    at t* = M_f R / (3.5 c_m). The input, not the state, drives the break-away function there; CVode locates its
+    zero, and the event must happen at it, not at the next output point (it came 5e-5 s late at 1e-4 s)."""
+    from cam_fmu.physics.parameters import PARAMETERS
+
+    p = {spec.name: spec.default for spec in PARAMETERS}
+    t_star = p["M_f"] * p["R"] / (3.5 * p["c_m"])
+    ramp = np.array([(0.0, 0.0), (1.0, 3.5)], dtype=[("time", float), ("u", float)])
+    logged: list[str] = []
+
+    def logger(_env, _name, _status, _category, message):
+        logged.append(message.decode())
+
+    result = fmpy.simulate_fmu(str(engine_fmu_path), fmi_type="ModelExchange", solver="CVode",
+                               relative_tolerance=CVODE_RTOL, input=ramp, stop_time=0.6, output_interval=interval,
+                               logger=logger, debug_logging=True)
+    (t_event,) = [float(m.group(1)) for m in (re.search(r"t = (\S+) s: event 'break_away'", text) for text in logged) if m]
+    assert abs(t_event - t_star) < 1e-9
+    assert np.all(result["omega"][result["time"] < t_star] == 0.0) and result["omega"][-1] > 1.0
+
+
 def engine_events(name: str, label: str | None) -> list[tuple[float, str]]:
     """The co-simulation engine's transitions (DriveSimulator.events) over the scene, 1 ms steps."""
     scene, run = scene_run(name, label)

@@ -91,6 +91,7 @@ int cam_exchange_attach(CamExchange *e)
     e->book_u = d->u;
     e->requested = 0;
     e->iterations = 0;
+    e->broke_away = 0;
     return CAM_OK;
 }
 
@@ -191,6 +192,7 @@ void cam_exchange_enter_event_mode(CamExchange *e)
 {
     e->requested = 0;
     e->iterations = 0;
+    e->broke_away = 0;
 }
 
 static int below_zero(const double z[CAM_EXCHANGE_NZ], int n)
@@ -207,9 +209,13 @@ static int below_zero(const double z[CAM_EXCHANGE_NZ], int n)
  * CVode's returns the state where the function it bracketed is exactly 0 when the arithmetic cancels
  * exactly there (the follower at the cam's lift plus the clearance); it then takes the function as
  * inactive and never sees it go below zero. The heading is the function a short probe later along the
- * derivatives, CAM_EXCHANGE_PROBE [s]: far below the drive's time scales, far above rounding. */
-static int due(const CamDrive *d, const double z[CAM_EXCHANGE_NZ], const int codes[CAM_MAX_EVENTS], int n)
+ * derivatives, CAM_EXCHANGE_PROBE [s]: far below the drive's time scales, far above rounding.
+ * The break-away at rest is driven by the input, which no probe of the state sees (with L = 0 the state does
+ * not move at all): at exactly zero its margin is at the threshold, which is where its transition starts the
+ * shaft (cam_apply_event), so it is due once per event instant. */
+static int due(const CamExchange *e, const double z[CAM_EXCHANGE_NZ], const int codes[CAM_MAX_EVENTS], int n)
 {
+    const CamDrive *d = e->drive;
     double dx[CAM_NX] = {0.0, 0.0, 0.0, 0.0, 0.0}, probe[CAM_NX];
     int k, j, have = 0;
     for (k = 0; k < n; k++) {
@@ -217,6 +223,8 @@ static int due(const CamDrive *d, const double z[CAM_EXCHANGE_NZ], const int cod
             return k;
         if (z[k] > 0.0)
             continue;
+        if (codes[k] == CAM_EV_BREAK_AWAY && !e->broke_away)
+            return k;
         if (!have) {
             cam_rhs(&d->model, &d->mode, d->x, d->u, dx);
             for (j = 0; j < CAM_NX; j++)
@@ -247,7 +255,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     e->iterations += 1;
     memcpy(fired->x_before, d->x, sizeof d->x);
     n = indicators(d, e->target, z, codes);
-    k = due(d, z, codes, n);
+    k = due(e, z, codes, n);
     if (k >= 0) {   /* one transition, logged as the co-simulation integrator logs its own */
         CamEventRecord *record = &d->event_log[d->events_logged % CAM_EVENT_LOG];
         fired->code = codes[k];
@@ -256,6 +264,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
         memcpy(record->x_before, d->x, sizeof d->x);
         record->mode_before = d->mode;
         cam_apply_event(m, &d->mode, d->x, codes[k], d->u);
+        e->broke_away |= codes[k] == CAM_EV_BREAK_AWAY;
         memcpy(record->x_after, d->x, sizeof d->x);
         d->events_logged += 1;
     } else {   /* at rest: stay stuck or start under the input now; the friction branch */
@@ -268,7 +277,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     d->stale = 1;
     e->target = next_breakpoint(d);
     n = indicators(d, e->target, z, codes);
-    *needed = due(d, z, codes, n) >= 0;
+    *needed = due(e, z, codes, n) >= 0;
     return CAM_OK;
 }
 
@@ -279,6 +288,7 @@ void cam_exchange_enter_continuous(CamExchange *e)
     CamDrive *d = e->drive;
     e->requested = 0;
     e->iterations = 0;
+    e->broke_away = 0;
     cam_exchange_sync(e);
     if (!d->have_budget) {
         cam_energy_init(&d->budget, &d->model, cam_drive_outputs(d));

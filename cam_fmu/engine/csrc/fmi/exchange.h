@@ -42,6 +42,7 @@ typedef struct {
     double book_time, book_u;   /* s, V: where the energy bound was booked last */
     int requested;              /* a completed step asked for event mode, not entered since */
     int iterations;             /* event updates at this event instant */
+    int broke_away;             /* the break-away's transition was applied at this event instant */
     char message[CAM_MESSAGE_LEN];
 } CamExchange;
 
