@@ -32,8 +32,9 @@ CSRC = HERE / "csrc"
 INCLUDE = CSRC / "include"
 SOURCES = CSRC / "src"
 LIBRARY_STEM = "libcamdrive"
-# C99, warnings as errors, IEEE arithmetic exactly as written (see the module doc).
-CFLAGS: tuple[str, ...] = ("-std=c99", "-O2", "-fPIC", "-ffp-contract=off", "-fno-fast-math",
+# C99, warnings as errors, IEEE arithmetic exactly as written (see the module doc); -O3: 8 % fewer
+# instructions than -O2 on fig. 6 (callgrind), the same bits (no reassociation without -ffast-math).
+CFLAGS: tuple[str, ...] = ("-std=c99", "-O3", "-fPIC", "-ffp-contract=off", "-fno-fast-math",
                            "-Wall", "-Wextra", "-Werror", "-pedantic")
 LDFLAGS: tuple[str, ...] = ("-shared", "-lm")
 
