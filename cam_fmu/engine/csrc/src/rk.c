@@ -103,49 +103,10 @@ static inline void rk_step_slots(const CamMethod *method, const CamModel *m, con
     }
 }
 
-/* rk_step_slots for cam_dopri5 on a rigid drive, the default and the hot path: the same operations in the same
- * order over the tableau's nonzero coefficients (its only zeros are b[1] and e[1]), written out so that no
- * zero test and no index list runs per step (fig. 6: 4.4 of 20 million instructions were that bookkeeping).
- * tests/test_engine_baseline.py holds it to the generic step's bits. */
-static void dopri5_rigid(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double h,
-                         CamStepWork *w)
-{
-    const double (*a)[CAM_MAX_STAGES] = cam_dopri5.a, *b = cam_dopri5.b, *e = cam_dopri5.e;
-    double (*k)[CAM_NX] = w->k, arg[CAM_NX];
-    int j;
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        arg[j] = x[j] + h * a[1][0] * k[0][j];
-    cam_rhs(m, mode, arg, u, k[1]);
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        arg[j] = x[j] + h * (a[2][0] * k[0][j] + a[2][1] * k[1][j]);
-    cam_rhs(m, mode, arg, u, k[2]);
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        arg[j] = x[j] + h * (a[3][0] * k[0][j] + a[3][1] * k[1][j] + a[3][2] * k[2][j]);
-    cam_rhs(m, mode, arg, u, k[3]);
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        arg[j] = x[j] + h * (a[4][0] * k[0][j] + a[4][1] * k[1][j] + a[4][2] * k[2][j] + a[4][3] * k[3][j]);
-    cam_rhs(m, mode, arg, u, k[4]);
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        arg[j] = x[j] + h * (a[5][0] * k[0][j] + a[5][1] * k[1][j] + a[5][2] * k[2][j] + a[5][3] * k[3][j]
-                             + a[5][4] * k[4][j]);
-    cam_rhs(m, mode, arg, u, k[5]);
-    for (j = 0; j < CAM_NX_RIGID; j++)
-        w->x_new[j] = x[j] + h * (b[0] * k[0][j] + b[2] * k[2][j] + b[3] * k[3][j] + b[4] * k[4][j]
-                                  + b[5] * k[5][j]);
-    cam_rhs(m, mode, w->x_new, u, k[6]);
-    for (j = 0; j < CAM_NX_RIGID; j++) {
-        w->f_new[j] = k[6][j];
-        w->error[j] = 0.0 + h * (e[0] * k[0][j] + e[2] * k[2][j] + e[3] * k[3][j] + e[4] * k[4][j]
-                                 + e[5] * k[5][j] + e[6] * k[6][j]);
-    }
-}
-
 void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u,
                  double h, CamStepWork *w)
 {
-    if (method->tableau == &cam_dopri5 && !m->compliant)
-        dopri5_rigid(m, mode, x, u, h, w);
-    else if (m->compliant)
+    if (m->compliant)
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX);
     else
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_RIGID);
