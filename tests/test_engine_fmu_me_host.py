@@ -33,7 +33,7 @@ def compile_host(folder: Path, extra: list[str]) -> Path:
     gcc = require("gcc")
     generated = [str(p) for p in codegen.write(folder / "gen") if p.suffix == ".c"]
     exe = folder / "me_host"
-    cmd = [gcc, *FLAGS, *extra, f'-DCAM_GUID="{GUID}"', f"-I{engine_build.INCLUDE}", f"-I{folder / 'gen'}",
+    cmd = [gcc, *FLAGS, *extra, f'-DMODEL_GUID="{GUID}"', f"-I{engine_build.INCLUDE}", f"-I{folder / 'gen'}",
            f"-I{engine_build.fmi_headers()}", *sorted(map(str, engine_build.SOURCES.glob("*.c"))), *generated,
            *map(str, GLUE[2]), str(HOST), "-o", str(exe), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)

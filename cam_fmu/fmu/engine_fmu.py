@@ -38,7 +38,7 @@ FMI = engine_build.CSRC / "fmi"
 # The FMI glue of each version: the instance layer, the Model Exchange layer, the glue both share, the
 # version's own files (FMI 2.0: co-simulation and Model Exchange; FMI 3.0: co-simulation); its official
 # headers; its platform folders (FMI 3.0 names them by architecture and OS).
-SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "glue.c", FMI / "glue_me.c")
+SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "model_cam.c", FMI / "glue.c", FMI / "glue_me.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
@@ -84,7 +84,7 @@ def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_fla
                    fmi_version: int = 2) -> Path:
     """Compile the engine, the instance layer and the FMI glue of ``fmi_version`` into the shared library ``dest``."""
     try:
-        return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DCAM_GUID="{guid}"', *extra_flags), compiler,
+        return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DMODEL_GUID="{guid}"', *extra_flags), compiler,
                                             extra_sources=GLUE[fmi_version], include=(engine_build.fmi_headers(),))
     except engine_build.EngineBuildError as exc:
         raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
@@ -131,7 +131,7 @@ def build(dest: Path, win64: bool | None = None, fmi_version: int = 2) -> Path:
         for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *GLUE[fmi_version],
                      *FMI.glob("*.h"), *(engine_build.fmi_headers() / name for name in HEADERS[fmi_version])]:
             shutil.copyfile(path, sources / path.name)
-        (sources / "guid.h").write_text(f'#define CAM_GUID "{guid}"\n')
+        (sources / "guid.h").write_text(f'#define MODEL_GUID "{guid}"\n')
         del generated
         out = root / f"{MODEL_IDENTIFIER}.fmu"
         with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:

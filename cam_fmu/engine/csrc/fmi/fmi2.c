@@ -1,11 +1,11 @@
-/* FMI 2.0 glue of cam.fmu, common and co-simulation functions, over the drive's instance API
- * (cam_instance.h); Model Exchange's functions are fmi2_me.c's.
+/* FMI 2.0 glue, common and co-simulation functions, over the model table (model.h: cam.fmu's drive or
+ * pi_speed.fmu's controller, whichever this binary carries); Model Exchange's functions are fmi2_me.c's.
  *
  * Thin by design: the FMI 2.0 calls over the shared glue (glue.h: the state machine, argument checks, logging,
  * variable access, steps, Model Exchange and FMU states, which fmi3_cs.c shares). Everything the drive does
- * is behind cam_instance_* and cam_exchange_*.
+ * is behind the model's table (model_table()).
  * Compiled into the FMU's binary with the engine (csrc/src/ *.c) and the official FMI 2.0 headers
- * (those fmpy ships); CAM_GUID is defined at build time from the model description.
+ * (those fmpy ships); MODEL_GUID is defined at build time from the model description.
  *
  * Rules kept here (docs/fmu.md, "Errors"):
  * - A call not allowed in the instance's state is fmi2Error naming the call and the state.
@@ -27,8 +27,8 @@
 
 #include "fmi2_glue.h"
 
-#ifndef CAM_GUID
-#error "CAM_GUID must be defined by the build (the model description's guid)"
+#ifndef MODEL_GUID
+#error "MODEL_GUID must be defined by the build (the model description's guid)"
 #endif
 
 static void emit(void *host, int status, const char *category, const char *message) {
@@ -57,21 +57,21 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     probe.environment = functions ? functions->componentEnvironment : NULL;
     probe.glue.emit = probe.logger ? emit : NULL;
     probe.glue.host = &probe;
-    probe.glue.name = (char *)(instanceName ? instanceName : "cam");
+    probe.glue.name = (char *)(instanceName ? instanceName : model_table()->name);
     if (!instanceName || !instanceName[0]) {
         glue_log(&probe.glue, GLUE_ERROR, "logStatusError", "fmi2Instantiate: instanceName must not be empty");
         return NULL;
     }
-    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
-        glue_log(&probe.glue, GLUE_ERROR, "logStatusError",
-                 "fmi2Instantiate: fmuType %d: cam.fmu is fmi2ModelExchange (0) or fmi2CoSimulation (1)",
-                 (int)fmuType);
+    if (fmuType != fmi2CoSimulation && !(fmuType == fmi2ModelExchange && model_table()->exchange)) {
+        glue_log(&probe.glue, GLUE_ERROR, "logStatusError", "fmi2Instantiate: fmuType %d: %s.fmu is %s", (int)fmuType,
+                 model_table()->name, model_table()->exchange ? "fmi2ModelExchange (0) or fmi2CoSimulation (1)"
+                                                              : "fmi2CoSimulation (1) only");
         return NULL;
     }
-    if (!fmuGUID || strcmp(fmuGUID, CAM_GUID) != 0) {
+    if (!fmuGUID || strcmp(fmuGUID, MODEL_GUID) != 0) {
         glue_log(&probe.glue, GLUE_ERROR, "logStatusError",
                  "fmi2Instantiate: GUID '%.80s' is not this binary's %s: the model description and the "
-                 "binary come from different builds", fmuGUID ? fmuGUID : "(null)", CAM_GUID);
+                 "binary come from different builds", fmuGUID ? fmuGUID : "(null)", MODEL_GUID);
         return NULL;
     }
     S = calloc(1, sizeof *S);
@@ -151,7 +151,7 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (value) for (k = 0; k < nvr; k++) value[k] = 0;
     if (!instance(c)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetInteger", "cam.fmu has no Integer variables");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetInteger", "this FMU has no Integer variables");
 }
 
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
@@ -187,7 +187,7 @@ fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     (void)value;
     if (!instance(c)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2SetInteger", "cam.fmu has no Integer variables");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2SetInteger", "this FMU has no Integer variables");
 }
 
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
@@ -218,7 +218,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
     if (!instance(c)) return fmi2Error;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2CancelStep", "cam.fmu steps synchronously: there is no step to cancel");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2CancelStep", "this FMU steps synchronously: there is no step to cancel");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -229,7 +229,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
     if (!instance(c)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     return (fmi2Status)glue_fail(GLUE(c), "fmi2SetRealInputDerivatives",
-                                 "cam.fmu cannot interpolate inputs (canInterpolateInputs=false)");
+                                 "this FMU cannot interpolate inputs (canInterpolateInputs=false)");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -241,7 +241,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     if (!instance(c)) return fmi2Error;
     if (nvr == 0) return fmi2OK;
     return (fmi2Status)glue_fail(GLUE(c), "fmi2GetRealOutputDerivatives",
-                                 "cam.fmu provides no output derivatives (maxOutputDerivativeOrder=0)");
+                                 "this FMU provides no output derivatives (maxOutputDerivativeOrder=0)");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
@@ -264,7 +264,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
     (void)s;
     if (value) *value = 0;
     if (!instance(c)) return fmi2Error;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetIntegerStatus", "cam.fmu has no Integer status");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetIntegerStatus", "this FMU has no Integer status");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
@@ -280,7 +280,7 @@ fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2Stri
     (void)s;
     if (value) *value = "";
     if (!instance(c)) return fmi2Error;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetStringStatus", "cam.fmu has no String status (steps are synchronous)");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetStringStatus", "this FMU has no String status (steps are synchronous)");
 }
 
 /* ------------------------------------------------------------------ FMU states */
@@ -340,5 +340,5 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
     (void)dvKnown;
     if (dvUnknown) for (k = 0; k < nUnknown; k++) dvUnknown[k] = 0.0;
     if (!instance(c)) return fmi2Error;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetDirectionalDerivative", "cam.fmu provides no directional derivatives");
+    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetDirectionalDerivative", "this FMU provides no directional derivatives");
 }

@@ -1,4 +1,4 @@
-/* FMI 2.0 Model Exchange functions of cam.fmu over the shared glue (glue.h, glue_me.c: the state machine
+/* FMI 2.0 Model Exchange functions over the shared glue (glue.h, glue_me.c: the state machine
  * of event and continuous-time mode over exchange.h); the common functions are fmi2.c's. */
 #include "fmi2_glue.h"
 
@@ -57,7 +57,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t n
 }
 
 /* The read calls: the array zeroed first, also for a component that is no instance. */
-static fmi2Status read(fmi2Component c, GlueRead which, fmi2Real values[], size_t n, const char *call) {
+static fmi2Status read(fmi2Component c, ModelRead which, fmi2Real values[], size_t n, const char *call) {
     size_t k;
     if (!instance(c)) {
         if (values) for (k = 0; k < n; k++) values[k] = 0.0;
@@ -67,17 +67,17 @@ static fmi2Status read(fmi2Component c, GlueRead which, fmi2Real values[], size_
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx) {
-    return read(c, GLUE_READ_DERIVATIVES, derivatives, nx, "fmi2GetDerivatives");
+    return read(c, MODEL_READ_DERIVATIVES, derivatives, nx, "fmi2GetDerivatives");
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni) {
-    return read(c, GLUE_READ_INDICATORS, eventIndicators, ni, "fmi2GetEventIndicators");
+    return read(c, MODEL_READ_INDICATORS, eventIndicators, ni, "fmi2GetEventIndicators");
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
-    return read(c, GLUE_READ_STATES, x, nx, "fmi2GetContinuousStates");
+    return read(c, MODEL_READ_STATES, x, nx, "fmi2GetContinuousStates");
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
-    return read(c, GLUE_READ_NOMINALS, x_nominal, nx, "fmi2GetNominalsOfContinuousStates");
+    return read(c, MODEL_READ_NOMINALS, x_nominal, nx, "fmi2GetNominalsOfContinuousStates");
 }

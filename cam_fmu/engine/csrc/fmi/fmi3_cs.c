@@ -1,11 +1,11 @@
-/* FMI 3.0 co-simulation glue of cam3.fmu over the shared glue (glue.h), as fmi2.c is for FMI 2.0.
+/* FMI 3.0 co-simulation glue over the shared glue (glue.h) and the model table (model.h), as fmi2.c is for FMI 2.0.
  *
  * The same engine, instance layer and rules (docs/fmu.md "Errors"); what FMI 3.0 changes is here: the
  * instantiation token, fmi3DoStep's out-arguments (lastSuccessfulTime where the FMU stands after a Discard),
- * Float64 in place of Real, arrays of nValues. cam3.fmu declares no event mode, no early return, no clocks
+ * Float64 in place of Real, arrays of nValues. The FMU declares no event mode, no early return, no clocks
  * and no Model Exchange or Scheduled Execution: their entry points exist (the standard asks every function
  * of the binary) and refuse with fmi3Error and a message. Compiled with the official FMI 3.0 headers (those
- * fmpy ships); CAM_GUID is the instantiation token, defined at build time from the model description.
+ * fmpy ships); MODEL_GUID is the instantiation token, defined at build time from the model description.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -13,11 +13,11 @@
 #include "fmi3Functions.h"
 #include "glue.h"
 
-#ifndef CAM_GUID
-#error "CAM_GUID must be defined by the build (the model description's instantiationToken)"
+#ifndef MODEL_GUID
+#error "MODEL_GUID must be defined by the build (the model description's instantiationToken)"
 #endif
 
-#define INSTANCE_MAGIC 0x63616d33u   /* 'cam3' */
+#define INSTANCE_MAGIC 0x666d6933u   /* 'fmi3' */
 
 typedef struct {
     Glue glue;
@@ -38,13 +38,13 @@ static Instance *instance(fmi3Instance c) {
 #define GLUE(c) (&instance(c)->glue)
 #define STATUS(x) ((fmi3Status)(x))
 
-/* A call cam3.fmu does not offer: fmi3Error with why. */
+/* A call the FMU does not offer: fmi3Error with why. */
 static fmi3Status unsupported(fmi3Instance c, const char *call, const char *why) {
     if (!instance(c)) return fmi3Error;
     return STATUS(glue_fail(GLUE(c), call, why));
 }
 
-#define NOT_CS "cam3.fmu is a co-simulation FMU without event mode, clocks or Model Exchange"
+#define NOT_CS "this FMU is a co-simulation FMU without event mode, clocks or Model Exchange"
 
 /* ------------------------------------------------------------------ inquire, instantiate, free */
 
@@ -67,7 +67,7 @@ static void refuse_instantiation(const char *name, fmi3InstanceEnvironment envir
     probe.environment = environment;
     probe.glue.emit = logger ? emit : NULL;
     probe.glue.host = &probe;
-    probe.glue.name = (char *)(name ? name : "cam");
+    probe.glue.name = (char *)(name ? name : model_table()->name);
     glue_log(&probe.glue, GLUE_ERROR, "logStatusError", format, a, b);
 }
 
@@ -80,7 +80,7 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
     (void)visible;
     (void)loggingOn;
     refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s", "fmi3InstantiateModelExchange",
-                         "cam3.fmu is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
+                         "this FMU is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
     return NULL;
 }
 
@@ -100,7 +100,7 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
     (void)unlockPreemption;
     refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s",
                          "fmi3InstantiateScheduledExecution",
-                         "cam3.fmu is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
+                         "this FMU is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
     return NULL;
 }
 
@@ -118,7 +118,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     (void)requiredIntermediateVariables;
     (void)nRequiredIntermediateVariables;
     (void)intermediateUpdate;
-    /* eventModeUsed, earlyReturnAllowed: cam3.fmu never enters event mode nor returns early (hasEventMode and
+    /* eventModeUsed, earlyReturnAllowed: the FMU never enters event mode nor returns early (hasEventMode and
      * canReturnEarlyAfterIntermediateUpdate are false), so an importer that allows either sees neither. */
     (void)eventModeUsed;
     (void)earlyReturnAllowed;
@@ -127,11 +127,11 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                              "instanceName must not be empty");
         return NULL;
     }
-    if (!instantiationToken || strcmp(instantiationToken, CAM_GUID) != 0) {
+    if (!instantiationToken || strcmp(instantiationToken, MODEL_GUID) != 0) {
         refuse_instantiation(instanceName, instanceEnvironment, logMessage,
                              "fmi3InstantiateCoSimulation: instantiationToken '%.80s' is not this binary's %s: the "
                              "model description and the binary come from different builds",
-                             instantiationToken ? instantiationToken : "(null)", CAM_GUID);
+                             instantiationToken ? instantiationToken : "(null)", MODEL_GUID);
         return NULL;
     }
     S = calloc(1, sizeof *S);
@@ -144,7 +144,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
     S->logger = logMessage;
     S->environment = instanceEnvironment;
     S->glue.emit = logMessage ? emit : NULL;
-    S->glue.vr_end = CAM_VR_STATES;   /* Model Exchange's states are cam.fmu's, not described here */
+    S->glue.vr_end = S->glue.model->vr_cs_end;   /* Model Exchange's states are FMI 2.0's, not described here */
     S->glue.host = S;
     S->glue.magic = INSTANCE_MAGIC;
     return S;
@@ -193,12 +193,12 @@ fmi3Status fmi3Reset(fmi3Instance c) {
 /* Scalars only: nValues must equal nValueReferences. */
 static int scalar_count(fmi3Instance c, size_t nvr, size_t nValues, const char *call) {
     if (nvr == nValues) return 1;
-    glue_fail(GLUE(c), call, "cam3.fmu has scalar variables only: nValues must equal nValueReferences");
+    glue_fail(GLUE(c), call, "this FMU has scalar variables only: nValues must equal nValueReferences");
     return 0;
 }
 
 /* The independent variable 'time' [s], after the whole table (model_description3.py). */
-#define TIME_VR ((fmi3ValueReference)CAM_VR_END)
+#define TIME_VR ((fmi3ValueReference)model_table()->vr_end)
 
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues) {
@@ -215,8 +215,8 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
         if (vr[k] != TIME_VR)
             status = glue_get_reals(GLUE(c), &vr[k], 1, &values[k], "fmi3GetFloat64");
         else if (glue_allowed(GLUE(c), GLUE_GET_STATES, "fmi3GetFloat64"))
-            values[k] = cam_instance_initialized(GLUE(c)->drive) ? cam_instance_time(GLUE(c)->drive)
-                                                                  : GLUE(c)->start_time;
+            values[k] = GLUE(c)->model->initialized(GLUE(c)->m) ? GLUE(c)->model->time(GLUE(c)->m)
+                                                                : GLUE(c)->start_time;
         else
             status = GLUE_ERROR;
     }
@@ -278,21 +278,21 @@ fmi3Status fmi3SetString(fmi3Instance c, const fmi3ValueReference vr[], size_t n
     return STATUS(glue_set_strings(GLUE(c), vr, nvr, values, "fmi3SetString"));
 }
 
-/* The types cam3.fmu has no variable of: nothing to get or set (0 references: fmi3OK). */
+/* The types the FMU has no variable of: nothing to get or set (0 references: fmi3OK). */
 #define NO_SUCH_TYPE(Get, Set, T, zero, what)                                                                   \
     fmi3Status Get(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, T values[], size_t nValues) {   \
         size_t k;                                                                                              \
         (void)vr;                                                                                              \
         if (values) for (k = 0; k < nValues; k++) values[k] = zero;                                            \
         if (!instance(c)) return fmi3Error;                                                                    \
-        return nvr == 0 ? fmi3OK : unsupported(c, #Get, "cam3.fmu has no " what " variables");                 \
+        return nvr == 0 ? fmi3OK : unsupported(c, #Get, "this FMU has no " what " variables");                 \
     }                                                                                                          \
     fmi3Status Set(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const T values[], size_t nValues) { \
         (void)vr;                                                                                              \
         (void)values;                                                                                          \
         (void)nValues;                                                                                         \
         if (!instance(c)) return fmi3Error;                                                                    \
-        return nvr == 0 ? fmi3OK : unsupported(c, #Set, "cam3.fmu has no " what " variables");                 \
+        return nvr == 0 ? fmi3OK : unsupported(c, #Set, "this FMU has no " what " variables");                 \
     }
 
 NO_SUCH_TYPE(fmi3GetFloat32, fmi3SetFloat32, fmi3Float32, 0.0f, "Float32")
@@ -314,7 +314,7 @@ fmi3Status fmi3GetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n
         if (values) values[k] = NULL;
     }
     if (!instance(c)) return fmi3Error;
-    return nvr == 0 ? fmi3OK : unsupported(c, "fmi3GetBinary", "cam3.fmu has no Binary variables");
+    return nvr == 0 ? fmi3OK : unsupported(c, "fmi3GetBinary", "this FMU has no Binary variables");
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, const size_t valueSizes[],
@@ -324,7 +324,7 @@ fmi3Status fmi3SetBinary(fmi3Instance c, const fmi3ValueReference vr[], size_t n
     (void)values;
     (void)nValues;
     if (!instance(c)) return fmi3Error;
-    return nvr == 0 ? fmi3OK : unsupported(c, "fmi3SetBinary", "cam3.fmu has no Binary variables");
+    return nvr == 0 ? fmi3OK : unsupported(c, "fmi3SetBinary", "this FMU has no Binary variables");
 }
 
 fmi3Status fmi3GetClock(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Clock values[]) {
@@ -344,7 +344,7 @@ fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance c, fmi3ValueReferenc
     (void)vr;
     if (n) *n = 0;
     return unsupported(c, "fmi3GetNumberOfVariableDependencies",
-                       "cam3.fmu declares its dependencies in the model description only");
+                       "this FMU declares its dependencies in the model description only");
 }
 
 fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference dependent, size_t elementIndices[],
@@ -357,7 +357,7 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance c, fmi3ValueReference depend
     (void)kinds;
     (void)n;
     return unsupported(c, "fmi3GetVariableDependencies",
-                       "cam3.fmu declares its dependencies in the model description only");
+                       "this FMU declares its dependencies in the model description only");
 }
 
 /* ------------------------------------------------------------------ FMU states */
@@ -405,13 +405,13 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedStat
     return STATUS(glue_deserialize(GLUE(c), serializedState, size, (GlueSaved **)state, "fmi3DeserializeFMUState"));
 }
 
-/* ------------------------------------------------------------------ what cam3.fmu does not provide */
+/* ------------------------------------------------------------------ what the FMU does not provide */
 
-/* Derivatives cam3.fmu does not provide: the sensitivities 0, then the refusal. */
+/* Derivatives the FMU does not provide: the sensitivities 0, then the refusal. */
 static fmi3Status no_derivatives(fmi3Instance c, const char *call, fmi3Float64 sensitivity[], size_t n) {
     size_t k;
     if (sensitivity) for (k = 0; k < n; k++) sensitivity[k] = 0.0;
-    return unsupported(c, call, "cam3.fmu provides no directional or adjoint derivatives");
+    return unsupported(c, call, "this FMU provides no directional or adjoint derivatives");
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
@@ -429,11 +429,11 @@ fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unk
 }
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance c) {
-    return unsupported(c, "fmi3EnterConfigurationMode", "cam3.fmu has no structural parameters");
+    return unsupported(c, "fmi3EnterConfigurationMode", "this FMU has no structural parameters");
 }
 
 fmi3Status fmi3ExitConfigurationMode(fmi3Instance c) {
-    return unsupported(c, "fmi3ExitConfigurationMode", "cam3.fmu has no structural parameters");
+    return unsupported(c, "fmi3ExitConfigurationMode", "this FMU has no structural parameters");
 }
 
 fmi3Status fmi3GetIntervalDecimal(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 intervals[],
@@ -560,7 +560,7 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance c, const fmi3ValueReference vr[
     if (values) for (k = 0; k < nValues; k++) values[k] = 0.0;
     if (!instance(c)) return fmi3Error;
     return nvr == 0 ? fmi3OK : unsupported(c, "fmi3GetOutputDerivatives",
-                                           "cam3.fmu provides no output derivatives (maxOutputDerivativeOrder=0)");
+                                           "this FMU provides no output derivatives (maxOutputDerivativeOrder=0)");
 }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance c, fmi3ValueReference clockReference,

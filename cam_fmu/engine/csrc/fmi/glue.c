@@ -1,6 +1,6 @@
 /* The glue both FMI versions share (glue.h): state machine, logging, variable access, steps and saved
- * states over the instance layer (cam_instance.h); Model Exchange's calls are glue_me.c's. No FMI header,
- * no globals. */
+ * states over the model table (model.h); Model Exchange's calls are glue_me.c's. No FMI header, no model's
+ * header, no globals. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -10,7 +10,6 @@
 #include "glue.h"
 
 #define MESSAGE_MAX 1024              /* a log line is cut here (a 20 MB bad value is not echoed whole) */
-#define STATE_MAGIC 0x43414d53u       /* 'CAMS': a serialised cam.fmu state */
 #define STATE_HEADER 16               /* magic, format, payload size (8 bytes) */
 #define STATE_FORMAT 1u
 /* |currentCommunicationPoint - the FMU's time| allowed: rounding of a host's summed steps */
@@ -18,13 +17,15 @@
 
 int glue_init(Glue *g, const char *name, int logging_on, const char *version, int exchange)
 {
+    g->model = model_table();
     g->name = malloc(strlen(name) + 1);
-    g->drive = cam_instance_new();
-    if (!g->name || !g->drive) {
+    g->m = g->model->create();
+    if (!g->name || !g->m) {
         free(g->name);
-        cam_instance_free(g->drive);
+        if (g->m)
+            g->model->destroy(g->m);
         g->name = NULL;
-        g->drive = NULL;
+        g->m = NULL;
         return 0;
     }
     strcpy(g->name, name);
@@ -32,18 +33,18 @@ int glue_init(Glue *g, const char *name, int logging_on, const char *version, in
     g->state = GLUE_INSTANTIATED;
     g->start_time = g->last_successful_time = 0.0;
     g->version = version;
-    g->vr_end = CAM_VR_END;
+    g->vr_end = g->model->vr_end;
     g->exchange = exchange ? 1 : 0;
-    cam_exchange_init(&g->me, g->drive);
     return 1;
 }
 
 void glue_free(Glue *g)
 {
     g->magic = 0;
-    cam_instance_free(g->drive);
+    if (g->m)
+        g->model->destroy(g->m);
     free(g->name);
-    g->drive = NULL;
+    g->m = NULL;
     g->name = NULL;
 }
 
@@ -97,16 +98,16 @@ int glue_allowed(const Glue *g, int states, const char *call)
     return 0;
 }
 
-int glue_drive_status(Glue *g, int status, const char *call)
+int glue_model_status(Glue *g, int status, const char *call)
 {
-    if (status == CAM_OK)
+    if (status == MODEL_OK)
         return GLUE_OK;
-    if (status == CAM_ERR_REJECTED) {
-        glue_log(g, GLUE_DISCARD, "logStatusDiscard", "%s: %s", call, cam_instance_message(g->drive));
+    if (status == MODEL_DISCARD) {
+        glue_log(g, GLUE_DISCARD, "logStatusDiscard", "%s: %s", call, g->model->message(g->m));
         g->state = GLUE_STEP_FAILED;
         return GLUE_DISCARD;
     }
-    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_instance_message(g->drive));
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->message(g->m));
     g->state = GLUE_ERROR_STATE;
     return GLUE_ERROR;
 }
@@ -139,10 +140,10 @@ int glue_exit_initialization(Glue *g, const char *call)
     int status;
     if (!glue_allowed(g, GLUE_INITIALIZATION, call))
         return GLUE_ERROR;
-    status = glue_drive_status(g, cam_instance_initialize(g->drive, g->start_time), call);
+    status = glue_model_status(g, g->model->initialize(g->m, g->start_time), call);
     if (status == GLUE_OK && g->exchange) {   /* Model Exchange starts in event mode */
-        if (cam_exchange_attach(&g->me) != CAM_OK) {
-            glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_exchange_message(&g->me));
+        if (g->model->exchange->attach(g->m) != MODEL_OK) {
+            glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->exchange->message(g->m));
             g->state = GLUE_ERROR_STATE;
             return GLUE_ERROR;
         }
@@ -167,20 +168,24 @@ int glue_terminate(Glue *g, const char *call)
 
 void glue_reset(Glue *g)
 {
-    cam_instance_reset(g->drive);
-    cam_exchange_init(&g->me, g->drive);
+    g->model->reset(g->m);
     g->state = GLUE_INSTANTIATED;
     g->start_time = g->last_successful_time = 0.0;
 }
 
 /* ------------------------------------------------------------------ variables */
 
-static int check_references(const Glue *g, const unsigned vr[], size_t nvr, const void *value, CamKind type,
+static const char *kind_name(ModelKind kind)
+{
+    return kind == MODEL_REAL ? "Real" : kind == MODEL_BOOLEAN ? "Boolean" : "String";
+}
+
+static int check_references(const Glue *g, const unsigned vr[], size_t nvr, const void *value, ModelKind type,
                             const char *call)
 {
     char text[300];
     size_t k;
-    CamKind kind;
+    ModelKind kind;
     const char *name;
     if (nvr == 0)
         return 1;
@@ -189,15 +194,15 @@ static int check_references(const Glue *g, const unsigned vr[], size_t nvr, cons
         return 0;
     }
     for (k = 0; k < nvr; k++) {
-        if (vr[k] >= g->vr_end || !cam_instance_variable(vr[k], &kind, &name)) {
-            snprintf(text, sizeof text, "value reference %u is not a variable of cam.fmu (0 to %u)", vr[k],
-                     g->vr_end - 1);
+        if (vr[k] >= g->vr_end || !g->model->variable(vr[k], &kind, &name)) {
+            snprintf(text, sizeof text, "value reference %u is not a variable of %s (0 to %u)", vr[k],
+                     g->model->name, g->vr_end - 1);
             glue_fail(g, call, text);
             return 0;
         }
         if (kind != type) {
             snprintf(text, sizeof text, "variable '%s' (value reference %u) is a %s, not a %s", name, vr[k],
-                     cam_kind_name(kind), cam_kind_name(type));
+                     kind_name(kind), kind_name(type));
             glue_fail(g, call, text);
             return 0;
         }
@@ -211,13 +216,13 @@ int glue_get_reals(Glue *g, const unsigned vr[], size_t nvr, double value[], con
     if (value)
         for (k = 0; k < nvr; k++)
             value[k] = 0.0;
-    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_REAL, call))
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_REAL, call))
         return GLUE_ERROR;
     if (g->state & GLUE_ME_STATES)
-        cam_exchange_sync(&g->me);   /* outputs at the host's state and inputs */
+        g->model->exchange->sync(g->m);   /* outputs at the host's state and inputs */
     for (k = 0; k < nvr; k++)
-        if (cam_instance_get_real(g->drive, vr[k], &value[k]) != CAM_OK)
-            return glue_fail(g, call, cam_instance_message(g->drive));
+        if (g->model->get_real(g->m, vr[k], &value[k]) != MODEL_OK)
+            return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
@@ -227,11 +232,11 @@ int glue_get_booleans(Glue *g, const unsigned vr[], size_t nvr, int value[], con
     if (value)
         for (k = 0; k < nvr; k++)
             value[k] = 0;
-    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_BOOLEAN, call))
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_BOOLEAN, call))
         return GLUE_ERROR;
     for (k = 0; k < nvr; k++)
-        if (cam_instance_get_boolean(g->drive, vr[k], &value[k]) != CAM_OK)
-            return glue_fail(g, call, cam_instance_message(g->drive));
+        if (g->model->get_boolean(g->m, vr[k], &value[k]) != MODEL_OK)
+            return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
@@ -241,12 +246,12 @@ int glue_get_strings(Glue *g, const unsigned vr[], size_t nvr, const char *value
     if (value)
         for (k = 0; k < nvr; k++)
             value[k] = "";
-    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_STRING, call))
+    if (!glue_allowed(g, GLUE_GET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_STRING, call))
         return GLUE_ERROR;
     for (k = 0; k < nvr; k++)
-        if (cam_instance_get_string(g->drive, vr[k], &value[k]) != CAM_OK) {
+        if (g->model->get_string(g->m, vr[k], &value[k]) != MODEL_OK) {
             value[k] = "";
-            return glue_fail(g, call, cam_instance_message(g->drive));
+            return glue_fail(g, call, g->model->message(g->m));
         }
     return GLUE_OK;
 }
@@ -255,27 +260,27 @@ int glue_set_reals(Glue *g, const unsigned vr[], size_t nvr, const double value[
 {
     char text[MESSAGE_MAX];
     size_t k;
-    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_REAL, call))
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_REAL, call))
         return GLUE_ERROR;
     for (k = 0; k < nvr; k++)   /* all or nothing: every value is checked before one is written */
-        if (cam_instance_check_real(g->drive, vr[k], value[k], text, sizeof text) != CAM_OK)
+        if (g->model->check_real(g->m, vr[k], value[k], text, sizeof text) != MODEL_OK)
             return glue_fail(g, call, text);
     for (k = 0; k < nvr; k++)
-        if (cam_instance_set_real(g->drive, vr[k], value[k]) != CAM_OK)
-            return glue_fail(g, call, cam_instance_message(g->drive));
+        if (g->model->set_real(g->m, vr[k], value[k]) != MODEL_OK)
+            return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
 int glue_set_booleans(Glue *g, const unsigned vr[], size_t nvr, const int value[], const char *call)
 {
     size_t k;
-    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_BOOLEAN, call))
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_BOOLEAN, call))
         return GLUE_ERROR;
-    if (nvr > 0 && cam_instance_initialized(g->drive))   /* booleans are parameters */
+    if (nvr > 0 && g->model->initialized(g->m))   /* booleans are parameters */
         return glue_fail(g, call, "parameters are fixed after initialisation (Reset first)");
     for (k = 0; k < nvr; k++)
-        if (cam_instance_set_boolean(g->drive, vr[k], value[k] != 0) != CAM_OK)
-            return glue_fail(g, call, cam_instance_message(g->drive));
+        if (g->model->set_boolean(g->m, vr[k], value[k] != 0) != MODEL_OK)
+            return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
@@ -283,22 +288,22 @@ int glue_set_strings(Glue *g, const unsigned vr[], size_t nvr, const char *const
 {
     size_t k, size;
     unsigned char *saved;
-    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, CAM_KIND_STRING, call))
+    if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_STRING, call))
         return GLUE_ERROR;
     for (k = 0; k < nvr; k++)
         if (!value[k])
             return glue_fail(g, call, "a string value must not be NULL");
     /* strings are checked as they are set: a multi-value set is undone on refusal by saving first */
-    size = cam_instance_state_size(g->drive);
+    size = g->model->state_size(g->m);
     saved = malloc(size ? size : 1);
-    if (!saved || cam_instance_save(g->drive, saved, size) != CAM_OK) {
+    if (!saved || g->model->save(g->m, saved, size) != MODEL_OK) {
         free(saved);
         return glue_fail(g, call, "out of memory");
     }
     for (k = 0; k < nvr; k++)
-        if (cam_instance_set_string(g->drive, vr[k], value[k], strlen(value[k])) != CAM_OK) {
-            int status = glue_fail(g, call, cam_instance_message(g->drive));
-            cam_instance_restore(g->drive, saved, size);
+        if (g->model->set_string(g->m, vr[k], value[k], strlen(value[k])) != MODEL_OK) {
+            int status = glue_fail(g, call, g->model->message(g->m));
+            g->model->restore(g->m, saved, size);
             free(saved);
             return status;
         }
@@ -315,7 +320,7 @@ int glue_do_step(Glue *g, double t, double h, const char *call)
     int status;
     if (!glue_allowed(g, GLUE_STEP_COMPLETE, call))
         return GLUE_ERROR;
-    now = cam_instance_time(g->drive);
+    now = g->model->time(g->m);
     if (!isfinite(t) || fabs(t - now) > TIME_SLACK(now)) {
         snprintf(text, sizeof text, "currentCommunicationPoint = %.17g s is not where the FMU is, t = %.17g s "
                  "(allowed difference %.3g s)", t, now, TIME_SLACK(now));
@@ -325,9 +330,9 @@ int glue_do_step(Glue *g, double t, double h, const char *call)
         snprintf(text, sizeof text, "communicationStepSize = %.17g s: allowed a finite value > 0", h);
         return glue_fail(g, call, text);
     }
-    status = glue_drive_status(g, cam_instance_step(g->drive, now, h), call);
+    status = glue_model_status(g, g->model->step(g->m, now, h), call);
     if (status == GLUE_OK)
-        g->last_successful_time = cam_instance_time(g->drive);
+        g->last_successful_time = g->model->time(g->m);
     return status;
 }
 
@@ -335,49 +340,50 @@ int glue_do_step(Glue *g, double t, double h, const char *call)
 
 GlueSaved *glue_save(Glue *g)
 {
-    size_t size = cam_instance_state_size(g->drive);
+    size_t size = g->model->state_size(g->m);
     GlueSaved *saved = malloc(sizeof *saved + size);
     int me = (g->state & GLUE_ME_STATES) != 0;
     if (!saved)
         return NULL;
     saved->size = size;
     saved->mode = me ? (unsigned)g->state : 0u;
-    if ((me ? cam_exchange_save(&g->me, saved->bytes, size) : cam_instance_save(g->drive, saved->bytes, size))
-        != CAM_OK) {
+    if ((me ? g->model->exchange->save(g->m, saved->bytes, size) : g->model->save(g->m, saved->bytes, size))
+        != MODEL_OK) {
         free(saved);
         return NULL;
     }
     return saved;
 }
 
-/* Model Exchange: the restored drive must be one Model Exchange runs, else the state before is put back. */
+/* Model Exchange: the restored model must be one Model Exchange runs, else the state before is put back. */
 static int restore_exchange(Glue *g, const GlueSaved *saved, const char *call)
 {
+    const Model *model = g->model;
     GlueSaved *before = glue_save(g);
     int status;
     if (!before)
         return glue_fail(g, call, "out of memory");
-    if (cam_instance_restore(g->drive, saved->bytes, saved->size) != CAM_OK) {
+    if (model->restore(g->m, saved->bytes, saved->size) != MODEL_OK) {
         free(before);
-        return glue_fail(g, call, cam_instance_message(g->drive));
+        return glue_fail(g, call, model->message(g->m));
     }
-    if (!cam_instance_initialized(g->drive)) {
+    if (!model->initialized(g->m)) {
         free(before);
         g->state = GLUE_INSTANTIATED;
         return GLUE_OK;
     }
-    if (cam_exchange_attach(&g->me) != CAM_OK) {
-        status = glue_fail(g, call, cam_exchange_message(&g->me));
-        cam_instance_restore(g->drive, before->bytes, before->size);
-        if (cam_instance_initialized(g->drive))
-            cam_exchange_attach(&g->me);
+    if (model->exchange->attach(g->m) != MODEL_OK) {
+        status = glue_fail(g, call, model->exchange->message(g->m));
+        model->restore(g->m, before->bytes, before->size);
+        if (model->initialized(g->m))
+            model->exchange->attach(g->m);
         free(before);
         return status;
     }
     free(before);
     /* the mode it was saved in; a co-simulation state enters event mode (the host then iterates) */
     g->state = saved->mode == GLUE_CONTINUOUS_TIME_MODE ? GLUE_CONTINUOUS_TIME_MODE : GLUE_EVENT_MODE;
-    g->last_successful_time = cam_instance_time(g->drive);
+    g->last_successful_time = model->time(g->m);
     return GLUE_OK;
 }
 
@@ -387,12 +393,12 @@ int glue_restore(Glue *g, const GlueSaved *saved, const char *call)
         return glue_fail(g, call, "the FMU state must not be NULL");
     if (g->exchange)
         return restore_exchange(g, saved, call);
-    /* the instance's state follows the drive's: an initialised one goes to step mode */
-    if (cam_instance_restore(g->drive, saved->bytes, saved->size) != CAM_OK)
-        return glue_fail(g, call, cam_instance_message(g->drive));
-    if (cam_instance_initialized(g->drive)) {
+    /* the instance's state follows the model's: an initialised one goes to step mode */
+    if (g->model->restore(g->m, saved->bytes, saved->size) != MODEL_OK)
+        return glue_fail(g, call, g->model->message(g->m));
+    if (g->model->initialized(g->m)) {
         g->state = GLUE_STEP_COMPLETE;
-        g->last_successful_time = cam_instance_time(g->drive);
+        g->last_successful_time = g->model->time(g->m);
     } else {
         g->state = GLUE_INSTANTIATED;
     }
@@ -426,7 +432,7 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
         return glue_fail(g, call, "the FMU state and the buffer must not be NULL");
     if (size < STATE_HEADER + saved->size)
         return glue_fail(g, call, "the buffer is smaller than the serialised state's size");
-    put_u32(out, STATE_MAGIC);
+    put_u32(out, g->model->state_magic);
     put_u32(out + 4, STATE_FORMAT);
     put_u32(out + 8, (unsigned long)(saved->size & 0xffffffffu));
     put_u32(out + 12, saved->mode);
@@ -441,14 +447,17 @@ int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **
     unsigned mode;
     if (!in || !saved)
         return glue_fail(g, call, "the arguments must not be NULL");
-    if (size < STATE_HEADER || get_u32(in) != STATE_MAGIC || get_u32(in + 4) != STATE_FORMAT)
-        return glue_fail(g, call, "these bytes are not a serialised cam.fmu state (format 1)");
+    if (size < STATE_HEADER || get_u32(in) != g->model->state_magic || get_u32(in + 4) != STATE_FORMAT) {
+        glue_log(g, GLUE_ERROR, "logStatusError", "%s: these bytes are not a serialised %s state (format %u)", call,
+                 g->model->name, STATE_FORMAT);
+        return GLUE_ERROR;
+    }
     payload = get_u32(in + 8);
     if (payload != size - STATE_HEADER)
         return glue_fail(g, call, "the serialised state is truncated or has trailing bytes");
     mode = (unsigned)get_u32(in + 12);
     if (mode != 0u && mode != GLUE_EVENT_MODE && mode != GLUE_CONTINUOUS_TIME_MODE)
-        return glue_fail(g, call, "the serialised state's mode word is not a mode of cam.fmu");
+        return glue_fail(g, call, "the serialised state's mode word is not a mode of this FMU");
     made = malloc(sizeof *made + payload);
     if (!made)
         return glue_fail(g, call, "out of memory");

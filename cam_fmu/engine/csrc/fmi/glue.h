@@ -1,7 +1,7 @@
-/* What the FMI 2.0 and FMI 3.0 glues of cam.fmu share, FMI-version neutral: the instance's state machine,
- * logging with its message rules, the checks of value references, the variable access, the communication
- * step, Model Exchange's calls (glue_me.c, over exchange.h) and the saved states (csrc/fmi/fmi2.c,
- * fmi2_me.c and fmi3_cs.c are thin over it).
+/* What the FMI 2.0 and FMI 3.0 glues share, FMI-version neutral and model neutral: the instance's state
+ * machine, logging with its message rules, the checks of value references, the variable access, the
+ * communication step, Model Exchange's calls (glue_me.c) and the saved states, over the model table of
+ * model.h (cam.fmu: model_cam.c; pi_speed.fmu: model_pi.c). fmi2.c, fmi2_me.c and fmi3_cs.c are thin over it.
  *
  * Statuses are the FMI numbering both versions share: OK 0, Warning 1, Discard 2, Error 3, Fatal 4.
  * Every call name in a message is the version's own ("fmi2GetReal", "fmi3GetFloat64"): the glue passes it.
@@ -13,8 +13,7 @@
 
 #include <stddef.h>
 
-#include "cam_instance.h"
-#include "exchange.h"
+#include "model.h"
 
 enum { GLUE_OK = 0, GLUE_WARNING = 1, GLUE_DISCARD = 2, GLUE_ERROR = 3 };
 
@@ -40,7 +39,8 @@ typedef void (*GlueEmit)(void *host, int status, const char *category, const cha
 
 typedef struct {
     unsigned magic;               /* the version's magic while alive, 0 once freed */
-    CamInstance *drive;
+    const Model *model;           /* the model's table (model_table()) */
+    void *m;                      /* the model's object */
     GlueEmit emit;                /* NULL: no logger */
     void *host;                   /* what emit gets back (the version's instance) */
     char *name;
@@ -50,8 +50,7 @@ typedef struct {
     double last_successful_time;  /* s */
     const char *version;          /* "fmi2" or "fmi3": names calls and statuses in state names */
     unsigned vr_end;              /* one past the last value reference the version describes */
-    int exchange;                 /* a Model Exchange instance: me runs the drive */
-    CamExchange me;
+    int exchange;                 /* a Model Exchange instance: the host's solver runs the model */
 } Glue;
 
 /* A saved state: the instance layer's bytes, and the Model Exchange mode it was saved in (0: co-simulation). */
@@ -61,8 +60,8 @@ typedef struct {
     unsigned char bytes[];
 } GlueSaved;
 
-/* Set up g (name copied, a new drive; exchange: a Model Exchange instance); 0 when out of memory (then
- * nothing is left allocated). Every variable of the table is addressable (vr_end CAM_VR_END). */
+/* Set up g (name copied, a new model object; exchange: a Model Exchange instance); 0 when out of memory
+ * (then nothing is left allocated). Every variable of the table is addressable (vr_end: the model's). */
 int glue_init(Glue *g, const char *name, int logging_on, const char *version, int exchange);
 void glue_free(Glue *g);
 
@@ -75,8 +74,8 @@ void glue_log(const Glue *g, int status, const char *category, const char *forma
 int glue_fail(const Glue *g, const char *call, const char *text);
 /* 1 when the instance's state is one of states, else logs the refusal and returns 0. */
 int glue_allowed(const Glue *g, int states, const char *call);
-/* The drive's verdict on initialisation or a step: OK, Discard (state STEP_FAILED) or Error (ERROR_STATE). */
-int glue_drive_status(Glue *g, int status, const char *call);
+/* The model's verdict on initialisation or a step: OK, Discard (state STEP_FAILED) or Error (ERROR_STATE). */
+int glue_model_status(Glue *g, int status, const char *call);
 
 /* The life cycle. */
 int glue_setup(Glue *g, double start_time, int stop_defined, double stop_time, const char *call);
@@ -102,7 +101,7 @@ int glue_restore(Glue *g, const GlueSaved *saved, const char *call);
 size_t glue_serialized_size(const GlueSaved *saved);
 int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t size, const char *call);
 /* A new saved state from serialised bytes into *saved (a former one freed); Error with a message if they are
- * not a serialised cam.fmu state. */
+ * not a serialised state of this model. */
 int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call);
 
 /* Model Exchange (glue_me.c): each call checks the instance is one, in one of states, and attached. */
@@ -117,7 +116,6 @@ int glue_completed_integrator_step(Glue *g, int *enter_event, int *terminate, co
 int glue_set_time(Glue *g, double time, const char *call);
 int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char *call);
 /* The read calls: values zeroed first; which: states, derivatives, event indicators or nominals. */
-typedef enum { GLUE_READ_STATES, GLUE_READ_DERIVATIVES, GLUE_READ_INDICATORS, GLUE_READ_NOMINALS } GlueRead;
-int glue_me_read(Glue *g, GlueRead which, double values[], size_t n, const char *call);
+int glue_me_read(Glue *g, ModelRead which, double values[], size_t n, const char *call);
 
 #endif

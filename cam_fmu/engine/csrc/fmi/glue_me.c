@@ -1,6 +1,6 @@
 /* Model Exchange's calls of the shared glue (glue.h), FMI-version neutral: the state machine of event and
- * continuous-time mode and the argument checks over the Model Exchange layer (exchange.h). No FMI header,
- * no globals. */
+ * continuous-time mode and the argument checks over the model's Model Exchange functions (model.h). No FMI
+ * header, no globals. */
 #include <stddef.h>
 
 #include "glue.h"
@@ -9,14 +9,14 @@
 
 int glue_me_allowed(Glue *g, int states, int attached, const char *call)
 {
-    if (!g->exchange) {
+    if (!g->exchange || !g->model->exchange) {
         glue_fail(g, call, "a Model Exchange function: this instance is a co-simulation one (step it with DoStep)");
         return 0;
     }
     if (!glue_allowed(g, states, call))
         return 0;
-    if (attached && !g->me.drive) {
-        glue_fail(g, call, "the drive was not initialised for Model Exchange (ExitInitializationMode failed)");
+    if (attached && !g->model->exchange->attached(g->m)) {
+        glue_fail(g, call, "the model was not initialised for Model Exchange (ExitInitializationMode failed)");
         return 0;
     }
     return 1;
@@ -26,7 +26,7 @@ int glue_me_allowed(Glue *g, int states, int attached, const char *call)
  * Error and the error state. */
 static int model_error(Glue *g, const char *call)
 {
-    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, cam_exchange_message(&g->me));
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->exchange->message(g->m));
     g->state = GLUE_ERROR_STATE;
     return GLUE_ERROR;
 }
@@ -35,23 +35,21 @@ int glue_enter_event_mode(Glue *g, const char *call)
 {
     if (!glue_me_allowed(g, GLUE_ME_STATES, 1, call))
         return GLUE_ERROR;
-    cam_exchange_enter_event_mode(&g->me);
+    g->model->exchange->enter_event_mode(g->m);
     g->state = GLUE_EVENT_MODE;
     return GLUE_OK;
 }
 
 int glue_new_discrete_states(Glue *g, int *needed, int *values_changed, const char *call)
 {
-    CamExchangeEvent fired;
+    char fired[400];
     *needed = *values_changed = 0;
     if (!glue_me_allowed(g, GLUE_EVENT_MODE, 1, call))
         return GLUE_ERROR;
-    if (cam_exchange_event_update(&g->me, &fired, values_changed, needed) != CAM_OK)
+    if (g->model->exchange->event_update(g->m, values_changed, needed, fired, sizeof fired) != MODEL_OK)
         return model_error(g, call);
-    if (fired.code >= 0)
-        glue_log(g, GLUE_OK, "logEvents", "t = %.17g s: event '%s' at theta = %.17g rad, omega %.17g -> %.17g rad/s",
-                 fired.time, cam_exchange_event_name(fired.code), fired.x_before[CAM_THETA],
-                 fired.x_before[CAM_OMEGA], fired.x_after[CAM_OMEGA]);
+    if (fired[0])
+        glue_log(g, GLUE_OK, "logEvents", "%s", fired);
     return GLUE_OK;
 }
 
@@ -59,7 +57,7 @@ int glue_enter_continuous_time_mode(Glue *g, const char *call)
 {
     if (!glue_me_allowed(g, GLUE_EVENT_MODE, 1, call))
         return GLUE_ERROR;
-    cam_exchange_enter_continuous(&g->me);
+    g->model->exchange->enter_continuous(g->m);
     g->state = GLUE_CONTINUOUS_TIME_MODE;
     return GLUE_OK;
 }
@@ -69,11 +67,11 @@ int glue_completed_integrator_step(Glue *g, int *enter_event, int *terminate, co
     *enter_event = *terminate = 0;
     if (!glue_me_allowed(g, GLUE_CONTINUOUS_TIME_MODE, 1, call))
         return GLUE_ERROR;
-    if (cam_exchange_completed_step(&g->me, enter_event) != CAM_OK) {
+    if (g->model->exchange->completed_step(g->m, enter_event) != MODEL_OK) {
         *terminate = 1;
         return model_error(g, call);
     }
-    g->last_successful_time = cam_instance_time(g->drive);
+    g->last_successful_time = g->model->time(g->m);
     return GLUE_OK;
 }
 
@@ -81,8 +79,8 @@ int glue_set_time(Glue *g, double time, const char *call)
 {
     if (!glue_me_allowed(g, GLUE_ME_STATES, 1, call))
         return GLUE_ERROR;
-    if (cam_exchange_set_time(&g->me, time) != CAM_OK)
-        return glue_fail(g, call, cam_exchange_message(&g->me));
+    if (g->model->exchange->set_time(g->m, time) != MODEL_OK)
+        return glue_fail(g, call, g->model->exchange->message(g->m));
     return GLUE_OK;
 }
 
@@ -92,15 +90,15 @@ int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char 
         return GLUE_ERROR;
     if (!x)
         return glue_fail(g, call, "x must not be NULL");
-    if (cam_exchange_set_states(&g->me, x, nx) != CAM_OK)
-        return glue_fail(g, call, cam_exchange_message(&g->me));
+    if (g->model->exchange->set_states(g->m, x, nx) != MODEL_OK)
+        return glue_fail(g, call, g->model->exchange->message(g->m));
     return GLUE_OK;
 }
 
-int glue_me_read(Glue *g, GlueRead which, double values[], size_t n, const char *call)
+int glue_me_read(Glue *g, ModelRead which, double values[], size_t n, const char *call)
 {
     size_t k;
-    int status, nominals = which == GLUE_READ_NOMINALS;
+    int nominals = which == MODEL_READ_NOMINALS;
     if (values)
         for (k = 0; k < n; k++)
             values[k] = 0.0;
@@ -110,16 +108,10 @@ int glue_me_read(Glue *g, GlueRead which, double values[], size_t n, const char 
         return GLUE_ERROR;
     if (!values && n > 0)
         return glue_fail(g, call, "the array must not be NULL");
-    switch (which) {
-    case GLUE_READ_STATES: status = cam_exchange_get_states(&g->me, values, n); break;
-    case GLUE_READ_DERIVATIVES: status = cam_exchange_derivatives(&g->me, values, n); break;
-    case GLUE_READ_INDICATORS: status = cam_exchange_indicators(&g->me, values, n); break;
-    default: status = cam_exchange_nominals(&g->me, values, n); break;
-    }
-    if (status != CAM_OK) {
+    if (g->model->exchange->read(g->m, which, values, n) != MODEL_OK) {
         for (k = 0; values && k < n; k++)
             values[k] = 0.0;
-        return glue_fail(g, call, cam_exchange_message(&g->me));
+        return glue_fail(g, call, g->model->exchange->message(g->m));
     }
     return GLUE_OK;
 }
