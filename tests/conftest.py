@@ -83,11 +83,11 @@ def copy_fmu(cam_fmu_path: Path, tmp_path_factory, label: str) -> Path:
 
 @pytest.fixture(autouse=True)
 def _no_python_fmu_in_pytest():
-    """A test that loads a pythonfmu FMU (pi_speed.fmu) into this process fails here, loudly: the CLI's
-    exit_after_fmu would otherwise end the whole pytest run at the next in-process `cam-fmu` call with
-    status 0 and the rest of the tests unrun (found when a run stopped silently at 92 %)."""
+    """A test that loads a pythonfmu FMU (a block written in Python) or pythonfmu itself into this process fails
+    here, loudly: the CLI's exit_after_fmu would otherwise end the whole pytest run at the next in-process
+    `cam-fmu` call with status 0 and the rest of the tests unrun (found when a run stopped silently at 92 %)."""
     import sys as _sys
 
     yield
-    loaded = [m for m in list(_sys.modules) if m.startswith("pi_speed_fmu_slave")]
+    loaded = [m for m in list(_sys.modules) if m.startswith("pythonfmu")]
     assert not loaded, f"a pythonfmu FMU was loaded into the pytest process ({loaded}): run it in a child process"

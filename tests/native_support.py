@@ -59,7 +59,7 @@ def value_references(fmu_dir: Path) -> Dict[str, int]:
 
 def compile_host(dest: Path) -> Path:
     """tests/native_host/host.c compiled (gcc is required: its absence fails the test)."""
-    from cam_fmu.fmu.native import soak
+    from cam_fmu.tools import soak
 
     require("gcc")
     return soak.compile_host(dest)

@@ -3,7 +3,7 @@
 Counts are small (the old binary failed 11 of 40 fmpy CLI runs, 10 of 332 scipy scripts and
 20 of 20 C-host runs; the CI counts below catch the first and the last with near certainty).
 The issue's full counts run with the developer command
-``python -m cam_fmu.fmu.native.soak models/cam.fmu`` (about 4 minutes).
+``python -m cam_fmu.tools.soak models/cam.fmu`` (about 4 minutes).
 Every tool is required: a missing one fails the test.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from cam_fmu.fmu.native import soak
+from cam_fmu.tools import soak
 from native_support import (EMPTY_ENV, compile_host, ecos_path, extract, libcosim_script, require, result_line,
                             run_python, valgrind_prefix, valgrind_summary)
 

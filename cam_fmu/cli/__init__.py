@@ -23,8 +23,9 @@ SUBCOMMANDS: tuple[str, ...] = (
     "contour",    # disc cam geometry, design checks, CSV/DXF export
     "simulate",   # run a scene: CSV + figure
     "bench",      # speed-accuracy benchmark of cam.fmu through fmpy
-    "host_env",   # environment line for native FMU hosts (diagnostic)
+    "host_env",   # deprecated: no shipped FMU needs Python on the host any more
     "cosim",      # run an SSP (the speed loop) on the project's co-simulation master
+    "python_block",  # a block written in Python (pythonfmu) packed as an FMU
     "sweep",      # parameter sweeps of a scene on dask.distributed
     "reflect",    # the inertia and load torque the motor sees over one turn
     "bode",       # the frequency response from the motor voltage to the motor and cam speed
@@ -43,9 +44,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-# Imported into this process (under a private name, ``pi_speed_fmu_slave_<hash>``) when pi_speed.fmu, a
-# pythonfmu FMU, is loaded here: then leave with os._exit. cam.fmu hosts no Python (its binary is the C engine).
-FMU_SLAVE_MODULES = ("pi_speed_fmu_slave",)
+# Imported into this process when a pythonfmu FMU (a block written in Python, `cosim --controller`) is loaded
+# here or one is built: then leave with os._exit. The shipped FMUs host no Python (their binaries are C).
+FMU_SLAVE_MODULES = ("pythonfmu",)
 
 
 def exit_after_fmu(status: int) -> int:

@@ -34,8 +34,34 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="run once per controller gain pair, e.g. 1:10,2:20,5:50 [V/(rad/s)]:[V/rad]")
     p.add_argument("--feedforward", choices=("off", "on", "both"), default=None,
                    help="controller feedforward in the runs (default: as the SSP says)")
+    p.add_argument("--controller", metavar="FMU", default=None,
+                   help="close the speed loop around cam.fmu with this controller FMU instead of an SSP (e.g. a "
+                        "block written in Python: cam-fmu python-block); it needs an input omega_meas and an "
+                        "output u, and gets M_load and J_load when it has them")
     p.add_argument("--no-plot", action="store_true", help="write the CSV files only")
     return p
+
+
+def controller_loop(controller: Path, folder: Path) -> Path:
+    """The speed loop of models/speed_loop.ssp with ``controller`` (an FMU file) in place of pi_speed.fmu,
+    written into ``folder``; the connections follow the controller's inputs (M_load, J_load when it has them)."""
+    from fmpy import read_model_description
+
+    from ..experiments.fmu_file import ensure_fmu
+    from ..experiments.ssp import SPEED_LOOP_CAM, speed_loop_system, write_ssp
+
+    if not controller.is_file():
+        raise ValueError(f"--controller {str(controller)!r}: no such FMU file")
+    variables = {v.name: v.causality for v in read_model_description(str(controller)).modelVariables}
+    missing = [name for name, causality in (("omega_meas", "input"), ("u", "output"))
+               if variables.get(name) != causality]
+    if missing:
+        raise ValueError(f"--controller {str(controller)!r}: needs an input 'omega_meas' and an output 'u' "
+                         f"(missing or of another causality: {', '.join(missing)})")
+    feedforward = variables.get("M_load") == "input" and variables.get("J_load") == "input"
+    system = speed_loop_system(SPEED_LOOP_CAM, {}, feedforward_connections=feedforward,
+                               name=f"speed_loop_{controller.stem}")
+    return write_ssp(system, {"cam": ensure_fmu(None), "controller": controller}, folder / f"{system.name}.ssp")
 
 
 def parse_assignment(text: str, option: str = "--set") -> tuple[str, str]:
@@ -78,19 +104,31 @@ def run(args) -> int:
     from ..experiments.ssp import read_ssp
     from ..physics.parameters import BY_NAME, resolve
 
-    system = read_ssp(ensure_ssp(args.ssp, log=print))  # progress on stdout: stderr carries only the error line
+    if args.controller and args.ssp:
+        raise ValueError("give either an SSP file or --controller FMU, not both")
+    out = Path(args.out)
+    if args.controller:
+        out.mkdir(parents=True, exist_ok=True)
+        system = read_ssp(controller_loop(Path(args.controller), out))
+    else:
+        system = read_ssp(ensure_ssp(args.ssp, log=print))  # progress on stdout: stderr carries only the error line
     for text in args.set:
         name, value = parse_assignment(text)
         comp, _, var = name.partition(".")
         if comp not in system.components or not var:
             raise ValueError(f"--set {text!r}: expected COMP.NAME=VALUE with COMP one of "
                              f"{', '.join(system.components)}")
+        if comp == "controller" and args.controller:  # a controller of the user's: its FMU checks its values
+            system.components[comp].parameters[var] = _typed(value)
+            continue
         table = pi.BY_NAME if comp == "controller" else BY_NAME
         if var not in table:
             raise ValueError(f"--set {text!r}: {comp} has no parameter {var!r}; known: {', '.join(table)}")
         system.components[comp].parameters[var] = table[var].check(_typed(value))
     variants = {"": {}}
     if args.gains or args.feedforward:
+        if args.controller and args.feedforward:
+            raise ValueError("--feedforward is pi_speed.fmu's parameter: not for --controller")
         if "controller" not in system.components:
             raise ValueError("--gains/--feedforward need a component named 'controller' (pi_speed.fmu)")
         gains = _gains(args.gains) if args.gains else [(None, None)]
@@ -112,7 +150,8 @@ def run(args) -> int:
         sysk = copy.deepcopy(system)
         if over:
             sysk.components["controller"].parameters.update(over)
-        ctrl = pi.resolve(sysk.components["controller"].parameters) if "controller" in sysk.components else None
+        ctrl = (pi.resolve(sysk.components["controller"].parameters)
+                if "controller" in sysk.components and not args.controller else None)
         stop = args.stop_time if args.stop_time is not None else sysk.stop_time
         bar = _progress(f"{label or system.name}")
         cam = sysk.components.get("cam")

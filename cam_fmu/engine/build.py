@@ -99,26 +99,35 @@ def library_dir() -> Path:
     return cache
 
 
+def compile_shared(dest: Path, sources: Sequence[Path], include: Sequence[Path] = (), extra_flags: Sequence[str] = (),
+                   compiler: str | None = None) -> Path:
+    """Compile C ``sources`` (with the folders ``include``) into the shared library ``dest`` with the
+    engine's flags (CFLAGS, LDFLAGS); returns ``dest``. Any model's binary is made here."""
+    cc = compiler or find_compiler()
+    if not sources:
+        raise EngineBuildError("no C sources to compile")
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
+    cmd = [cc, *CFLAGS, *extra_flags, *(f"-I{p}" for p in include), *map(str, sources), "-o", str(tmp), *LDFLAGS]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        tmp.unlink(missing_ok=True)
+        raise EngineBuildError(f"compiling failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")
+    os.replace(tmp, dest)  # atomic: a concurrent loader never sees half a library
+    return dest
+
+
 def compile_library(dest: Path, extra_flags: Sequence[str] = (), compiler: str | None = None,
                     extra_sources: Sequence[Path] = (), include: Sequence[Path] = ()) -> Path:
     """Compile every engine source (and ``extra_sources``, with the folders ``include``) into the shared
     library ``dest``; returns ``dest``. The FMU's binary is this library plus its FMI glue."""
-    cc = compiler or find_compiler()
-    sources = [str(p) for p in sorted(SOURCES.glob("*.c"))] + [str(p) for p in extra_sources]
-    if not sources:
-        raise EngineBuildError(f"no C sources in {SOURCES}")
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dest.with_name(f".{dest.name}.{os.getpid()}.tmp")
+    sources = [*sorted(SOURCES.glob("*.c")), *extra_sources]
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
-        generated = [str(p) for p in codegen.write(Path(gen)) if p.suffix == ".c"]
-        cmd = [cc, *CFLAGS, *extra_flags, f"-I{INCLUDE}", f"-I{gen}", *(f"-I{p}" for p in include), *sources,
-               *generated, "-o", str(tmp), *LDFLAGS]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        tmp.unlink(missing_ok=True)
-        raise EngineBuildError(f"compiling the engine failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")
-    os.replace(tmp, dest)  # atomic: a concurrent loader never sees half a library
-    return dest
+        generated = [p for p in codegen.write(Path(gen)) if p.suffix == ".c"]
+        try:
+            return compile_shared(dest, [*sources, *generated], (INCLUDE, Path(gen), *include), extra_flags, compiler)
+        except EngineBuildError as exc:
+            raise EngineBuildError(f"the engine: {exc}") from None
 
 
 def library_name(extra_flags: Sequence[str] = ()) -> str:

@@ -1,14 +1,15 @@
-"""Build the project's models: cam.fmu, pi_speed.fmu (FMI 2.0 co-simulation) and speed_loop.ssp.
+"""Build the project's models: cam.fmu, cam3.fmu, pi_speed.fmu and the loops speed_loop.ssp, compliant_loop.ssp.
 
-    python build_fmu.py                          # -> models/cam.fmu, pi_speed.fmu, speed_loop.ssp, compliant_loop.ssp
+    python build_fmu.py                          # -> models/cam.fmu, cam3.fmu, pi_speed.fmu, *.ssp
     python -m cam_fmu.fmu.build --dest /tmp/x/cam.fmu
     python -m cam_fmu.fmu.build --model pi_speed --dest /tmp/x/pi_speed.fmu
 
-- cam.fmu: the C engine compiled into a binary FMU that needs nothing but the C
-  library (``engine_fmu``; docs/fmu.md).
-- pi_speed.fmu: a controller written in Python, packed by pythonfmu with the
-  project's Python-hosting binary (``python_fmu``).
-- speed_loop.ssp: the two closing a speed loop (``experiments.ssp``).
+Every FMU is a C model on the shared FMI glue, compiled into a binary FMU that
+needs nothing but the C library (``engine_fmu``; docs/fmu.md):
+- cam.fmu (FMI 2.0, co-simulation and Model Exchange) and cam3.fmu (FMI 3.0
+  co-simulation): the drive's C engine;
+- pi_speed.fmu (FMI 2.0 co-simulation): the PI speed controller (control/csrc);
+- speed_loop.ssp and compliant_loop.ssp: the two closing a loop (``experiments.ssp``).
 """
 from __future__ import annotations
 
@@ -17,11 +18,12 @@ import sys
 from pathlib import Path
 from typing import List
 
-from . import engine_fmu, python_fmu
+from . import engine_fmu
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
-ENGINE_MODELS = {"cam": 2, "cam3": 3}  # the C engine's FMUs and their FMI versions
-MODELS = (*ENGINE_MODELS, *python_fmu.MODELS)  # every FMU the project builds
+# every FMU the project builds: name -> (its C model, FMI version)
+ENGINE_MODELS = {"cam": ("cam", 2), "cam3": ("cam", 3), "pi_speed": ("pi_speed", 2)}
+MODELS = tuple(ENGINE_MODELS)
 SSP_NAME = "speed_loop"  # models/speed_loop.ssp: pi_speed.fmu closing a speed loop around cam.fmu
 SSP_NAMES = (SSP_NAME, "compliant_loop")  # and the loop on the cam's speed around a compliant shaft
 
@@ -32,9 +34,7 @@ class BuildError(RuntimeError):
 
 def sources(model: str = "cam") -> list[Path]:
     """Every file whose content ends up in (or shapes) the FMU of ``model``."""
-    if model in ENGINE_MODELS:
-        return engine_fmu.sources()
-    return python_fmu.sources(model=model)
+    return engine_fmu.sources(ENGINE_MODELS[model][0])
 
 
 def is_stale(fmu: Path, model: str = "cam") -> bool:
@@ -46,16 +46,14 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Path | None = None) -> Path:
-    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it.
-    ``package_dir``: a Python FMU's bundle from another copy of the package (developers' tests)."""
+def build(dest: Path, model: str = "cam") -> Path:
+    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it."""
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
+    c_model, fmi_version = ENGINE_MODELS[model]
     try:
-        if model in ENGINE_MODELS:
-            return engine_fmu.build(dest, fmi_version=ENGINE_MODELS[model])
-        return python_fmu.build(dest, model, package_dir=package_dir, verbose=verbose)
-    except (engine_fmu.FmuBuildError, python_fmu.BuildError) as exc:
+        return engine_fmu.build(dest, fmi_version=fmi_version, model=c_model)
+    except engine_fmu.FmuBuildError as exc:
         raise BuildError(str(exc)) from None
 
 
@@ -76,22 +74,20 @@ def main(argv: List[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="build_fmu.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dest", type=Path, default=None,
                         help="build one FMU (--model, default cam) into this file; without --dest: "
-                             "cam.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a source checkout "
-                             "(else a user cache)")
+                             "cam.fmu, cam3.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a "
+                             "source checkout (else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
-    parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules of a Python FMU")
-    parser.add_argument("--package-dir", type=Path, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     try:
         if args.dest is not None:
-            print(build(args.dest, args.model, args.verbose, args.package_dir))
+            print(build(args.dest, args.model))
             return 0
-        built = {name: build(default_model_path(name), name, args.verbose, args.package_dir) for name in MODELS}
+        built = {name: build(default_model_path(name), name) for name in MODELS}
         for path in built.values():
             print(path)
         for name in SSP_NAMES:
             print(build_ssp(default_model_path(name, ".ssp"), built["cam"], built["pi_speed"], name))
-    except (BuildError, RuntimeError) as exc:  # RuntimeError: native.NativeBuildError (no C compiler ...)
+    except (BuildError, RuntimeError) as exc:  # RuntimeError: the engine's build (no C compiler ...)
         print(f"build_fmu: error: {exc}", file=sys.stderr)
         return 1
     return 0

@@ -1,50 +1,48 @@
-"""Build cam.fmu from the C engine: a binary FMU that needs nothing but the C library.
+"""Build a binary FMU from a C model on the shared FMI glue: cam.fmu and cam3.fmu (the drive), pi_speed.fmu
+(the PI speed controller). Each needs nothing but the C library.
 
-Build time only. Steps:
+Build time only. A model (``CModel``) is its hand-written C (the model table of ``csrc/fmi/model.h`` and
+what it calls), a generator of its variable table in C, its variable rows (``model_description``) and its
+default experiment; the FMI glue (``csrc/fmi``: glue.c, glue_me.c and the version's files) is the same for
+every model. Steps:
 
-1. The GUID: a hash of the variable table (``model_description.variable_rows``)
-   and of the engine's sources (``engine.build.digest``).
-2. The generated headers (``engine.codegen``: the variable and parameter tables of
-   ``physics/parameters.py`` and ``physics/variables.py``) in a temporary folder.
-3. The binary: every engine source (``engine/csrc/src/*.c``) and the FMI 2.0
-   glue (``engine/csrc/fmi/fmi2.c`` and ``fmi2_me.c`` over ``glue.c``, ``glue_me.c``,
-   ``exchange.c`` and ``instance.c``) compiled into one shared library with the
-   official FMI headers (fmpy's copy), only the FMI functions exported, linked
-   with libc and libm only: ``binaries/linux64/cam.so``; with the MinGW-w64 cross
-   compiler also ``binaries/win64/cam.dll`` (Windows' own KERNEL32 and msvcrt only).
-4. ``modelDescription.xml``: ``model_description.skeleton`` completed by
-   ``model_description.postprocess`` (units, ranges, structure, the default
-   experiment of the paper's fig. 6 scene).
-5. The C sources under ``sources/``, with the generated table and the official
-   headers: anyone can rebuild the binary for another platform
+1. The GUID: a hash of the variable rows and of every source and generated file.
+2. The generated tables (``engine.codegen`` for the drive, ``pi_codegen`` for the controller) in a
+   temporary folder.
+3. The binary: the model's C, the generated C and the glue of the FMI version compiled into one shared
+   library with the official FMI headers, only the FMI functions exported, linked with libc and libm only:
+   ``binaries/linux64/<id>.so``; with the MinGW-w64 cross compiler also ``binaries/win64/<id>.dll``.
+4. ``modelDescription.xml`` (``model_description`` for FMI 2.0, ``model_description3`` for FMI 3.0).
+5. The C sources under ``sources/``, with the generated table and the official headers: anyone can rebuild
+   the binary for another platform
    (``cc -std=c99 -shared -fPIC -include sources/guid.h -Isources sources/*.c -lm``).
 """
 from __future__ import annotations
 
+import hashlib
 import shutil
 import tempfile
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import build as engine_build
 from ..engine import codegen
-from . import model_description, model_description3
+from . import model_description, model_description3, pi_codegen
 
-MODEL_IDENTIFIER = "cam"
-DESCRIPTION = ("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
-               "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu")
+PACKAGE_DIR = engine_build.HERE.parent  # cam_fmu/
 FMI = engine_build.CSRC / "fmi"
-# The FMI glue of each version: the instance layer, the Model Exchange layer, the glue both share, the
-# version's own files (FMI 2.0: co-simulation and Model Exchange; FMI 3.0: co-simulation); its official
-# headers; its platform folders (FMI 3.0 names them by architecture and OS).
-SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "model_cam.c", FMI / "glue.c", FMI / "glue_me.c")
+CONTROL_CSRC = PACKAGE_DIR / "control" / "csrc"
+# The FMI glue of each version, for every model: the glue both versions share and the version's own files
+# (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0: co-simulation). Its official headers; its
+# platform folders (FMI 3.0 names them by architecture and OS).
+SHARED_GLUE = (FMI / "glue.c", FMI / "glue_me.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 PLATFORM_DIRS = {2: {"linux64": "linux64", "win64": "win64"}, 3: {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}
-FMU_NAMES = {2: "cam.fmu", 3: "cam3.fmu"}
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
 BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
 # win64: Debian's MinGW-w64 cross compiler; libgcc linked in, so the DLL needs only Windows' own
@@ -58,36 +56,128 @@ class FmuBuildError(RuntimeError):
     """The FMU could not be built; the message says why."""
 
 
-def sources() -> list[Path]:
-    """Every file whose content shapes cam.fmu: the engine's C, the FMI glue, the generators and the tables."""
-    package = engine_build.HERE.parent
-    return [*engine_build.source_files(), *sorted(FMI.glob("*.[ch]")), Path(__file__), Path(model_description.__file__),
-            Path(model_description3.__file__), Path(codegen.__file__), Path(engine_build.__file__),
-            package / "physics" / "parameters.py",
-            package / "physics" / "variables.py"]
+@dataclass(frozen=True)
+class CModel:
+    """A C model on the shared FMI glue: what its binary, model description and sources/ are made of."""
+
+    identifier: str                                  # the model identifier: the binary's name
+    description: str                                 # the model description's description
+    sources: Callable[[], List[Path]]                # its hand-written C (.c and .h), the model table's file included
+    include: Sequence[Path]                          # folders of its headers
+    generate: Callable[[Path], List[Path]]           # writes its generated C into a folder
+    rows: Callable[[], List[Dict[str, Any]]]         # its variables in value-reference order
+    experiment: Callable[[], tuple]                  # (start, stop, step) [s] of its default experiment
+    model_exchange: bool                             # it offers Model Exchange (FMI 2.0) beside co-simulation
+    shaping: Callable[[], List[Path]]                # the Python files that shape its FMU (staleness)
 
 
 def default_experiment() -> tuple[float, float, float]:
-    """(start, stop, step) [s] of the paper's fig. 6 scene: the FMU's default experiment."""
+    """(start, stop, step) [s] of the paper's fig. 6 scene: cam.fmu's default experiment."""
     from ..experiments.scenes import find_scene
 
     scene = find_scene("paper_fig6")
     return 0.0, float(scene.stop_time), float(scene.output_interval)
 
 
+def controller_experiment() -> tuple[float, float, float]:
+    """(start, stop, step) [s] of pi_speed.fmu's default experiment: 2 s sampled every millisecond."""
+    return 0.0, 2.0, 1e-3
+
+
+def _cam_sources() -> List[Path]:
+    return [*engine_build.source_files(), FMI / "instance.c", FMI / "exchange.c", FMI / "exchange.h",
+            FMI / "model_cam.c"]
+
+
+def _pi_sources() -> List[Path]:
+    return sorted(CONTROL_CSRC.glob("*.[ch]"))
+
+
+CAM = CModel(
+    identifier="cam",
+    description=("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
+                 "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu"),
+    sources=_cam_sources, include=(engine_build.INCLUDE,), generate=codegen.write,
+    rows=model_description.variable_rows, experiment=default_experiment, model_exchange=True,
+    shaping=lambda: [Path(codegen.__file__), Path(engine_build.__file__), PACKAGE_DIR / "physics" / "parameters.py",
+                     PACKAGE_DIR / "physics" / "variables.py"],
+)
+PI_SPEED = CModel(
+    identifier="pi_speed",
+    description=("Sampled PI speed controller (one sample per communication step) with conditional-integration "
+                 "anti-windup, output clamp [u_min, u_max] and optional load-torque feedforward from cam.fmu's "
+                 "M and J (control/pi.py; C in control/csrc)"),
+    sources=_pi_sources, include=(CONTROL_CSRC,), generate=pi_codegen.write,
+    rows=model_description.controller_rows, experiment=controller_experiment, model_exchange=False,
+    shaping=lambda: [Path(pi_codegen.__file__), PACKAGE_DIR / "control" / "pi.py",
+                     PACKAGE_DIR / "physics" / "parameters.py"],
+)
+MODELS: Dict[str, CModel] = {"cam": CAM, "pi_speed": PI_SPEED}
+
+
+def _model(model: str | CModel) -> CModel:
+    if isinstance(model, CModel):
+        return model
+    if model not in MODELS:
+        raise FmuBuildError(f"C model {model!r}: allowed {', '.join(map(repr, MODELS))}")
+    return MODELS[model]
+
+
+def glue_sources() -> List[Path]:
+    """The glue's files, every version's (C and headers)."""
+    return sorted(FMI.glob("glue*.[ch]")) + sorted(FMI.glob("fmi*.[ch]")) + [FMI / "model.h"]
+
+
+def sources(model: str | CModel = "cam") -> List[Path]:
+    """Every file whose content shapes the model's FMUs: its C, the glue, the generators and the tables."""
+    m = _model(model)
+    return [*m.sources(), *glue_sources(), Path(__file__), Path(model_description.__file__),
+            Path(model_description3.__file__), *m.shaping()]
+
+
+def binary_sources(model: str | CModel = "cam", fmi_version: int = 2) -> List[Path]:
+    """The C files of the model's binary for ``fmi_version``, the generated table aside."""
+    m = _model(model)
+    return [p for p in m.sources() if p.suffix == ".c"] + list(GLUE[fmi_version])
+
+
+def digest(model: str | CModel = "cam") -> str:
+    """12 hex digits of the model's C, the glue and its generated table: the binary's identity."""
+    m = _model(model)
+    h = hashlib.sha256()
+    for path in [*m.sources(), *glue_sources()]:
+        h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
+        for path in m.generate(Path(gen)):
+            h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    h.update(" ".join(engine_build.CFLAGS + engine_build.LDFLAGS).encode())
+    return h.hexdigest()[:12]
+
+
+def model_guid(model: str | CModel = "cam") -> str:
+    """The GUID of the model's FMU built from this checkout."""
+    m = _model(model)
+    return model_description.guid(m.rows(), digest(m))
+
+
 def engine_guid() -> str:
     """The GUID of a cam.fmu built from this checkout."""
-    return model_description.guid(model_description.variable_rows(), engine_build.digest())
+    return model_guid(CAM)
 
 
 def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = (),
-                   fmi_version: int = 2) -> Path:
-    """Compile the engine, the instance layer and the FMI glue of ``fmi_version`` into the shared library ``dest``."""
-    try:
-        return engine_build.compile_library(dest, (*BINARY_FLAGS, f'-DMODEL_GUID="{guid}"', *extra_flags), compiler,
-                                            extra_sources=GLUE[fmi_version], include=(engine_build.fmi_headers(),))
-    except engine_build.EngineBuildError as exc:
-        raise FmuBuildError(f"cam.fmu's binary: {exc}") from None
+                   fmi_version: int = 2, model: str | CModel = "cam") -> Path:
+    """Compile the model, its generated table and the FMI glue of ``fmi_version`` into the shared library ``dest``."""
+    m = _model(model)
+    with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
+        generated = [p for p in m.generate(Path(gen)) if p.suffix == ".c"]
+        try:
+            return engine_build.compile_shared(
+                dest, [*binary_sources(m, fmi_version), *generated],
+                (*m.include, Path(gen), FMI, engine_build.fmi_headers()),
+                (*BINARY_FLAGS, f'-DMODEL_GUID="{guid}"', *extra_flags), compiler)
+        except engine_build.EngineBuildError as exc:
+            raise FmuBuildError(f"{m.identifier}'s binary: {exc}") from None
 
 
 def win64_compiler() -> str | None:
@@ -95,13 +185,23 @@ def win64_compiler() -> str | None:
     return shutil.which(WIN64_COMPILER)
 
 
-def build(dest: Path, win64: bool | None = None, fmi_version: int = 2) -> Path:
-    """Build cam.fmu (``fmi_version`` 2) or cam3.fmu (3) at ``dest`` (a path ending in .fmu) and return it.
+def model_description_xml(m: CModel, guid: str, fmi_version: int) -> bytes:
+    """The model description of ``m`` for ``fmi_version``."""
+    rows = m.rows()
+    if fmi_version == 2:
+        return model_description.postprocess(model_description.skeleton(m.identifier, guid, rows, m.model_exchange),
+                                             m.experiment(), m.description, rows)
+    return model_description3.model_description(m.identifier, guid, rows, m.experiment(), m.description)
+
+
+def build(dest: Path, win64: bool | None = None, fmi_version: int = 2, model: str | CModel = "cam") -> Path:
+    """Build the FMU of ``model`` for ``fmi_version`` (2 or 3) at ``dest`` (a path ending in .fmu) and return it.
 
     ``win64``: True requires the win64 binary (FmuBuildError without the cross compiler), False
     leaves it out, None (the default) adds it when the cross compiler is installed."""
     if fmi_version not in GLUE:
         raise FmuBuildError(f"fmi_version {fmi_version!r}: allowed 2 or 3")
+    m = _model(model)
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
         raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
@@ -109,31 +209,23 @@ def build(dest: Path, win64: bool | None = None, fmi_version: int = 2) -> Path:
     if win64 and not cross:
         raise FmuBuildError(f"the win64 binary needs the MinGW-w64 cross compiler {WIN64_COMPILER} "
                             "(Debian: apt-get install gcc-mingw-w64-x86-64; setup.sh installs it)")
-    rows = model_description.variable_rows()
-    guid = engine_guid()
+    guid = model_guid(m)
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         root = Path(tmp)
         folders = PLATFORM_DIRS[fmi_version]
-        compile_binary(root / "fmu" / "binaries" / folders["linux64"] / f"{MODEL_IDENTIFIER}.so", guid,
-                       fmi_version=fmi_version)
+        compile_binary(root / "fmu" / "binaries" / folders["linux64"] / f"{m.identifier}.so", guid,
+                       fmi_version=fmi_version, model=m)
         if cross:
-            compile_binary(root / "fmu" / "binaries" / folders["win64"] / f"{MODEL_IDENTIFIER}.dll", guid, cross,
-                           WIN64_FLAGS, fmi_version)
-        if fmi_version == 2:
-            xml = model_description.postprocess(model_description.skeleton(MODEL_IDENTIFIER, guid, rows),
-                                                default_experiment(), DESCRIPTION, rows)
-        else:
-            xml = model_description3.model_description(MODEL_IDENTIFIER, guid, rows, default_experiment(),
-                                                       DESCRIPTION)
-        (root / "fmu" / "modelDescription.xml").write_bytes(xml)
-        sources = root / "fmu" / "sources"
-        generated = codegen.write(sources)  # the generated table, beside the hand-written sources
-        for path in [*engine_build.SOURCES.glob("*.c"), *engine_build.INCLUDE.glob("*.h"), *GLUE[fmi_version],
-                     *FMI.glob("*.h"), *(engine_build.fmi_headers() / name for name in HEADERS[fmi_version])]:
-            shutil.copyfile(path, sources / path.name)
-        (sources / "guid.h").write_text(f'#define MODEL_GUID "{guid}"\n')
-        del generated
-        out = root / f"{MODEL_IDENTIFIER}.fmu"
+            compile_binary(root / "fmu" / "binaries" / folders["win64"] / f"{m.identifier}.dll", guid, cross,
+                           WIN64_FLAGS, fmi_version, m)
+        (root / "fmu" / "modelDescription.xml").write_bytes(model_description_xml(m, guid, fmi_version))
+        folder = root / "fmu" / "sources"
+        m.generate(folder)  # the generated table, beside the hand-written sources
+        for path in [*m.sources(), *GLUE[fmi_version], *FMI.glob("glue*.h"), *FMI.glob(f"fmi{fmi_version}*.h"),
+                     FMI / "model.h", *(engine_build.fmi_headers() / name for name in HEADERS[fmi_version])]:
+            shutil.copyfile(path, folder / path.name)
+        (folder / "guid.h").write_text(f'#define MODEL_GUID "{guid}"\n')
+        out = root / f"{m.identifier}.fmu"
         with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
             for path in sorted((root / "fmu").rglob("*")):
                 if path.is_file():

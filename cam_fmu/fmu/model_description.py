@@ -252,18 +252,20 @@ def guid(rows: List[Dict[str, Any]], engine_digest: str) -> str:
     return "{%s-%s-%s-%s-%s}" % (h[:8], h[8:12], h[12:16], h[16:20], h[20:32])
 
 
-def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]]) -> bytes:
-    """A modelDescription.xml (Model Exchange and co-simulation) with every variable of ``rows`` (value reference = row
-    index) and the capabilities of the C binary; ``postprocess`` completes it."""
+def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]], model_exchange: bool = True) -> bytes:
+    """A modelDescription.xml (co-simulation, and Model Exchange unless ``model_exchange`` is False) with every
+    variable of ``rows`` (value reference = row index) and the capabilities of the C binary; ``postprocess``
+    completes it."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=model_identifier, guid=model_guid,
                       generationTool="cam_fmu", variableNamingConvention="flat",
-                      numberOfEventIndicators=str(EVENT_INDICATORS))
+                      numberOfEventIndicators=str(EVENT_INDICATORS if model_exchange else 0))
     # Model Exchange beside co-simulation, one binary (csrc/fmi/fmi2.c over exchange.c): the host's
     # solver integrates the consistent formulation's states (docs/fmu.md, "Model Exchange").
-    ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, needsExecutionTool="false",
-                  completedIntegratorStepNotNeeded="false", canBeInstantiatedOnlyOncePerProcess="false",
-                  canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
-                  canSerializeFMUstate="true", providesDirectionalDerivative="false")
+    if model_exchange:
+        ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, needsExecutionTool="false",
+                      completedIntegratorStepNotNeeded="false", canBeInstantiatedOnlyOncePerProcess="false",
+                      canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
+                      canSerializeFMUstate="true", providesDirectionalDerivative="false")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier, needsExecutionTool="false",
                   canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
                   canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",

@@ -67,7 +67,7 @@ def fmi2_include_dir() -> Path:
 
 
 def compile_binary(dest_so: Path, compiler: str | None = None) -> Path:
-    from ...fmu.native.compile import find_compiler
+    from ...engine.build import find_compiler
 
     vrs = value_references()
     cc = compiler or find_compiler()

@@ -46,7 +46,7 @@ def _description(folder: Path) -> tuple[str, str, dict[str, int]]:
 
 def compile_loop(dest: Path) -> Path:
     """``c_floor/loop.c`` compiled against the official FMI 2.0 headers that fmpy ships."""
-    from ...fmu.native.compile import find_compiler
+    from ...engine.build import find_compiler
     from .c_floor import fmi2_include_dir
 
     cmd = [find_compiler(), "-std=c99", "-O2", "-Wall", "-Wextra", f"-I{fmi2_include_dir()}", str(LOOP_SOURCE),

@@ -2,7 +2,7 @@
 
 Developer command (the issue's counts; about 4 minutes on 2 shared cores):
 
-    python -m cam_fmu.fmu.native.soak models/cam.fmu --fmpy-cli 200 --scipy-script 200 --ecos 50 --c-host 50
+    python -m cam_fmu.tools.soak models/cam.fmu --fmpy-cli 200 --scipy-script 200 --ecos 50 --c-host 50
 
 The tests (tests/test_native_hosts.py) run the same functions with smaller counts.
 A run fails on a non-zero exit status (an abort is -6, a segfault -11 / 139) or on a
@@ -24,7 +24,7 @@ import zipfile
 from pathlib import Path
 from typing import Dict, List, Optional
 
-REPO = Path(__file__).resolve().parents[3]
+REPO = Path(__file__).resolve().parents[2]
 HOST_C = REPO / "tests" / "native_host" / "host.c"
 EMPTY_ENV = {"PATH": "/usr/bin:/bin"}
 HEAP_MESSAGES = ("corrupted", "double free", "free(): invalid", "malloc(): ", "Segmentation fault", "Aborted")
@@ -61,7 +61,7 @@ def compile_host(dest: Path) -> Path:
     cc = shutil.which(os.environ.get("CC", "")) or shutil.which("cc") or shutil.which("gcc")
     if not cc:
         raise RuntimeError("no C compiler for the test host")
-    from ...engine.build import fmi_headers
+    from ..engine.build import fmi_headers
 
     subprocess.run([cc, "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-g", "-Wall", "-Wextra", "-Werror",
                     f"-I{fmi_headers()}", "-o", str(dest), str(HOST_C), "-ldl", "-lm"], check=True)
