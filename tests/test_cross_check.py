@@ -37,8 +37,7 @@ def shipped(engine_fmu_path, tmp_path_factory) -> list[Path]:
     from conftest import _build_fmu
 
     from cam_fmu.fmu.build import MODELS
-    from cam_fmu.fmu.python_fmu import MODELS as PYTHON_MODELS
-    others = [name for name in MODELS if name not in PYTHON_MODELS and name != "cam"]
+    others = [name for name in MODELS if name != "cam"]
     return [engine_fmu_path] + [_build_fmu(tmp_path_factory.mktemp(f"{n}_build") / f"{n}.fmu", n) for n in others]
 
 
@@ -109,15 +108,15 @@ def test_one_folder_per_interface_and_binary(package):
         assert (folder / f"{folder.name}.fmu").read_bytes() == package["fmus"][folder.name].read_bytes()
 
 
-def test_by_default_the_fmus_that_need_no_python(monkeypatch):
-    """Without --fmu: every model fmu.build builds, less pi_speed (a Python model: an importer would
-    need Python, which the rules exclude)."""
+def test_by_default_every_shipped_fmu(monkeypatch):
+    """Without --fmu: every model fmu.build builds (all are C: none needs Python on the importing machine),
+    pi_speed.fmu included since it is C."""
     import cam_fmu.experiments.fmu_file as fmu_file
     from cam_fmu.fmu.build import MODELS
     from cam_fmu.tools.cross_check.layout import shipped_fmus
     monkeypatch.setattr(fmu_file, "ensure_fmu", lambda path, log=None, model="cam": Path(f"{model}.fmu"))
     names = [p.stem for p in shipped_fmus()]
-    assert "cam" in names and "pi_speed" in MODELS and "pi_speed" not in names
+    assert names == list(MODELS) and {"cam", "cam3", "pi_speed"} <= set(names)
 
 
 def test_fmpy_cross_check_validation_finds_no_problem(package):

@@ -97,12 +97,9 @@ def entries(fmu: str | Path) -> list[Entry]:
 
 
 def shipped_fmus() -> list[Path]:
-    """The project's FMUs that run without Python (every model fmu.build builds, less the pythonfmu ones),
-    each built first when missing or stale. pi_speed.fmu is left out: it runs a Python model and needs a
-    Python installation on the importing machine, which the cross-check rules exclude (no additional
-    requirements)."""
+    """The project's FMUs (every model fmu.build builds: all are C and run without Python), each built first
+    when missing or stale."""
     from ...experiments.fmu_file import ensure_fmu
     from ...fmu.build import MODELS
-    from ...fmu.python_fmu import MODELS as PYTHON_MODELS
 
-    return [ensure_fmu(None, model=name) for name in MODELS if name not in PYTHON_MODELS]
+    return [ensure_fmu(None, model=name) for name in MODELS]
