@@ -40,7 +40,7 @@ def block(tmp_path_factory) -> Path:
 def test_the_example_is_a_pythonfmu_fmu(block):
     with zipfile.ZipFile(block) as z:
         names = z.namelist()
-    assert "resources/python_pi_slave.py" in names and "binaries/linux64/python_pi_slave.so" in names
+    assert "resources/python_pi_slave.py" in names and "binaries/linux64/PythonPi.so" in names
     from fmpy import read_model_description
 
     md = read_model_description(str(block))
