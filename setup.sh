@@ -5,8 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 # Debian packages, installed only when missing (apt is not touched otherwise):
-# - gcc:      compiles the C engine (cam.fmu's binary, the library Python calls), pi_speed.fmu's
-#             Python-hosting binary (cam_fmu/fmu/native/fmi2_python.c) and the test hosts;
+# - gcc:      compiles the C engine and the FMI glue (every FMU's binary, the library Python calls)
+#             and the test hosts;
 # - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
 # - libtbb12: needed by the FMU host `ecos`;
 # - gcc-mingw-w64-x86-64: cross-compiles cam.fmu's win64 binary (cam_fmu/fmu/engine_fmu.py);
