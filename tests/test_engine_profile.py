@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from cam_fmu.engine.profile import EngineProfile, first_crossed, law_eval, law_segments
+from engine_profile import EngineProfile, first_crossed, law_eval, law_segments
 from cam_fmu.kinematics.cam_program import CamProgram, first_angle_crossed
 from cam_fmu.kinematics.motion_law import MotionLaw
 from cam_fmu.kinematics.motion_table import parse_motion_table, program_from_table_text

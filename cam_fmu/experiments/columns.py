@@ -32,11 +32,6 @@ def header(name: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
-def strip_unit(column: str) -> str:
-    """'omega [rad/s]' -> 'omega'."""
-    return column.split(" [", 1)[0]
-
-
 def write_csv(columns: Mapping[str, np.ndarray], path: str | Path, order: Sequence[str] | None = None) -> Path:
     """Write ``columns`` (name -> array) with unit headers, 12 significant digits."""
     names = list(order or columns)

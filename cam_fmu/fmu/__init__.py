@@ -1,5 +1,3 @@
-"""The FMU: the co-simulation engine (formulation + solver), the pythonfmu slave,
-the model description, and the build of cam.fmu.
-
-Kept import-free: the FMU bundles ``engine`` and the slave script's closure only.
-"""
+"""The FMUs: every one a C model on the one FMI glue (``engine_fmu``), their model descriptions, the
+controller's generated variable table, the build of every FMU and SSP (``build``), and pythonfmu for blocks
+users write in Python (``python_block``). Kept import-free."""

@@ -160,11 +160,6 @@ def model_guid(model: str | CModel = "cam") -> str:
     return model_description.guid(m.rows(), digest(m))
 
 
-def engine_guid() -> str:
-    """The GUID of a cam.fmu built from this checkout."""
-    return model_guid(CAM)
-
-
 def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = (),
                    fmi_version: int = 2, model: str | CModel = "cam") -> Path:
     """Compile the model, its generated table and the FMI glue of ``fmi_version`` into the shared library ``dest``."""

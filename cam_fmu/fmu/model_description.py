@@ -18,8 +18,6 @@ The same table (``variable_rows``) generates the variable table of docs/fmu.md
 from __future__ import annotations
 
 import math
-import zipfile
-from pathlib import Path
 from typing import Any, Dict, List, Optional
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -280,20 +278,6 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
         ET.SubElement(sv, row["type"])
     ET.SubElement(root, "ModelStructure")
     return ET.tostring(root, encoding="UTF-8")
-
-
-def rewrite_fmu(fmu_path: Path, **kwargs: Any) -> None:
-    """Replace modelDescription.xml inside ``fmu_path`` by its post-processed version."""
-    fmu_path = Path(fmu_path)
-    with zipfile.ZipFile(fmu_path) as zin:
-        entries = [(info, zin.read(info.filename)) for info in zin.infolist()]
-    tmp = fmu_path.with_suffix(".fmu.tmp")
-    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zout:
-        for info, data in entries:
-            if info.filename == "modelDescription.xml":
-                data = postprocess(data, **kwargs)
-            zout.writestr(info.filename, data)
-    tmp.replace(fmu_path)
 
 
 def markdown_table() -> str:

@@ -42,16 +42,6 @@ OUTPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in OUTPUTS)
 UNITS: dict[str, str] = {row[0]: row[1] for row in INPUTS + OUTPUTS}  # type: ignore[operator]
 
 
-def check_input(name: str, value: float) -> float:
-    """The input as a float, or ValueError naming it and its allowed range."""
-    number = float(value)
-    low, high = INPUT_RANGES[name]
-    if not (low <= number <= high):  # NaN fails too
-        raise ValueError(f"input {name!r} = {number!r} [{UNITS[name]}] is outside the allowed range "
-                         f"[{low:g}, {high:g}] {UNITS[name]}")
-    return number
-
-
 def output_record(**values: Any) -> dict[str, float]:
     """Every output, in table order, from keyword values (a missing one is a KeyError)."""
     return {name: values[name] for name in OUTPUT_NAMES}

@@ -35,8 +35,8 @@ the last step reached, and the full outputs at the end. The engine carries its s
 step to step, so a difference at any step (a constant, an operation order, an event found one
 step later, a changed step size of rk45) shows in every later sample: sampling loses nothing
 but the step at which a divergence began. Floats are written by ``json`` with ``repr``, which
-round-trips exactly. The files also hold the Python, numpy, scipy, hypothesis and Cython
-versions and the git commit the record was made at.
+round-trips exactly. The files also hold the Python, numpy, scipy and hypothesis versions
+(the first records also the Cython version of the engine they recorded) and the git commit.
 
 The comparison (``compare``): every recorded sample to RTOL = 1e-12 relative, where a value
 below ZERO = 1e-3 of its output's scale (the largest |value| of that output over the case's
@@ -224,7 +224,7 @@ def provenance() -> dict[str, Any]:
 
     info: dict[str, Any] = {"python": platform.python_version(), "numpy": numpy.__version__,
                             "scipy": scipy.__version__, "machine": platform.machine()}
-    for module in ("hypothesis", "Cython"):
+    for module in ("hypothesis",):
         try:
             info[module.lower()] = __import__(module).__version__
         except ImportError:

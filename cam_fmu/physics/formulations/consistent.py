@@ -18,8 +18,7 @@ triggers ``apply_event`` with the index of the function.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
-from typing import Any
+from dataclasses import dataclass
 
 from ..drive import DriveModel
 from ..variables import output_record
@@ -47,9 +46,6 @@ class Mode:
     def copy(self) -> "Mode":
         return Mode(self.stuck, self.direction, self.contact, self.s_free, self.side)
 
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
 
 class HybridDrive:
     """Consistent formulation of the drive under a voltage input u [V]."""
@@ -62,8 +58,6 @@ class HybridDrive:
         self.compliant = model.compliant
         self.size = 5 if self.compliant else (3 if self.has_current else 2)
         self.guide_side = model.mu > 0.0 and model.follower  # the side force's sign is an event
-        # theta enters the physics mod 2 pi: its error is scaled by at most 2 pi
-        self.error_caps = (2.0 * math.pi, math.inf, math.inf, math.inf, math.inf)[: self.size]
         self.feature_angle = model.program.feature_angle()  # rad
 
     # ------------------------------------------------------------ set-up
@@ -139,7 +133,7 @@ class HybridDrive:
     def _compliant_rhs(self, u: float, mode: Mode):
         """dy/dt of the two-mass drive: the cam side as the rigid drive's under the shaft's torque, the rotor
         J_m omega_m' = c_m i - M_shaft, the twist's rate omega_m - omega (docs/model.md section 12)."""
-        model, motor, hybrid = self.model, self.motor, self
+        model, hybrid = self.model, self
         direction, engaged = mode.direction, mode.contact != 0
         side = mode.side if self.guide_side else 0.0
         stuck, has_current = mode.stuck, self.has_current
@@ -156,10 +150,6 @@ class HybridDrive:
             d_i = (u - model.R * i - model.c_e * omega_m) / model.L if has_current else 0.0
             return (d_theta, d_omega, d_i, omega_m - omega, d_omega_m)
         return rhs
-
-    def stuck_state(self, y, u: float, dt: float) -> list[float]:
-        """y after dt [s] held by static friction, rigid drive: only i moves (exactly, toward u / R)."""
-        return [y[THETA], 0.0, self.motor.current_at_rest(y[CURRENT], u, dt)]
 
     def stiffness_rate(self, y, mode: Mode, electrical: bool) -> float:
         """Largest rate [1/s] of the dynamics at y, for an explicit method's stability limit.

@@ -3,16 +3,15 @@
 ``EngineProfile.from_laws(...)`` and ``EngineProfile.from_table(text)`` build the C
 engine's ``CamProfile`` (csrc/include/cam_profile.h); refusals raise ValueError with the
 engine's message. The structures below mirror the header (their size is checked against
-``cam_profile_sizeof``). Used by tests (the C program against the Python model) and by
-Python code that wants the engine's own program.
+``cam_profile_sizeof``). A test helper: tests/test_engine_profile.py holds the C program against
+the Python model with it.
 """
 from __future__ import annotations
 
 import ctypes
-import math
 from typing import Sequence
 
-from .library import load
+from cam_fmu.engine.library import load
 
 __all__ = ["EngineProfile", "law_segments", "SEGMENT_FIELDS"]
 
@@ -44,7 +43,7 @@ def _lib() -> ctypes.CDLL:
         lib.cam_profile_sizeof.restype = _SIZE
         lib.cam_profile_sizeof.argtypes = []
         if lib.cam_profile_sizeof() != ctypes.sizeof(CamProfile):
-            raise RuntimeError("cam_fmu.engine.profile: CamProfile differs from cam_profile.h")
+            raise RuntimeError("engine_profile: CamProfile differs from cam_profile.h")
         lib.cam_law_init.argtypes = [ctypes.POINTER(CamLaw), _D * 6, ctypes.c_char_p, ctypes.c_char_p, _SIZE]
         lib.cam_law_eval.argtypes = [ctypes.POINTER(CamLaw), _D, _D * 4]
         lib.cam_law_eval.restype = None
@@ -56,8 +55,6 @@ def _lib() -> ctypes.CDLL:
         lib.cam_profile_free.restype = None
         lib.cam_profile_eval_counted.argtypes = [ctypes.POINTER(CamProfile), _D, _D * 4, ctypes.POINTER(_SIZE)]
         lib.cam_profile_eval_counted.restype = None
-        lib.cam_profile_first_breakpoint.argtypes = [ctypes.POINTER(CamProfile), _D, _D]
-        lib.cam_profile_first_breakpoint.restype = _D
         lib.cam_first_crossed.argtypes = [_PD, _SIZE, _D, _D, ctypes.POINTER(_SIZE)]
         lib.cam_first_crossed.restype = _D
         lib._cam_profile_typed = True
@@ -145,11 +142,6 @@ class EngineProfile:
     def lift(self) -> float:
         """The lift h [m] (a table: its largest lift)."""
         return self._p.lift
-
-    def first_breakpoint(self, start: float, end: float) -> float | None:
-        """The first breakpoint angle [rad] strictly between start and end, or None."""
-        found = self._lib.cam_profile_first_breakpoint(ctypes.byref(self._p), start, end)
-        return None if math.isnan(found) else found
 
 
 def first_crossed(points: Sequence[float], start: float, end: float) -> tuple[float, int]:
