@@ -22,7 +22,6 @@ __all__ = ["DriveSimulator", "run_scene"]
 
 N_OUTPUTS = len(OUTPUT_NAMES)
 MESSAGE_LEN = 1024
-STATE_LEN = 48
 NX, NX_RIGID = 5, 3  # cam_model.h CAM_NX, CAM_NX_RIGID: the state slots (theta, omega, i, twist, omega_m)
 # Slots of the engine's state array (cam_model.h, CAM_S_*).
 (S_VERSION, S_FORMULATION, S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF, S_H_NEXT, S_STEPS_TAKEN, S_X) = range(9)
@@ -84,6 +83,7 @@ _SIGNATURES = {
     "cam_drive_event": (ctypes.POINTER(CamEventRecord), [_P, ctypes.c_long]),
     "cam_drive_events_logged": (ctypes.c_long, [_P]),
     "cam_event_record_sizeof": (ctypes.c_size_t, []),
+    "cam_state_len": (ctypes.c_size_t, []),
 }
 
 
@@ -195,15 +195,16 @@ class DriveSimulator:
 
     def state_array(self) -> array:
         """The engine's whole state as its flat array of doubles (cam_model.h, CAM_S_*)."""
-        raw = (ctypes.c_double * STATE_LEN)()
+        raw = (ctypes.c_double * self._lib.cam_state_len())()
         self._lib.cam_drive_get_state(self._drive, raw)
         return array("d", raw)
 
     def set_state_array(self, state: Sequence[float]) -> None:
         """Restore a state_array(); the engine checks every entry first (SimulationError naming it)."""
-        if len(state) != STATE_LEN:
-            raise SimulationError(f"engine state has {len(state)} entries, expected {STATE_LEN}")
-        raw = (ctypes.c_double * STATE_LEN)(*state)
+        length = self._lib.cam_state_len()
+        if len(state) != length:
+            raise SimulationError(f"engine state has {len(state)} entries, expected {length}")
+        raw = (ctypes.c_double * length)(*state)
         if self._lib.cam_drive_set_state(self._drive, raw, ctypes.byref(self._err)):
             raise_for(self._err)
 

@@ -57,3 +57,8 @@ size_t cam_event_record_sizeof(void)
 {
     return sizeof(CamEventRecord);
 }
+
+size_t cam_state_len(void)
+{
+    return CAM_STATE_LEN;
+}
