@@ -16,9 +16,6 @@ ROOT = Path(__file__).resolve().parents[1]
 def _build_fmu(dest: Path, model: str = "cam") -> Path:
     """Build an FMU with build_fmu.py in a subprocess: the command users run, from this checkout."""
     cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", model, "--dest", str(dest)]
-    package_dir = os.environ.get("CAM_FMU_BUILD_PACKAGE_DIR")  # developers only: a Python FMU from another tree
-    if package_dir:
-        cmd += ["--package-dir", package_dir]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
     if proc.returncode != 0 or not dest.is_file():
         pytest.fail(f"build_fmu.py --model {model} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")

@@ -12,7 +12,7 @@ import pytest
 
 from cam_fmu.engine import build as engine_build
 from cam_fmu.engine import codegen
-from cam_fmu.fmu.engine_fmu import GLUE
+from cam_fmu.fmu.engine_fmu import binary_sources
 from cam_fmu.fmu.model_description import variable_rows
 from native_support import require, valgrind_prefix, valgrind_summary
 
@@ -34,8 +34,8 @@ def compile_host(folder: Path, extra: list[str]) -> Path:
     generated = [str(p) for p in codegen.write(folder / "gen") if p.suffix == ".c"]
     exe = folder / "me_host"
     cmd = [gcc, *FLAGS, *extra, f'-DMODEL_GUID="{GUID}"', f"-I{engine_build.INCLUDE}", f"-I{folder / 'gen'}",
-           f"-I{engine_build.fmi_headers()}", *sorted(map(str, engine_build.SOURCES.glob("*.c"))), *generated,
-           *map(str, GLUE[2]), str(HOST), "-o", str(exe), "-lm"]
+           f"-I{engine_build.fmi_headers()}", *generated,
+           *map(str, binary_sources("cam", 2)), str(HOST), "-o", str(exe), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     return exe
