@@ -15,9 +15,10 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import List
+from typing import List, Sequence
 
-from . import engine_fmu, python_fmu
+from ..engine import targets
+from . import binaries, engine_fmu, python_fmu
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 ENGINE_MODELS = {"cam": 2, "cam3": 3}  # the C engine's FMUs and their FMI versions
@@ -46,16 +47,18 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Path | None = None) -> Path:
+def build(dest: Path, model: str = "cam", verbose: bool = False, package_dir: Path | None = None,
+          platforms: Sequence[str] | None = None) -> Path:
     """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it.
-    ``package_dir``: a Python FMU's bundle from another copy of the package (developers' tests)."""
+    ``package_dir``: a Python FMU's bundle from another copy of the package (developers' tests).
+    ``platforms``: a C model's targets (engine/targets.py; default all, ``["host"]``: this machine only)."""
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
     try:
         if model in ENGINE_MODELS:
-            return engine_fmu.build(dest, fmi_version=ENGINE_MODELS[model])
+            return engine_fmu.build(dest, fmi_version=ENGINE_MODELS[model], platforms=platforms)
         return python_fmu.build(dest, model, package_dir=package_dir, verbose=verbose)
-    except (engine_fmu.FmuBuildError, python_fmu.BuildError) as exc:
+    except (engine_fmu.FmuBuildError, python_fmu.BuildError, targets.TargetError) as exc:
         raise BuildError(str(exc)) from None
 
 
@@ -79,14 +82,19 @@ def main(argv: List[str] | None = None) -> int:
                              "cam.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a source checkout "
                              "(else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
+    parser.add_argument("--platforms", default="all",
+                        help=f"the C models' binaries: all (default; zig), {binaries.HOST} (this machine, the system "
+                             f"C compiler) or a comma-separated list of {', '.join(targets.NAMES)}")
     parser.add_argument("-v", "--verbose", action="store_true", help="list the bundled modules of a Python FMU")
     parser.add_argument("--package-dir", type=Path, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    platforms = None if args.platforms == "all" else args.platforms.split(",")
     try:
         if args.dest is not None:
-            print(build(args.dest, args.model, args.verbose, args.package_dir))
+            print(build(args.dest, args.model, args.verbose, args.package_dir, platforms))
             return 0
-        built = {name: build(default_model_path(name), name, args.verbose, args.package_dir) for name in MODELS}
+        built = {name: build(default_model_path(name), name, args.verbose, args.package_dir, platforms)
+                 for name in MODELS}
         for path in built.values():
             print(path)
         for name in SSP_NAMES:
