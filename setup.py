@@ -3,12 +3,16 @@
 The engine (cam_fmu/engine/csrc) is a plain shared library that needs no Python C
 API: ``build_py`` compiles it with the system C compiler into
 ``cam_fmu/engine/_lib/`` of the build, under the name ``cam_fmu.engine.build``
-looks for, so an installed package never compiles at run time. The wheel is
+looks for, so an installed package never compiles at run time. With
+``CAM_FMU_ENGINE_TARGET`` set to a name of cam_fmu/engine/targets.py (x86_64-linux,
+aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin) it is compiled by zig
+for that platform instead (a wheel for another platform, built on Linux). The wheel is
 marked platform-specific because it carries that library. Everything else is
 in pyproject.toml.
 """
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -26,8 +30,9 @@ class BuildPyWithEngine(build_py):
         sys.path.insert(0, str(ROOT))  # this checkout's cam_fmu (the build tools only)
         from cam_fmu.engine import build
 
-        dest = Path(self.build_lib) / "cam_fmu" / "engine" / "_lib" / build.library_name()
-        build.compile_library(dest)
+        target = os.environ.get("CAM_FMU_ENGINE_TARGET") or None
+        dest = Path(self.build_lib) / "cam_fmu" / "engine" / "_lib" / build.library_name(target=target)
+        build.compile_library(dest, target=target)
         print(f"cam_fmu: built the engine library {dest.name}")
 
 

@@ -5,14 +5,16 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 # Debian packages, installed only when missing (apt is not touched otherwise):
-# - gcc:      compiles the C engine and the FMI glue (every FMU's binary, the library Python calls)
-#             and the test hosts;
+# - gcc:      compiles the C engine library Python calls and the x86_64 test hosts; its binutils (readelf,
+#             objdump) read the other platforms' binaries in the tests. Every FMU's binaries for every
+#             platform come from zig (the ziglang wheel, pyproject.toml's build extra), not from apt;
 # - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
 # - libtbb12: needed by the FMU host `ecos`;
-# - gcc-mingw-w64-x86-64: cross-compiles cam.fmu's win64 binary (cam_fmu/fmu/engine_fmu.py);
-# - wine64:   runs that binary in the win64 test host (tests/test_engine_fmu_win64.py).
+# - wine64:   runs the x86_64-windows binaries in the Windows test hosts (tests/test_engine_fmu_win64.py);
+# - qemu-user-static, libc6-arm64-cross: run the aarch64-linux binaries in an aarch64 test host
+#             (qemu-aarch64-static -L /usr/aarch64-linux-gnu; tests/test_fmu_platforms.py).
 missing=()
-for pkg in gcc valgrind libtbb12 gcc-mingw-w64-x86-64 wine64; do
+for pkg in gcc valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
         missing+=("$pkg")
     fi
@@ -24,5 +26,5 @@ fi
 
 # the test environment pinned (constraints/test.txt; refresh: bash constraints/refresh.sh), the package keeps ranges
 python -m pip install -c constraints/test.txt -e ".[test]"
-# the C engine's shared library (gcc; skipped while current: its name hashes its sources)
+# the C engine's shared library (the system C compiler; skipped while current: its name hashes its sources)
 python -m cam_fmu.engine.build

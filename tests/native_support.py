@@ -147,3 +147,42 @@ def libcosim_script(names: Sequence[str], u: Optional[float] = None) -> str:
 def result_line(stdout: str):
     """The JSON after ``RESULT`` in a host's output (its own log lines around it)."""
     return json.loads(next(line for line in stdout.splitlines() if line.startswith("RESULT "))[7:])
+
+
+# --------------------------------------------------------------------------- other platforms (engine/targets.py)
+WINE = Path("/usr/lib/wine/wine64")  # Debian's wine64 package (the `wine` wrapper is another package)
+QEMU_AARCH64 = "qemu-aarch64-static"  # Debian's qemu-user-static
+AARCH64_ROOT = Path("/usr/aarch64-linux-gnu")  # Debian's libc6-arm64-cross: the aarch64 loader and libc
+
+
+def zig_host(target: str, dest: Path, source: Path, *flags: str) -> Path:
+    """The C test host ``source`` compiled by zig for ``target`` (a name of engine/targets.py), against the
+    vendored FMI headers; on Linux dynamically linked, so it can dlopen the FMU's binary of that platform."""
+    from cam_fmu.engine import build, targets
+
+    row = targets.get(target)
+    libs = ["-D_POSIX_C_SOURCE=200809L", "-ldl", "-lm"] if row.system == "Linux" else []  # strdup, dlopen
+    cmd = [*build.zig_cc(), "-target", row.zig, "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-Wno-strict-prototypes",
+           f"-I{build.fmi_headers(2)}", f"-I{build.fmi_headers(3)}", *flags, str(source), "-o", str(dest), *libs]
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=dest.parent)
+    assert proc.returncode == 0, proc.stderr
+    return dest
+
+
+def runner(target: str) -> List[str]:
+    """The command prefix that runs an executable of ``target`` on this x86_64 Linux machine (qemu, wine);
+    a missing tool fails the test (setup.sh installs them)."""
+    from cam_fmu.engine import targets
+
+    runs = targets.get(target).runs
+    if runs == "qemu":
+        if not (AARCH64_ROOT / "lib" / "ld-linux-aarch64.so.1").exists():
+            pytest.fail(f"{AARCH64_ROOT} has no aarch64 loader: setup.sh installs Debian's libc6-arm64-cross")
+        return [require(QEMU_AARCH64), "-L", str(AARCH64_ROOT)]
+    if runs == "wine":
+        if not WINE.is_file():
+            pytest.fail(f"{WINE} is missing: setup.sh installs Debian's wine64 package")
+        return [str(WINE)]
+    if runs == "native":
+        return []
+    pytest.fail(f"{target} binaries cannot run here (engine/targets.py: runs={runs!r})")

@@ -1,9 +1,9 @@
-"""cam.fmu's win64 binary, run for real: the C test host cross-compiled for Windows loads
+"""cam.fmu's win64 binary, run for real: the C test host cross-compiled for Windows (zig, as the binary) loads
 binaries/win64/cam.dll under wine and runs the same commands as the linux64 host on cam.so.
 
 Both binaries come from the same sources; their outputs agree to 1e-12 relative (the two C
-libraries' libm differ in the last bits: measured 1e-14 on fig. 6). The cross compiler
-(gcc-mingw-w64-x86-64) and wine64 are installed by setup.sh: a missing one fails these tests.
+libraries' libm differ in the last bits). zig (the ziglang wheel) and wine64 are installed by setup.sh:
+a missing one fails these tests.
 """
 from __future__ import annotations
 
@@ -16,18 +16,13 @@ from pathlib import Path
 import pytest
 
 from cam_fmu.engine.build import fmi_headers
-from cam_fmu.fmu import engine_fmu
-from native_support import HOST_C, compile_host, require
-
-WINE = Path("/usr/lib/wine/wine64")  # Debian's wine64 package (the `wine` wrapper is another package)
+from native_support import HOST_C, WINE, compile_host, require, runner, zig_host
 
 
 @pytest.fixture(scope="module")
-def fmu_dir(tmp_path_factory) -> Path:
-    require(engine_fmu.WIN64_COMPILER)
+def fmu_dir(engine_fmu_path, tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("win64")
-    fmu = engine_fmu.build(folder / "cam.fmu", win64=True)
-    with zipfile.ZipFile(fmu) as z:
+    with zipfile.ZipFile(engine_fmu_path) as z:
         z.extractall(folder / "x")
     return folder / "x"
 
@@ -35,14 +30,8 @@ def fmu_dir(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def hosts(fmu_dir, tmp_path_factory) -> dict:
     folder = tmp_path_factory.mktemp("win64_hosts")
-    exe = folder / "host.exe"
-    proc = subprocess.run([require(engine_fmu.WIN64_COMPILER), "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror",
-                           f"-I{fmi_headers()}", "-static", "-o", str(exe), str(HOST_C)],
-                          capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    if not WINE.is_file():
-        pytest.fail(f"{WINE} is missing: setup.sh installs Debian's wine64 package")
-    return {"linux64": compile_host(folder / "host"), "win64": exe}
+    runner("x86_64-windows")  # wine64 is there, else the test fails
+    return {"linux64": compile_host(folder / "host"), "win64": zig_host("x86_64-windows", folder / "host.exe", HOST_C)}
 
 
 def _guid(fmu_dir: Path) -> str:
@@ -113,7 +102,7 @@ def test_both_binaries_export_exactly_the_functions_of_fmi2(fmu_dir):
     nm = subprocess.run([require("nm"), "-D", "--defined-only", str(fmu_dir / "binaries" / "linux64" / "cam.so")],
                         capture_output=True, text=True)
     linux = {line.split()[-1] for line in nm.stdout.splitlines() if line.strip()}
-    table = subprocess.run([require("x86_64-w64-mingw32-objdump"), "-p", str(fmu_dir / "binaries" / "win64" / "cam.dll")],
+    table = subprocess.run([require("objdump"), "-p", str(fmu_dir / "binaries" / "win64" / "cam.dll")],
                            capture_output=True, text=True).stdout
     export_table = table[table.index("[Ordinal/Name Pointer] Table"):]
     windows = set(re.findall(r"\]\s+(fmi2\w+)", export_table))
@@ -129,13 +118,12 @@ def test_model_exchange_runs_under_wine_as_on_linux(fmu_dir, tmp_path):
     from test_engine_fmu_me_host import BACKLASH, HOST, STEP, STOP, VR
 
     flags = ["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-DME_HOST_DYNAMIC", f"-I{fmi_headers()}"]
-    builds = {"linux64": [require("gcc"), *flags, "-o", str(tmp_path / "me_host"), str(HOST), "-ldl", "-lm"],
-              "win64": [require(engine_fmu.WIN64_COMPILER), *flags, "-static", "-o", str(tmp_path / "me_host.exe"),
-                        str(HOST)]}
+    proc = subprocess.run([require("gcc"), *flags, "-o", str(tmp_path / "me_host"), str(HOST), "-ldl", "-lm"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    zig_host("x86_64-windows", tmp_path / "me_host.exe", HOST, "-DME_HOST_DYNAMIC")
     results = {}
-    for platform, cmd in builds.items():
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        assert proc.returncode == 0, proc.stderr
+    for platform in ("linux64", "win64"):
         library = fmu_dir / "binaries" / platform / ("cam.dll" if platform == "win64" else "cam.so")
         env = {"PATH": "/usr/bin:/bin", "CAM_FMU_LIBRARY": str(library), "CAM_FORMULATION_VR": str(VR["formulation"])}
         run = [str(tmp_path / "me_host")] if platform == "linux64" else [str(WINE), str(tmp_path / "me_host.exe")]

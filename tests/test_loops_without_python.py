@@ -1,11 +1,12 @@
 """The shipped closed loops (models/speed_loop.ssp, models/compliant_loop.ssp) run where there is no Python:
 a co-simulation master written in C (tests/native_host/loop_host.c) loads cam's and pi_speed's binaries from
-the SSP, with an empty environment on linux64 and as a Windows program under wine on win64.
+the SSP, with an empty environment: on x86_64 Linux, on aarch64 Linux under qemu-user and as a Windows
+program under wine.
 
-- linux64: the C master gives the project's master (experiments.cosim, fmpy) to the bit: the same binaries,
-  the same calls in the same order.
-- win64 under wine: the DLLs (another compiler, another libm) agree to 1e-12 of each signal's range.
-Every tool (gcc, MinGW-w64, wine) is required: a missing one fails these tests.
+- x86_64 Linux: the C master gives the project's master (experiments.cosim, fmpy) to the bit: the same
+  binaries, the same calls in the same order.
+- aarch64 Linux and x86_64 Windows (other C libraries, another libm) agree to 1e-12 of each signal's range.
+Every tool (gcc, zig, qemu-user-static with libc6-arm64-cross, wine) is required: a missing one fails.
 """
 from __future__ import annotations
 
@@ -18,29 +19,30 @@ from xml.etree import ElementTree as ET
 import numpy as np
 import pytest
 
+from cam_fmu.engine import targets
 from cam_fmu.engine.build import fmi_headers
 from cam_fmu.experiments.cosim import simulate_system
 from cam_fmu.experiments.fmu_file import ensure_ssp
 from cam_fmu.experiments.ssp import read_ssp
-from native_support import require
+from native_support import require, runner, zig_host
 
 HERE = Path(__file__).resolve().parent
 LOOP_HOST = HERE / "native_host" / "loop_host.c"
-WINE = Path("/usr/lib/wine/wine64")
-FLAGS = ["-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", f"-I{fmi_headers()}"]
+OTHERS = ("aarch64-linux", "x86_64-windows")  # the targets run here besides this machine's
 
 
 @pytest.fixture(scope="module")
 def hosts(tmp_path_factory) -> dict[str, Path]:
     folder = tmp_path_factory.mktemp("loop_host")
-    linux, win = folder / "loop_host", folder / "loop_host.exe"
-    for cmd in ([require("gcc"), *FLAGS, str(LOOP_HOST), "-o", str(linux), "-ldl"],
-                [require("x86_64-w64-mingw32-gcc"), *FLAGS, "-static", str(LOOP_HOST), "-o", str(win)]):
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        assert proc.returncode == 0, proc.stderr
-    if not WINE.is_file():
-        pytest.fail(f"{WINE} is missing: setup.sh installs Debian's wine64 package")
-    return {"linux64": linux, "win64": win}
+    linux = folder / "loop_host"
+    proc = subprocess.run([require("gcc"), "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", f"-I{fmi_headers()}",
+                           str(LOOP_HOST), "-o", str(linux), "-ldl"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    built = {"x86_64-linux": linux}
+    for name in OTHERS:
+        runner(name)  # the tool that runs it is there, else the test fails
+        built[name] = zig_host(name, folder / f"loop_host_{name}{'.exe' if 'windows' in name else ''}", LOOP_HOST)
+    return built
 
 
 def _loop(name: str, folder: Path):
@@ -77,16 +79,15 @@ def _loop(name: str, folder: Path):
     return system, info, items
 
 
-def _run_loop(host: Path, system, info, items, platform: str) -> np.ndarray:
-    suffix = ".so" if platform == "linux64" else ".dll"
+def _run_loop(host: Path, system, info, items, target: str) -> np.ndarray:
+    row = targets.get(target)
     args = []
     for comp in ("cam", "controller"):
         folder, guid, _vars, identifier = info[comp]
-        args += [str(folder / "binaries" / platform / f"{identifier}{suffix}"), guid]
-    cmd = [str(host), *args, repr(system.stop_time), repr(system.step_size), *items]
+        args += [str(folder / "binaries" / row.fmi2 / f"{identifier}{row.suffix}"), guid]
+    cmd = [*runner(target), str(host), *args, repr(system.stop_time), repr(system.step_size), *items]
     env = {"PATH": "/usr/bin:/bin"}
-    if platform == "win64":
-        cmd = [str(WINE), *cmd]
+    if row.runs == "wine":
         env = {**env, "WINEDEBUG": "-all", "HOME": os.environ.get("HOME", "/root")}
     proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
     lines = proc.stdout.splitlines()
@@ -100,14 +101,15 @@ def test_the_loop_runs_with_no_python_as_the_project_master_does(hosts, name, tm
     master = simulate_system(system)
     columns = [f"{c.start_element}.{c.start_connector}" for c in system.connections]
     expected = np.column_stack([master["time"], *(master[c] for c in columns)])
-    linux = _run_loop(hosts["linux64"], system, info, items, "linux64")
+    linux = _run_loop(hosts["x86_64-linux"], system, info, items, "x86_64-linux")
     assert linux.shape == expected.shape
     assert np.array_equal(linux, expected), float(np.max(np.abs(linux - expected)))
-    win = _run_loop(hosts["win64"], system, info, items, "win64")
-    assert win.shape == expected.shape and np.array_equal(win[:, 0], expected[:, 0])
     span = np.ptp(expected[:, 1:], axis=0) + 1e-300
-    worst = float(np.max(np.abs(win[:, 1:] - expected[:, 1:]) / span))
-    assert worst <= 1e-12, f"win64 under wine differs from linux64 by {worst:.3g} of a signal's range"
+    for name in OTHERS:
+        other = _run_loop(hosts[name], system, info, items, name)
+        assert other.shape == expected.shape and np.array_equal(other[:, 0], expected[:, 0])
+        worst = float(np.max(np.abs(other[:, 1:] - expected[:, 1:]) / span))
+        assert worst <= 1e-12, f"{name} differs from x86_64-linux by {worst:.3g} of a signal's range"
     # the loop did its job: the cam's speed settles near the setpoint in the second half
     omega = expected[len(expected) // 2:, 1 + columns.index("cam.omega")]
     setpoint = float(system.components["controller"].parameters.get("omega_set", 5.0))

@@ -79,7 +79,10 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_", dir=path.parent) as tmp:
         dest = Path(tmp) / f"{model}.fmu"
-        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--model", model, "--dest", str(dest)],
+        # a checkout's models/ get every platform (zig); the user cache of an installed package, this machine's
+        platforms = [] if source_checkout() is not None else ["--platforms", "host"]
+        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--model", model, "--dest", str(dest),
+                               *platforms],
                               capture_output=True, text=True, cwd=str(PACKAGE_DIR.parent), timeout=600)
         if proc.returncode != 0 or not dest.is_file():
             raise FmuFileError(f"building {path} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")

@@ -16,9 +16,10 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import List
+from typing import List, Sequence
 
-from . import engine_fmu
+from ..engine import targets
+from . import binaries, engine_fmu
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 # every FMU the project builds: name -> (its C model, FMI version)
@@ -46,14 +47,15 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     return fmu.stat().st_mtime < newest
 
 
-def build(dest: Path, model: str = "cam") -> Path:
-    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it."""
+def build(dest: Path, model: str = "cam", platforms: Sequence[str] | None = None) -> Path:
+    """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it.
+    ``platforms``: its binaries' targets (engine/targets.py; default all, ``["host"]``: this machine only)."""
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
     c_model, fmi_version = ENGINE_MODELS[model]
     try:
-        return engine_fmu.build(dest, fmi_version=fmi_version, model=c_model)
-    except engine_fmu.FmuBuildError as exc:
+        return engine_fmu.build(dest, fmi_version=fmi_version, model=c_model, platforms=platforms)
+    except (engine_fmu.FmuBuildError, targets.TargetError) as exc:
         raise BuildError(str(exc)) from None
 
 
@@ -77,12 +79,16 @@ def main(argv: List[str] | None = None) -> int:
                              "cam.fmu, cam3.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a "
                              "source checkout (else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
+    parser.add_argument("--platforms", default="all",
+                        help=f"the binaries: all (default; zig), {binaries.HOST} (this machine, the system "
+                             f"C compiler) or a comma-separated list of {', '.join(targets.NAMES)}")
     args = parser.parse_args(argv)
+    platforms = None if args.platforms == "all" else args.platforms.split(",")
     try:
         if args.dest is not None:
-            print(build(args.dest, args.model))
+            print(build(args.dest, args.model, platforms))
             return 0
-        built = {name: build(default_model_path(name), name) for name in MODELS}
+        built = {name: build(default_model_path(name), name, platforms) for name in MODELS}
         for path in built.values():
             print(path)
         for name in SSP_NAMES:

@@ -6,16 +6,17 @@ what it calls), a generator of its variable table in C, its variable rows (``mod
 default experiment; the FMI glue (``csrc/fmi``: glue.c, glue_me.c and the version's files) is the same for
 every model. Steps:
 
-1. The GUID: a hash of the variable rows and of every source and generated file.
-2. The generated tables (``engine.codegen`` for the drive, ``pi_codegen`` for the controller) in a
-   temporary folder.
-3. The binary: the model's C, the generated C and the glue of the FMI version compiled into one shared
-   library with the official FMI headers, only the FMI functions exported, linked with libc and libm only:
-   ``binaries/linux64/<id>.so``; with the MinGW-w64 cross compiler also ``binaries/win64/<id>.dll``.
-4. ``modelDescription.xml`` (``model_description`` for FMI 2.0, ``model_description3`` for FMI 3.0).
-5. The C sources under ``sources/``, with the generated table and the official headers: anyone can rebuild
-   the binary for another platform
-   (``cc -std=c99 -shared -fPIC -include sources/guid.h -Isources sources/*.c -lm``).
+1. The GUID: a hash of the variable rows and of every source and generated file (``digest``).
+2. ``sources/``: the model's C, its generated tables, the FMI glue of the version (FMI 2.0: ``fmi2.c`` and
+   ``fmi2_me.c``; FMI 3.0: ``fmi3_cs.c``; both over ``glue.c`` and ``glue_me.c``), the official headers of
+   the version (vendored, ``csrc/fmi/headers``) and ``guid.h``. They compile as they are
+   (``cc -shared -fPIC sources/*.c -lm``); FMI 2.0 lists them in the model description's
+   ``<SourceFiles>``, FMI 3.0 in ``sources/buildDescription.xml``.
+3. The binaries: exactly those ``sources/*.c``, compiled for every platform of ``engine.targets`` by zig
+   (``binaries.compile_sources``), only the FMI functions exported, linked with the C library and libm only;
+   placed in the version's platform folders (``binaries.place``; FMI 2.0's darwin64 is one universal binary).
+4. ``modelDescription.xml``: ``model_description.skeleton`` completed by ``model_description.postprocess``,
+   or FMI 3.0's ``model_description3``.
 """
 from __future__ import annotations
 
@@ -28,28 +29,23 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import build as engine_build
-from ..engine import codegen
-from . import model_description, model_description3, pi_codegen
+from ..engine import codegen, targets
+from . import binaries, macho, model_description, model_description3, pi_codegen
 
 PACKAGE_DIR = engine_build.HERE.parent  # cam_fmu/
 FMI = engine_build.CSRC / "fmi"
 CONTROL_CSRC = PACKAGE_DIR / "control" / "csrc"
 # The FMI glue of each version, for every model: the glue both versions share and the version's own files
-# (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0: co-simulation). Its official headers; its
-# platform folders (FMI 3.0 names them by architecture and OS).
+# (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0: co-simulation); its official headers
+# (vendored: engine_build.fmi_headers).
 SHARED_GLUE = (FMI / "glue.c", FMI / "glue_me.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
+GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h")
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
-PLATFORM_DIRS = {2: {"linux64": "linux64", "win64": "win64"}, 3: {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).
 BINARY_FLAGS: tuple[str, ...] = ("-fvisibility=hidden",)
-# win64: Debian's MinGW-w64 cross compiler; libgcc linked in, so the DLL needs only Windows' own
-# KERNEL32.dll and msvcrt.dll.
-WIN64_COMPILER = "x86_64-w64-mingw32-gcc"
-WIN64_FLAGS: tuple[str, ...] = ("-static-libgcc",)
-PLATFORMS = ("linux64", "win64")
 
 
 class FmuBuildError(RuntimeError):
@@ -63,7 +59,6 @@ class CModel:
     identifier: str                                  # the model identifier: the binary's name
     description: str                                 # the model description's description
     sources: Callable[[], List[Path]]                # its hand-written C (.c and .h), the model table's file included
-    include: Sequence[Path]                          # folders of its headers
     generate: Callable[[Path], List[Path]]           # writes its generated C into a folder
     rows: Callable[[], List[Dict[str, Any]]]         # its variables in value-reference order
     experiment: Callable[[], tuple]                  # (start, stop, step) [s] of its default experiment
@@ -97,8 +92,8 @@ CAM = CModel(
     identifier="cam",
     description=("Electromechanical cam drive: DC motor, disc cam, translating roller follower "
                  "(energy-consistent hybrid model, docs/model.md); the C engine of cam_fmu"),
-    sources=_cam_sources, include=(engine_build.INCLUDE,), generate=codegen.write,
-    rows=model_description.variable_rows, experiment=default_experiment, model_exchange=True,
+    sources=_cam_sources, generate=codegen.write, rows=model_description.variable_rows,
+    experiment=default_experiment, model_exchange=True,
     shaping=lambda: [Path(codegen.__file__), Path(engine_build.__file__), PACKAGE_DIR / "physics" / "parameters.py",
                      PACKAGE_DIR / "physics" / "variables.py"],
 )
@@ -107,8 +102,8 @@ PI_SPEED = CModel(
     description=("Sampled PI speed controller (one sample per communication step) with conditional-integration "
                  "anti-windup, output clamp [u_min, u_max] and optional load-torque feedforward from cam.fmu's "
                  "M and J (control/pi.py; C in control/csrc)"),
-    sources=_pi_sources, include=(CONTROL_CSRC,), generate=pi_codegen.write,
-    rows=model_description.controller_rows, experiment=controller_experiment, model_exchange=False,
+    sources=_pi_sources, generate=pi_codegen.write, rows=model_description.controller_rows,
+    experiment=controller_experiment, model_exchange=False,
     shaping=lambda: [Path(pi_codegen.__file__), PACKAGE_DIR / "control" / "pi.py",
                      PACKAGE_DIR / "physics" / "parameters.py"],
 )
@@ -125,14 +120,16 @@ def _model(model: str | CModel) -> CModel:
 
 def glue_sources() -> List[Path]:
     """The glue's files, every version's (C and headers)."""
-    return sorted(FMI.glob("glue*.[ch]")) + sorted(FMI.glob("fmi*.[ch]")) + [FMI / "model.h"]
+    return sorted({*GLUE[2], *GLUE[3], *GLUE_HEADERS})
 
 
 def sources(model: str | CModel = "cam") -> List[Path]:
-    """Every file whose content shapes the model's FMUs: its C, the glue, the generators and the tables."""
+    """Every file whose content shapes the model's FMUs: its C, the glue and the official headers, the
+    generators, the target table and the tables."""
     m = _model(model)
-    return [*m.sources(), *glue_sources(), Path(__file__), Path(model_description.__file__),
-            Path(model_description3.__file__), *m.shaping()]
+    return [*m.sources(), *glue_sources(), *sorted(engine_build.FMI_HEADERS.rglob("*.h")), Path(__file__),
+            Path(model_description.__file__), Path(model_description3.__file__), Path(targets.__file__),
+            Path(binaries.__file__), Path(macho.__file__), *m.shaping()]
 
 
 def binary_sources(model: str | CModel = "cam", fmi_version: int = 2) -> List[Path]:
@@ -150,7 +147,7 @@ def digest(model: str | CModel = "cam") -> str:
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
         for path in m.generate(Path(gen)):
             h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    h.update(" ".join(engine_build.CFLAGS + engine_build.LDFLAGS).encode())
+    h.update(" ".join(engine_build.CFLAGS + engine_build.LDFLAGS + BINARY_FLAGS).encode())
     return h.hexdigest()[:12]
 
 
@@ -161,65 +158,72 @@ def model_guid(model: str | CModel = "cam") -> str:
 
 
 def compile_binary(dest: Path, guid: str, compiler: str | None = None, extra_flags: Sequence[str] = (),
-                   fmi_version: int = 2, model: str | CModel = "cam") -> Path:
-    """Compile the model, its generated table and the FMI glue of ``fmi_version`` into the shared library ``dest``."""
+                   fmi_version: int = 2, target: targets.Target | str | None = None,
+                   model: str | CModel = "cam") -> Path:
+    """Compile the model, its generated table and the FMI glue of ``fmi_version`` into the shared library ``dest``
+    for ``target`` (None: this machine with ``compiler``, default the system C compiler; tests add sanitizers)."""
     m = _model(model)
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
         generated = [p for p in m.generate(Path(gen)) if p.suffix == ".c"]
+        include = sorted({p.parent for p in m.sources()} | {Path(gen), FMI, engine_build.fmi_headers(fmi_version)})
         try:
-            return engine_build.compile_shared(
-                dest, [*binary_sources(m, fmi_version), *generated],
-                (*m.include, Path(gen), FMI, engine_build.fmi_headers()),
-                (*BINARY_FLAGS, f'-DMODEL_GUID="{guid}"', *extra_flags), compiler)
+            return engine_build.compile_shared(dest, [*binary_sources(m, fmi_version), *generated], include,
+                                               {"MODEL_GUID": f'"{guid}"'}, target, (*BINARY_FLAGS, *extra_flags),
+                                               compiler)
         except engine_build.EngineBuildError as exc:
             raise FmuBuildError(f"{m.identifier}'s binary: {exc}") from None
 
 
-def win64_compiler() -> str | None:
-    """The MinGW-w64 cross compiler on PATH, or None."""
-    return shutil.which(WIN64_COMPILER)
+def write_sources(folder: Path, m: CModel, guid: str, fmi_version: int) -> list[str]:
+    """The FMU's ``sources/`` in ``folder``: the model's C, its generated tables, the glue, the official headers
+    and ``guid.h``; returns the names of its C files (what a build compiles), sorted."""
+    folder.mkdir(parents=True, exist_ok=True)
+    m.generate(folder)  # the generated table, beside the hand-written sources
+    headers = engine_build.fmi_headers(fmi_version)
+    for path in [*m.sources(), *GLUE[fmi_version], *GLUE_HEADERS, *(headers / name for name in HEADERS[fmi_version])]:
+        shutil.copyfile(path, folder / path.name)
+    shutil.copyfile(engine_build.FMI_HEADERS / "LICENSE.txt", folder / "FMI_HEADERS_LICENSE.txt")
+    (folder / "guid.h").write_text(f'/* the model description\'s {"guid" if fmi_version == 2 else "instantiationToken"} */\n'
+                                   f'#define MODEL_GUID "{guid}"\n')
+    return sorted(p.name for p in folder.glob("*.c"))
 
 
-def model_description_xml(m: CModel, guid: str, fmi_version: int) -> bytes:
-    """The model description of ``m`` for ``fmi_version``."""
+def model_description_xml(m: CModel, guid: str, fmi_version: int, files: Sequence[str]) -> bytes:
+    """The model description of ``m`` for ``fmi_version`` (``files``: FMI 2.0's SourceFiles)."""
     rows = m.rows()
     if fmi_version == 2:
-        return model_description.postprocess(model_description.skeleton(m.identifier, guid, rows, m.model_exchange),
-                                             m.experiment(), m.description, rows)
+        return model_description.postprocess(
+            model_description.skeleton(m.identifier, guid, rows, list(files), m.model_exchange),
+            m.experiment(), m.description, rows)
     return model_description3.model_description(m.identifier, guid, rows, m.experiment(), m.description)
 
 
-def build(dest: Path, win64: bool | None = None, fmi_version: int = 2, model: str | CModel = "cam") -> Path:
+def build(dest: Path, fmi_version: int = 2, platforms: Sequence[str] | None = None,
+          model: str | CModel = "cam") -> Path:
     """Build the FMU of ``model`` for ``fmi_version`` (2 or 3) at ``dest`` (a path ending in .fmu) and return it.
 
-    ``win64``: True requires the win64 binary (FmuBuildError without the cross compiler), False
-    leaves it out, None (the default) adds it when the cross compiler is installed."""
+    ``platforms``: target names of ``engine.targets`` (default: all, with zig), or ``["host"]``: this machine
+    only, with the system C compiler."""
     if fmi_version not in GLUE:
         raise FmuBuildError(f"fmi_version {fmi_version!r}: allowed 2 or 3")
     m = _model(model)
     dest = Path(dest).resolve()
     if dest.suffix != ".fmu":
         raise FmuBuildError(f"the FMU's path must end in .fmu: {dest}")
-    cross = win64_compiler() if win64 is not False else None
-    if win64 and not cross:
-        raise FmuBuildError(f"the win64 binary needs the MinGW-w64 cross compiler {WIN64_COMPILER} "
-                            "(Debian: apt-get install gcc-mingw-w64-x86-64; setup.sh installs it)")
     guid = model_guid(m)
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_") as tmp:
         root = Path(tmp)
-        folders = PLATFORM_DIRS[fmi_version]
-        compile_binary(root / "fmu" / "binaries" / folders["linux64"] / f"{m.identifier}.so", guid,
-                       fmi_version=fmi_version, model=m)
-        if cross:
-            compile_binary(root / "fmu" / "binaries" / folders["win64"] / f"{m.identifier}.dll", guid, cross,
-                           WIN64_FLAGS, fmi_version, m)
-        (root / "fmu" / "modelDescription.xml").write_bytes(model_description_xml(m, guid, fmi_version))
         folder = root / "fmu" / "sources"
-        m.generate(folder)  # the generated table, beside the hand-written sources
-        for path in [*m.sources(), *GLUE[fmi_version], *FMI.glob("glue*.h"), *FMI.glob(f"fmi{fmi_version}*.h"),
-                     FMI / "model.h", *(engine_build.fmi_headers() / name for name in HEADERS[fmi_version])]:
-            shutil.copyfile(path, folder / path.name)
-        (folder / "guid.h").write_text(f'#define MODEL_GUID "{guid}"\n')
+        files = write_sources(folder, m, guid, fmi_version)
+        try:
+            built = binaries.compile_sources(root / "built", m.identifier, [folder / f for f in files], (folder,),
+                                             names=platforms, extra_flags=BINARY_FLAGS)
+        except (engine_build.EngineBuildError, binaries.BinaryBuildError, targets.TargetError) as exc:
+            raise FmuBuildError(f"{m.identifier} (FMI {fmi_version}.0)'s binaries: {exc}") from None
+        binaries.place(root / "fmu", m.identifier, fmi_version, built)
+        if fmi_version == 3:
+            (folder / "buildDescription.xml").write_bytes(binaries.build_description(m.identifier, files))
+        (root / "fmu" / "modelDescription.xml").write_bytes(model_description_xml(m, guid, fmi_version, files))
         out = root / f"{m.identifier}.fmu"
         with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
             for path in sorted((root / "fmu").rglob("*")):

@@ -250,9 +250,11 @@ def guid(rows: List[Dict[str, Any]], engine_digest: str) -> str:
     return "{%s-%s-%s-%s-%s}" % (h[:8], h[8:12], h[12:16], h[16:20], h[20:32])
 
 
-def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]], model_exchange: bool = True) -> bytes:
+def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
+             source_files: Optional[List[str]] = None, model_exchange: bool = True) -> bytes:
     """A modelDescription.xml (co-simulation, and Model Exchange unless ``model_exchange`` is False) with every
-    variable of ``rows`` (value reference = row index) and the capabilities of the C binary; ``postprocess``
+    variable of ``rows`` (value reference = row index) and the capabilities of the C binary; ``source_files``:
+    the C files of ``sources/`` a build compiles (``<SourceFiles>`` of each interface); ``postprocess``
     completes it."""
     root = ET.Element("fmiModelDescription", fmiVersion="2.0", modelName=model_identifier, guid=model_guid,
                       generationTool="cam_fmu", variableNamingConvention="flat",
@@ -269,6 +271,11 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
                   canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",
                   canGetAndSetFMUstate="true", canSerializeFMUstate="true",
                   providesDirectionalDerivative="false")
+    for interface in root:  # FMI 2.0's build description: the files to compile, in each interface
+        if source_files:
+            files = ET.SubElement(interface, "SourceFiles")
+            for name in source_files:
+                ET.SubElement(files, "File", name=name)
     categories = ET.SubElement(root, "LogCategories")
     for name, description in LOG_CATEGORIES:
         ET.SubElement(categories, "Category", name=name, description=description)

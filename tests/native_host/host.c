@@ -2,7 +2,7 @@
  * A minimal native FMI 2.0 co-simulation host, as real tools load FMUs:
  * dlopen(RTLD_NOW | RTLD_LOCAL) (LoadLibrary on Windows), fmi2Instantiate, run,
  * fmi2FreeInstance, dlclose, exit.  No libpython is linked or preloaded. The FMI
- * types are the official headers' (fmi2FunctionTypes.h, the copy fmpy ships).
+ * types are the official headers' (fmi2FunctionTypes.h, vendored in cam_fmu/engine/csrc/fmi/headers).
  *
  *   host <binary> <resources-dir> COMMAND...
  *

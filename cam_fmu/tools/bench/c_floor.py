@@ -4,8 +4,8 @@ Its model is trivial (two states, one forward-Euler step per ``fmi2DoStep``,
 ``c_floor/floor.c``), so a run through fmpy measures what the host itself costs
 per communication step. The model description is written here from
 ``physics.variables`` (the same names, causalities and input start values as
-cam.fmu); the binary is compiled with the system C compiler against the FMI 2.0
-headers that fmpy ships, and both are zipped into ``folder/c_floor.fmu``.
+cam.fmu); the binary is compiled with the system C compiler against the official FMI 2.0
+headers (vendored in the engine's csrc/fmi/headers), and both are zipped into ``folder/c_floor.fmu``.
 """
 from __future__ import annotations
 
@@ -57,13 +57,10 @@ def model_description(guid: str) -> str:
 
 
 def fmi2_include_dir() -> Path:
-    """fmpy's copy of the FMI 2.0 headers (fmi2Functions.h, ...)."""
-    import fmpy
+    """The official FMI 2.0 headers (fmi2Functions.h, ...), vendored with the engine (csrc/fmi/headers/fmi2)."""
+    from ...engine.build import fmi_headers
 
-    include = Path(fmpy.__file__).resolve().parent / "c-code"
-    if not (include / "fmi2Functions.h").is_file():
-        raise CFloorError(f"fmi2Functions.h not found in {include} (fmpy ships the FMI 2.0 headers there)")
-    return include
+    return fmi_headers(2)
 
 
 def compile_binary(dest_so: Path, compiler: str | None = None) -> Path:

@@ -45,7 +45,7 @@ def _description(folder: Path) -> tuple[str, str, dict[str, int]]:
 
 
 def compile_loop(dest: Path) -> Path:
-    """``c_floor/loop.c`` compiled against the official FMI 2.0 headers that fmpy ships."""
+    """``c_floor/loop.c`` compiled against the official FMI 2.0 headers (vendored)."""
     from ...engine.build import find_compiler
     from .c_floor import fmi2_include_dir
 

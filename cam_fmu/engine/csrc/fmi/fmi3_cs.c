@@ -4,8 +4,8 @@
  * instantiation token, fmi3DoStep's out-arguments (lastSuccessfulTime where the FMU stands after a Discard),
  * Float64 in place of Real, arrays of nValues. The FMU declares no event mode, no early return, no clocks
  * and no Model Exchange or Scheduled Execution: their entry points exist (the standard asks every function
- * of the binary) and refuse with fmi3Error and a message. Compiled with the official FMI 3.0 headers (those
- * fmpy ships); MODEL_GUID is the instantiation token, defined at build time from the model description.
+ * of the binary) and refuse with fmi3Error and a message. Compiled with the official FMI 3.0 headers (vendored
+ * in csrc/fmi/headers); MODEL_GUID is the instantiation token, from guid.h (written by the build) or -DMODEL_GUID.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -14,7 +14,7 @@
 #include "glue.h"
 
 #ifndef MODEL_GUID
-#error "MODEL_GUID must be defined by the build (the model description's instantiationToken)"
+#include "guid.h" /* the model description's instantiationToken: written by the build beside the sources */
 #endif
 
 #define INSTANCE_MAGIC 0x666d6933u   /* 'fmi3' */

@@ -7,6 +7,7 @@
  * (fmi2Discard) naming h_max. The scheme's answer must not depend on the host's step pattern: with
  * T = h / ceil(h / h_max) (the former rule), steps alternating 0.7/0.3 ms gave theta(0.5 s) = 0.719 rad
  * against 2.05 rad for uniform steps. A refused step leaves the state as it was. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -30,11 +31,18 @@ static double electrical_rate(const CamModel *m, double J)
     return m->c_e * m->c_m / (m->R * J);
 }
 
+/* The cap of the sub-step count: 9e15 where long has 64 bits, LONG_MAX where it has 32 (Windows' LLP64). */
+#if LONG_MAX > 9000000000000000
+#define RK4_SUBSTEPS_CAP 9000000000000000L
+#else
+#define RK4_SUBSTEPS_CAP LONG_MAX
+#endif
+
 /* RK4 sub-steps that keep one calculation step T inside RK4's stability limit (rate * sub-step <= 2). */
 static long rk4_substeps(const CamModel *m, double J, double T)
 {
     double n = ceil(T * electrical_rate(m, J) / 2.0);
-    return n > 1.0 ? (n < 9.0e15 ? (long)n : 9000000000000000L) : 1L;
+    return n > 1.0 ? (n < (double)RK4_SUBSTEPS_CAP ? (long)n : RK4_SUBSTEPS_CAP) : 1L;
 }
 
 /* RK4 on eq. (12): omega_dot = (c_m u - R M - c_e c_m omega) / (R J), in n sub-steps. */
