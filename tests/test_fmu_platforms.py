@@ -357,3 +357,12 @@ def test_fmpy_builds_the_binary_from_the_build_description(unzipped, tmp_path, v
     assert rebuilt["theta"][-1] > 0.05
     for name in ("theta", "omega", "i"):
         assert rebuilt[name] == pytest.approx(shipped[name], rel=1e-12, abs=1e-15), name
+
+
+def test_an_unknown_platform_is_refused_naming_the_allowed_ones(tmp_path):
+    import sys
+
+    proc = subprocess.run([sys.executable, str(HERE.parent / "build_fmu.py"), "--platforms", "riscv64-linux", "--dest",
+                           str(tmp_path / "cam.fmu")], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 1 and not (tmp_path / "cam.fmu").exists()
+    assert "'riscv64-linux'" in proc.stderr and all(name in proc.stderr for name in targets.NAMES), proc.stderr
