@@ -106,14 +106,18 @@ def pe_machine_and_exports(path: Path) -> tuple[int, set[str], set[str]]:
     return struct.unpack_from("<H", data, offset + 4)[0], exports, dlls
 
 
-def macho_thin(data: bytes, base: int = 0) -> tuple[int, int, set[str]]:
-    """(cputype, filetype, exported names without the leading underscore) of the thin 64-bit Mach-O at ``base``:
-    the external, defined, non-private symbols of its LC_SYMTAB."""
+def macho_thin(data: bytes, base: int = 0) -> tuple[int, int, set[str], tuple[int, int]]:
+    """(cputype, filetype, exported names without the leading underscore, minimum macOS (major, minor)) of the
+    thin 64-bit Mach-O at ``base``: the external, defined, non-private symbols of its LC_SYMTAB; the minimum
+    from LC_BUILD_VERSION or LC_VERSION_MIN_MACOSX."""
     magic, cputype, _sub, filetype, ncmds, _size = struct.unpack_from("<IiiIII", data, base)
     assert magic == 0xFEEDFACF, hex(magic)
-    names, offset = set(), base + 32
+    names, offset, minos = set(), base + 32, None
     for _ in range(ncmds):
         cmd, size = struct.unpack_from("<II", data, offset)
+        if cmd in (0x32, 0x24):  # LC_BUILD_VERSION (platform, minos), LC_VERSION_MIN_MACOSX (version): xxxx.yy.zz
+            version = struct.unpack_from("<I", data, offset + (12 if cmd == 0x32 else 8))[0]
+            minos = (version >> 16, (version >> 8) & 0xFF)
         if cmd == 0x2:  # LC_SYMTAB
             symoff, nsyms, stroff, _strsize = struct.unpack_from("<IIII", data, offset + 8)
             for k in range(nsyms):
@@ -122,7 +126,7 @@ def macho_thin(data: bytes, base: int = 0) -> tuple[int, int, set[str]]:
                     start = base + stroff + strx
                     names.add(data[start:data.index(b"\0", start)].decode()[1:])
         offset += size
-    return cputype, filetype, names
+    return cputype, filetype, names, minos
 
 
 def macho_fat(data: bytes) -> list[tuple[int, int, int, int]]:
@@ -178,10 +182,12 @@ def test_the_windows_binaries_are_x86_64_and_export_exactly_the_fmi_functions(un
 
 def test_the_macos_binaries_are_dylibs_of_their_architecture_exporting_the_fmi_functions(unzipped, engine_libraries):
     """FMI 3.0: one thin dylib per tuple. FMI 2.0's darwin64: one universal file, an x86_64 and an arm64 slice at
-    16 KiB-aligned offsets, inside the file and not overlapping, each exporting exactly the FMI 2.0 functions."""
+    16 KiB-aligned offsets, inside the file and not overlapping, each exporting exactly the FMI 2.0 functions.
+    Each loads on macOS 10.13 (Intel) or 11.0 (Apple silicon, its first) and later."""
+    minimum = {CPU_X86_64: (10, 13), CPU_ARM64: (11, 0)}
     for folder, cputype in (("x86_64-darwin", CPU_X86_64), ("aarch64-darwin", CPU_ARM64)):
-        found, filetype, names = macho_thin((unzipped[3] / "binaries" / folder / "cam.dylib").read_bytes())
-        assert (found, filetype) == (cputype, 6)  # MH_DYLIB
+        found, filetype, names, minos = macho_thin((unzipped[3] / "binaries" / folder / "cam.dylib").read_bytes())
+        assert (found, filetype, minos) == (cputype, 6, minimum[cputype])  # MH_DYLIB
         assert names - LINKER_SYMBOLS == _required(3)
     data = (unzipped[2] / "binaries" / "darwin64" / "cam.dylib").read_bytes()
     slices = macho_fat(data)
@@ -190,11 +196,11 @@ def test_the_macos_binaries_are_dylibs_of_their_architecture_exporting_the_fmi_f
     for cputype, offset, size, align in sorted(slices, key=lambda s: s[1]):
         assert offset % (1 << align) == 0 and align >= 12 and offset >= end and offset + size <= len(data)
         end = offset + size
-        found, filetype, names = macho_thin(data, offset)
-        assert (found, filetype) == (cputype, 6) and names - LINKER_SYMBOLS == _required(2)
+        found, filetype, names, minos = macho_thin(data, offset)
+        assert (found, filetype, minos) == (cputype, 6, minimum[cputype]) and names - LINKER_SYMBOLS == _required(2)
     for name, cputype in (("x86_64-darwin", CPU_X86_64), ("aarch64-darwin", CPU_ARM64)):
-        found, _, names = macho_thin(engine_libraries[name].read_bytes())
-        assert found == cputype and "cam_law_eval" in names
+        found, _, names, minos = macho_thin(engine_libraries[name].read_bytes())
+        assert found == cputype and minos == minimum[cputype] and "cam_law_eval" in names
 
 
 def test_the_fat_merger_refuses_what_is_not_two_thin_architectures(unzipped, tmp_path):
@@ -357,3 +363,12 @@ def test_fmpy_builds_the_binary_from_the_build_description(unzipped, tmp_path, v
     assert rebuilt["theta"][-1] > 0.05
     for name in ("theta", "omega", "i"):
         assert rebuilt[name] == pytest.approx(shipped[name], rel=1e-12, abs=1e-15), name
+
+
+def test_an_unknown_platform_is_refused_naming_the_allowed_ones(tmp_path):
+    import sys
+
+    proc = subprocess.run([sys.executable, str(HERE.parent / "build_fmu.py"), "--platforms", "riscv64-linux", "--dest",
+                           str(tmp_path / "cam.fmu")], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 1 and not (tmp_path / "cam.fmu").exists()
+    assert "'riscv64-linux'" in proc.stderr and all(name in proc.stderr for name in targets.NAMES), proc.stderr

@@ -141,8 +141,9 @@ def compile_shared(dest: Path, sources: Sequence[Path], include: Sequence[Path] 
     # (a concurrent loader never sees half a library)
     with tempfile.TemporaryDirectory(prefix=f".{dest.name}.", dir=dest.parent) as tmp:
         out = Path(tmp) / dest.name
-        cmd = [*head, *CFLAGS, *extra_flags, *(f"-I{p}" for p in include),
-               *(f"-D{k}={v}" for k, v in (defines or {}).items()), *map(str, sources), "-o", str(out), *LDFLAGS]
+        cmd = [*head, *CFLAGS, *extra_flags, *(f"-I{Path(p).resolve()}" for p in include),  # absolute: cwd is tmp
+               *(f"-D{k}={v}" for k, v in (defines or {}).items()), *(str(Path(p).resolve()) for p in sources),
+               "-o", str(out), *LDFLAGS]
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp)
         if proc.returncode != 0:
             raise EngineBuildError(f"compiling {dest.name} failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")

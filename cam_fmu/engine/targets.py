@@ -40,9 +40,11 @@ TARGETS: tuple[Target, ...] = (
            "Linux", ("aarch64", "arm64")),
     Target("x86_64-windows", "x86_64-windows-gnu", "win64", "x86_64-windows", ".dll", (), "wine",
            "Windows", ("amd64", "x86_64")),
-    Target("x86_64-darwin", "x86_64-macos", "darwin64", "x86_64-darwin", ".dylib", (), "none",
+    # macOS: the oldest release as the minimum (zig's default is its newest SDK's, 15.0): 10.13 on Intel, 11.0 (the
+    # first) on Apple silicon
+    Target("x86_64-darwin", "x86_64-macos.10.13", "darwin64", "x86_64-darwin", ".dylib", (), "none",
            "Darwin", ("x86_64",)),
-    Target("aarch64-darwin", "aarch64-macos", "darwin64", "aarch64-darwin", ".dylib", (), "none",
+    Target("aarch64-darwin", "aarch64-macos.11.0", "darwin64", "aarch64-darwin", ".dylib", (), "none",
            "Darwin", ("arm64", "aarch64")),
 )
 NAMES = tuple(t.name for t in TARGETS)
