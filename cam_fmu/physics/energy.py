@@ -18,6 +18,7 @@ its own copy (it checks every published state).
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 # Relative slack of the bound (integration error, rounding), of the energy scale |E| + r sum |W_in|.
@@ -67,9 +68,10 @@ class EnergyBudget:
             setattr(self, key, float(state[key]))
 
     def surplus(self, omega: float, s: float, J: float, i: float) -> float:
-        """Energy above the bound, less the tolerance [J]: > 0 means energy was created."""
+        """Energy above the bound, less the tolerance [J]: > 0 means energy was created (inf: the energy
+        overflowed, which counts as created)."""
         excess, tolerance = self.excess(omega, s, J, i)
-        return excess - tolerance
+        return excess - tolerance if math.isfinite(excess) and math.isfinite(tolerance) else math.inf
 
     def excess(self, omega: float, s: float, J: float, i: float) -> tuple[float, float]:
         """(energy above the bound [J], the tolerance [J]) at the state omega, s, J, i.
