@@ -22,7 +22,7 @@ HERE = Path(__file__).resolve()
 def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
     from cam_fmu.fmu.engine import DriveSimulator
 
-    sim = DriveSimulator(params)
+    sim = DriveSimulator(params, start_time=t0)
     sim.set_inputs(u, omega_ref, 0.0)
     n = int(round(stop / h))
     for k in range(n):
