@@ -38,7 +38,7 @@ FMI = engine_build.CSRC / "fmi"
 # The FMI glue of each version: the instance layer, the Model Exchange layer, the glue both share, the
 # version's own files (FMI 2.0: co-simulation and Model Exchange; FMI 3.0: co-simulation); its official
 # headers; its platform folders (FMI 3.0 names them by architecture and OS).
-SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "glue.c", FMI / "glue_me.c")
+SHARED_GLUE = (FMI / "instance.c", FMI / "exchange.c", FMI / "glue.c", FMI / "glue_me.c", FMI / "checksum.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
