@@ -118,40 +118,47 @@ def test_a_bad_step_or_input_is_an_error_naming_it(step, names):
     assert error is not None and error[0] is SimulationError and names in error[1], error
 
 
-def test_the_energy_guard_refuses_a_state_that_created_energy():
-    """A state whose books say the source delivered far less than the drive holds: energy was created."""
+def test_a_state_whose_books_disagree_with_its_energy_is_not_restored():
+    """A state whose books say the source delivered far less than the drive holds: energy was created. The
+    restore refuses it with the step guard's verdict (it used to restore, and the next step refused it)."""
     sim = DriveSimulator()
     for k in range(200):
         sim.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
-    state = sim.get_state()
-    state["energy"] = dict(state["energy"], work_in=-1.0)
-    sim.set_state(state)
-    error = _error(lambda: sim, 0.2, 1e-3, 3.5, 1.0)
-    assert error[0] is SimulationError and "energy was created" in error[1] and "rtol" in error[1]
+    saved, before = sim.get_state(), sim.outputs()
+    state = dict(saved, energy=dict(saved["energy"], work_in=-1.0))
+    error = _error(lambda: sim.set_state(state))
+    assert error[0] is SimulationError and "more energy than its account" in error[1]
+    assert sim.outputs() == before and sim.get_state() == saved  # nothing restored
+    sim.do_step(0.2, 1e-3, 3.5, 1.0)  # the drive as it was goes on
 
 
 def test_the_step_floor_is_a_step_rejected_naming_rtol():
-    """A diverging state (omega = 1e200: the right-hand side overflows) drives rk45's step below its floor."""
+    """A diverging state (omega = 1e150: the right-hand side overflows) drives rk45's step below its floor;
+    at omega = 1e200 the outputs themselves overflow, and the restore refuses it."""
     sim = DriveSimulator()
     state = sim.get_state()
-    state["y"] = [0.5, 1e200]
     state["mode"] = dict(state["mode"], stuck=False)
+    state["y"] = [0.5, 1e200]
+    error = _error(lambda: sim.set_state(state))
+    assert error[0] is SimulationError and "is none the drive can reach" in error[1]
+    state["y"] = [0.5, 1e150]
     sim.set_state(state)
     error = _error(lambda: sim, 0.0, 1e-3, 3.5, 1.0)
     assert error[0] is StepRejected and "its step fell below 1e-15 s" in error[1] and "rtol" in error[1]
 
 
-def test_the_clearance_guard_names_the_missed_contact():
-    """A follower 10 mm off the cam in a 0.5 mm gap, held at rest (u = 0): a missed contact."""
+def test_a_follower_beyond_the_clearance_is_not_restored():
+    """A follower 10 mm off the cam in a 0.5 mm gap: no state the drive can be in (the step guard that names a
+    missed contact sees the same thing; the restore now refuses it first)."""
     sim = DriveSimulator({"c": 5e-4})
     for k in range(100):
         sim.do_step(k * 1e-3, 1e-3, 3.5, 1.0)
     state, out = sim.get_state(), sim.outputs()
     state["y"] = [state["y"][0], 0.0]
     state["mode"] = dict(state["mode"], stuck=True, contact=0, s_free=out["s_cam"] + 0.01)
-    sim.set_state(state)
-    error = _error(lambda: sim, 0.1, 1e-3, 0.0, 1.0)
-    assert error[0] is SimulationError and "a contact event was missed" in error[1] and "c = 0.0005 m" in error[1]
+    error = _error(lambda: sim.set_state(state))
+    assert error[0] is SimulationError and "beyond the clearance c = 0.0005 m" in error[1] and "s_free" in error[1]
+    assert sim.outputs() == out
 
 
 def test_resolve_and_the_model_agree_on_what_they_accept():

@@ -414,3 +414,45 @@ def test_a_host_that_steps_over_an_impact_without_event_mode_gets_an_error(engin
     assert text.startswith("fmi2CompletedIntegratorStep: the follower is ") and "beyond the clearance c = 0.0005 m" in text
     assert 0.036 < len(asked) * h < 0.039  # s: the first engagement (0.0372 s in the co-simulation)
     model.freeInstance()
+
+
+# ------------------------------------------------------------------ the energy guard does not overflow
+def _completed_with(fmu, start: dict, slot: int, value: float) -> tuple[bool, list[str]]:
+    """One host step that sets continuous state ``slot`` to ``value``: (refused?, error messages)."""
+    logged = Logged()
+    model, vr = raw_model(fmu, logged)
+    model.setupExperiment(startTime=0.0)
+    model.enterInitializationMode()
+    for name, v in start.items():
+        model.setReal([vr[name]], [v])
+    model.exitInitializationMode()
+    model.newDiscreteStates()
+    model.enterContinuousTimeMode()
+    x = get(model.getContinuousStates, NX)
+    x[slot] = value
+    model.setTime(1e-4)
+    model.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), NX)
+    refused_now = refused(model.completedIntegratorStep)
+    model.freeInstance()
+    return refused_now, [text for status, text in logged.messages if status == 3]
+
+
+OVERFLOW_CASES = [({}, 1, "x_omega"), ({"k_shaft": 50.0, "J_cam": 1e-4}, 4, "x_omega_m"),
+                  ({"L": 1e-3}, 2, "x_i")]
+
+
+@pytest.mark.parametrize("start,slot,name", OVERFLOW_CASES, ids=[c[2] for c in OVERFLOW_CASES])
+@pytest.mark.parametrize("value", [1e6, 1e155, 1e200, -1e300])
+def test_a_state_whose_energy_overflows_is_energy_created(engine_fmu_path, start, slot, name, value):
+    """fmi2CompletedIntegratorStep refused x_omega = 1e6 but returned OK for x_omega >= 1e160, x_omega_m =
+    1e200 with a shaft, x_i = 1e200 with L = 1 mH: 1/2 J omega^2 was inf and the comparison with the books
+    passed. Every magnitude past the bound is now refused, with the guard's message."""
+    refused_now, texts = _completed_with(engine_fmu_path, start, slot, value)
+    assert refused_now, (name, value)
+    assert any("fmi2CompletedIntegratorStep" in t and ("energy was created" in t or "not finite" in t)
+               for t in texts), texts
+
+
+def test_a_modest_state_still_completes(engine_fmu_path):
+    """The guard still lets a physical state through (the check can fail: this one is accepted)."""
+    assert _completed_with(engine_fmu_path, {}, 1, 1e-3) == (False, [])

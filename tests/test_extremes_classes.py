@@ -22,7 +22,7 @@ HERE = Path(__file__).resolve()
 def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
     from cam_fmu.fmu.engine import DriveSimulator
 
-    sim = DriveSimulator(params)
+    sim = DriveSimulator(params, start_time=t0)
     sim.set_inputs(u, omega_ref, 0.0)
     n = int(round(stop / h))
     for k in range(n):
@@ -265,9 +265,11 @@ def scenario_fmi(fmu):
     # 9: a state blob with omega = NaN, one cut short and one of another format are refused before anything is
     # restored. The blob (cam_fmu/engine/csrc/fmi/instance.c): a 24-byte header, the start time, the inputs,
     # the parameters, the drive's 48-double state (cam_model.h CAM_S_*: omega is slot CAM_S_X + 1 = 9), and
-    # the motion table's text (none here).
+    # the motion table's text (none here); the serialised form adds a 16-byte header before and a CRC-32 after
+    # (csrc/fmi/checksum.h), resealed here so that the entry's own check is what refuses the NaN.
     import math
     import struct
+    import zlib
 
     m = Manual(unzipdir, md, "blob")
     m.init()
@@ -275,13 +277,14 @@ def scenario_fmi(fmu):
     state = m.fmu.getFMUstate()
     blob = bytes(m.fmu.serializeFMUstate(state))
     before = m.outputs()
-    omega_at = len(blob) - 8 * 48 + 8 * 9
+    omega_at = len(blob) - 4 - 8 * 48 + 8 * 9
     assert struct.unpack_from("<d", blob, omega_at)[0] == before[0]  # the layout read right: omega is there
     results = {}
     for case in ("nan", "short", "version"):
         bad = bytearray(blob)
         if case == "nan":
             struct.pack_into("<d", bad, omega_at, math.nan)
+            struct.pack_into("<I", bad, len(bad) - 4, zlib.crc32(bytes(bad[:-4])))
         elif case == "short":
             bad = bad[:-8]
         else:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import struct
+import zlib
 
 import pytest
 
@@ -200,4 +201,6 @@ def _edits(blob: bytes):
         if math.isfinite(value) and 1e-3 < abs(value) < 1e3:
             edited = bytearray(blob)
             struct.pack_into("<d", edited, offset, value + 0.5)
+            if blob[:4] == b"SMAC":  # cam.fmu's serialised state: resealed with its CRC-32 (csrc/fmi/checksum.h)
+                struct.pack_into("<I", edited, len(edited) - 4, zlib.crc32(bytes(edited[:-4])))
             yield bytes(edited)

@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 from ..kinematics.presets import PRESETS
-from ..physics.parameters import PARAMETERS, RIGID_ONLY, ParameterSpec
+from ..physics.parameters import MOUNTING_ZERO, PARAMETERS, RIGID_ONLY, ParameterSpec
 from ..physics.variables import EVENT_INDICATORS, INPUT_RANGES, INPUTS, OUTPUTS, STATES
 
 HEADER = "cam_params.h"
@@ -80,6 +80,7 @@ def header_text() -> str:
         f"#define CAM_VR_STATES {n_in + n_out + len(PARAMETERS)}   /* of the first state, after the parameters */",
         f"#define CAM_VR_DERIVATIVES {n_in + n_out + len(PARAMETERS) + len(STATES)}   /* of der(first state) */",
         f"#define CAM_N_EVENT_INDICATORS {EVENT_INDICATORS}   /* Model Exchange's event indicators */",
+        f"#define CAM_MOUNTING_ZERO {c_double(MOUNTING_ZERO)}   /* a mounting's sin/cos this small (x max(1, |angle|)) is 0 */",
         "", "typedef enum { CAM_KIND_REAL = 0, CAM_KIND_BOOLEAN = 1, CAM_KIND_STRING = 2 } CamKind;", "",
         "enum {",
     ]

@@ -68,6 +68,7 @@ _SIGNATURES = {
     "cam_params_set_string": (ctypes.c_int, [_P, ctypes.c_int, ctypes.c_char_p, ctypes.c_size_t, _P]),
     "cam_drive_init": (ctypes.c_int, [_P, _P, _P]),
     "cam_drive_free": (None, [_P]),
+    "cam_drive_set_start_time": (ctypes.c_int, [_P, ctypes.c_double, _P]),
     "cam_drive_set_inputs": (ctypes.c_int, [_P, ctypes.c_double, ctypes.c_double, ctypes.c_double, _P]),
     "cam_drive_do_step": (ctypes.c_int, [_P, ctypes.c_double, ctypes.c_double, ctypes.c_double, ctypes.c_double,
                                          ctypes.c_double, _P]),
@@ -137,10 +138,12 @@ def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any
 class DriveSimulator:
     """One cam drive in the C engine, advanced by ``do_step`` (DriveSimulator's API)."""
 
-    def __init__(self, params: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, params: Mapping[str, Any] | None = None, start_time: float = 0.0) -> None:
+        """A drive from ``params`` whose clock starts at ``start_time`` [s]: the first ``do_step`` is from there."""
         self._lib = lib = engine()
         self._err = CamError()
         self._params = dict(params or {})
+        self._start_time = start_time
         self._drive = None
         raw = ctypes.create_string_buffer(lib.cam_params_sizeof())
         lib.cam_params_defaults(raw)
@@ -153,6 +156,8 @@ class DriveSimulator:
         finally:
             lib.cam_params_free(raw)
         self._drive = drive
+        if start_time != 0.0 and lib.cam_drive_set_start_time(drive, float(start_time), ctypes.byref(self._err)):
+            raise_for(self._err)
         self.values = (ctypes.c_double * N_OUTPUTS).from_address(
             ctypes.addressof(lib.cam_drive_values(drive).contents))
 
@@ -179,7 +184,8 @@ class DriveSimulator:
 
     def do_step(self, t: float, h: float, u: float = INPUT_STARTS["u"],
                 omega_ref: float = INPUT_STARTS["omega_ref"], omega_dot_ref: float = 0.0) -> None:
-        """Advance from t to t + h [s] with the inputs held over the step (FMI co-simulation)."""
+        """Advance from t to t + h [s] with the inputs held over the step (FMI co-simulation). t must be where the
+        drive is (``time``, to 1e-9 max(1, |time|): fmi2DoStep's rule), else SimulationError names both."""
         if self._lib.cam_drive_do_step(self._drive, t, h, u, omega_ref, omega_dot_ref, ctypes.byref(self._err)):
             raise_for(self._err)
 
@@ -191,7 +197,7 @@ class DriveSimulator:
     def reset(self) -> None:
         """Back to the start: a new drive from the same parameters."""
         self.__del__()
-        self.__init__(self._params)
+        self.__init__(self._params, self._start_time)
 
     def state_array(self) -> array:
         """The engine's whole state as its flat array of doubles (cam_model.h, CAM_S_*)."""

@@ -184,7 +184,7 @@ def reference_loop(system: System, stop_time: float | None = None, step_size: fl
     stop = system.stop_time if stop_time is None else float(stop_time)
     h = system.step_size if step_size is None else float(step_size)
     n = _n_steps(start, stop, h)
-    cam = DriveSimulator(resolve(system.components["cam"].parameters))
+    cam = DriveSimulator(resolve(system.components["cam"].parameters), start_time=start)
     cam_inputs = dict(INPUT_STARTS)
     cam.set_inputs(**cam_inputs)
     ctrl = PiSpeedController(system.components["controller"].parameters)

@@ -35,13 +35,13 @@ from . import binaries, macho, model_description, model_description3, pi_codegen
 PACKAGE_DIR = engine_build.HERE.parent  # cam_fmu/
 FMI = engine_build.CSRC / "fmi"
 CONTROL_CSRC = PACKAGE_DIR / "control" / "csrc"
-# The FMI glue of each version, for every model: the glue both versions share and the version's own files
-# (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0: co-simulation); its official headers
-# (vendored: engine_build.fmi_headers).
-SHARED_GLUE = (FMI / "glue.c", FMI / "glue_me.c")
+# The FMI glue of each version, for every model: the glue both versions share (with the saved states'
+# checksum) and the version's own files (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0:
+# co-simulation); its official headers (vendored: engine_build.fmi_headers).
+SHARED_GLUE = (FMI / "glue.c", FMI / "glue_me.c", FMI / "checksum.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
-GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h")
+GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h", FMI / "checksum.h")
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).

@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import RIGID_ONLY, ParameterError, law_spec, resolve
+from .parameters import RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
 
 
 def sign(x: float) -> float:
@@ -146,9 +146,13 @@ class DriveModel:
         self.M_f = p["M_f"] if p["shaft_friction"] else 0.0
         self.m = p["m"] if p["follower_inertia"] else 0.0
         G = p["G"] if p["gravity"] else 0.0
-        self.F_gx = G * math.sin(p["gamma"]) * math.cos(p["beta"])  # N, gravity along X
-        self.G_y = G * math.sin(p["gamma"]) * math.sin(p["beta"])  # N, gravity along Y
-        self.N_g = abs(G * math.cos(p["gamma"]))  # N, guide support |N_g|
+        # Each sine and cosine of the mounting is exactly 0 where the angle makes it 0 (docs/model.md 4.1).
+        gamma, beta = p["gamma"], p["beta"]
+        sin_g, cos_g = mounting_component(math.sin(gamma), gamma), mounting_component(math.cos(gamma), gamma)
+        sin_b, cos_b = mounting_component(math.sin(beta), beta), mounting_component(math.cos(beta), beta)
+        self.F_gx = G * sin_g * cos_b  # N, gravity along X
+        self.G_y = G * sin_g * sin_b  # N, gravity along Y
+        self.N_g = abs(G * cos_g)  # N, guide support |N_g|
         self.mu = p["mu"] if p["guide_friction"] else 0.0
         self.r_b = p["r_b"]
         self.c = p["c"] if p["backlash"] else 0.0

@@ -14,6 +14,15 @@ from ..kinematics.presets import PRESETS
 
 KGF = 9.80665  # N per kgf: the paper's c_m = 0.015 is in kgf m/A (docs/model.md section 3)
 PAPER_A = 0.035  # m, the paper's profile constant A
+# A sine or cosine of a mounting angle (gamma, beta) at most MOUNTING_ZERO * max(1, |angle|) in magnitude is
+# exactly 0: the angle is a multiple of 90 deg to within a few of its rounding units (sin(pi) = 1.2e-16 in
+# doubles is no force; docs/model.md section 4.1). 4 x 2^-52.
+MOUNTING_ZERO = 4.0 * 2.220446049250313e-16
+
+
+def mounting_component(value: float, angle: float) -> float:
+    """sin or cos ``value`` of the mounting angle ``angle`` [rad], 0 where the angle makes it 0 (MOUNTING_ZERO)."""
+    return 0.0 if abs(value) <= MOUNTING_ZERO * max(1.0, abs(angle)) else value
 
 
 class ParameterError(ValueError):

@@ -129,6 +129,20 @@ class _Consistent:
             # an angle below 4 pi, not on the unbounded theta (long runs keep their accuracy).
             base = 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
             names = list(hybrid.event_names(mode))
+            due = self._due(y[:n], u_now, mode, names)
+            if due is not None:
+                # An event function below zero at the start: it jumped there, which solve_ivp's crossing
+                # search cannot see. The side force N_r does at a breakpoint where s'' jumps (every row of a
+                # motion table): its transition applies now, as the C engine's at a step's start.
+                stalled = stalled + 1 if t <= t_event_last else 0
+                t_event_last = t
+                if stalled > 1000:
+                    raise RuntimeError(f"reference integration: more than 1000 events at t = {t!r} s "
+                                       f"without progress (last mode {mode})")
+                events_seen += 1
+                hybrid.apply_event(y, u_now, mode, due)
+                input_changed = False
+                continue
             funcs = [self._event(k, mode, base) for k in range(len(names))]
             if not mode.stuck:
                 target = self._next_breakpoint(y[0], mode.direction)
@@ -167,10 +181,25 @@ class _Consistent:
                 y = list(sol.y_events[k][0])
                 y[0] += base
                 events_seen += 1
+                if not mode.stuck and abs(target - y[0]) <= 1e-12 * max(1.0, abs(target)):
+                    # At the breakpoint: go on from just past it, as the C engine ends its step there. A root
+                    # located a rounding short of it lies where s'' is still the piece's before (the left
+                    # limit), and an event caused by the jump there (N_r's sign at a motion table's row)
+                    # would be applied on the wrong side of its cause.
+                    past = target + mode.direction * 1e-15 * max(1.0, abs(target))
+                    if mode.direction * (past - y[0]) > 0.0:
+                        y[0] = past
                 if names[k] != "breakpoint":
                     hybrid.apply_event(y, u.value(t), mode, names[k])
         self.events_seen = events_seen
         return _collect(rows, grid)
+
+    def _due(self, y, u: float, mode, names: list[str]) -> str | None:
+        """The first event whose function is already below zero at the state y (it jumped there), or None."""
+        for name, value in zip(names, self.hybrid.event_values(y, u, mode)):
+            if value < 0.0:
+                return name
+        return None
 
     def _atol(self, size: int) -> list[float]:
         tol = [self.atol] * size

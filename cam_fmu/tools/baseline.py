@@ -36,7 +36,10 @@ step to step, so a difference at any step (a constant, an operation order, an ev
 step later, a changed step size of rk45) shows in every later sample: sampling loses nothing
 but the step at which a divergence began. Floats are written by ``json`` with ``repr``, which
 round-trips exactly. The files also hold the Python, numpy, scipy and hypothesis versions
-(the first records also the Cython version of the engine they recorded) and the git commit.
+(the first records also the Cython version of the engine they recorded) and the git commit the
+record was made at; a change of the engine that moves answers on purpose re-records only the cases
+it moves, and the file's "re_recorded" list names them with the commit they were re-recorded on and
+why (``load`` reads it; ``write`` records everything anew).
 
 The comparison (``compare``): every recorded sample to RTOL = 1e-12 relative, where a value
 below ZERO = 1e-3 of its output's scale (the largest |value| of that output over the case's

@@ -356,7 +356,7 @@ int cam_exchange_completed_step(CamExchange *e, int *enter_event)
         e->book_time = d->time;
         e->book_u = d->u;
         cam_energy_excess(&d->budget, out, &excess, &tolerance);
-        if (excess - tolerance > 0.0)
+        if (cam_energy_created(&d->budget, out))
             return fail(e, CAM_ERR_SIMULATION, "the state at t = %g s holds %.6g J more energy than the source "
                         "delivered (tolerance %.3g J): energy was created, the result cannot be trusted; reduce the "
                         "host's step size or tighten its tolerance", d->time, excess, tolerance);

@@ -8,10 +8,11 @@
 #include <string.h>
 
 #include "glue.h"
+#include "checksum.h"
 
 #define MESSAGE_MAX 1024              /* a log line is cut here (a 20 MB bad value is not echoed whole) */
 #define STATE_HEADER 16               /* magic, format, payload size (8 bytes) */
-#define STATE_FORMAT 1u
+#define STATE_FORMAT 2u             /* 2: a CRC-32 after the payload (checksum.h) */
 /* |currentCommunicationPoint - the FMU's time| allowed: rounding of a host's summed steps */
 #define TIME_SLACK(t) (1e-9 * (fabs(t) > 1.0 ? fabs(t) : 1.0))
 
@@ -407,7 +408,7 @@ int glue_restore(Glue *g, const GlueSaved *saved, const char *call)
 
 size_t glue_serialized_size(const GlueSaved *saved)
 {
-    return STATE_HEADER + saved->size;
+    return STATE_HEADER + saved->size + CHECKSUM_BYTES;
 }
 
 static void put_u32(unsigned char *p, unsigned long v)
@@ -430,13 +431,14 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
 {
     if (!saved || !out)
         return glue_fail(g, call, "the FMU state and the buffer must not be NULL");
-    if (size < STATE_HEADER + saved->size)
+    if (size < STATE_HEADER + saved->size + CHECKSUM_BYTES)
         return glue_fail(g, call, "the buffer is smaller than the serialised state's size");
     put_u32(out, g->model->state_magic);
     put_u32(out + 4, STATE_FORMAT);
     put_u32(out + 8, (unsigned long)(saved->size & 0xffffffffu));
     put_u32(out + 12, saved->mode);
     memcpy(out + STATE_HEADER, saved->bytes, saved->size);
+    checksum_append(out, STATE_HEADER + saved->size);
     return GLUE_OK;
 }
 
@@ -447,13 +449,17 @@ int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **
     unsigned mode;
     if (!in || !saved)
         return glue_fail(g, call, "the arguments must not be NULL");
-    if (size < STATE_HEADER || get_u32(in) != g->model->state_magic || get_u32(in + 4) != STATE_FORMAT) {
+    if (size < STATE_HEADER + CHECKSUM_BYTES || get_u32(in) != g->model->state_magic
+        || get_u32(in + 4) != STATE_FORMAT) {
         glue_log(g, GLUE_ERROR, "logStatusError", "%s: these bytes are not a serialised %s state (format %u)", call,
                  g->model->name, STATE_FORMAT);
         return GLUE_ERROR;
     }
+    if (!checksum_valid(in, size - CHECKSUM_BYTES))
+        return glue_fail(g, call, "the serialised state is corrupt: its CRC-32 does not match its bytes (changed "
+                         "or truncated since it was serialised)");
     payload = get_u32(in + 8);
-    if (payload != size - STATE_HEADER)
+    if (payload != size - STATE_HEADER - CHECKSUM_BYTES)
         return glue_fail(g, call, "the serialised state is truncated or has trailing bytes");
     mode = (unsigned)get_u32(in + 12);
     if (mode != 0u && mode != GLUE_EVENT_MODE && mode != GLUE_CONTINUOUS_TIME_MODE)

@@ -394,6 +394,7 @@ int cam_instance_initialize(CamInstance *d, double start_time)
     if ((status = cam_params_check(&d->params, &err)) != CAM_OK || (status = cam_drive_init(&d->drive, &d->params, &err)) != CAM_OK)
         return refuse(d, &err);
     d->drive.time = start_time;
+    d->drive.start_time = start_time;
     if ((status = cam_drive_set_inputs(&d->drive, d->inputs[CAM_I_U], d->inputs[CAM_I_OMEGA_REF],
                                        d->inputs[CAM_I_OMEGA_DOT_REF], &err)) != CAM_OK) {
         cam_drive_free(&d->drive);
@@ -576,6 +577,7 @@ int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t siz
         /* the usual case, a state of this instance: the drive's program is kept, not built again */
         CamDrive backup = d->drive;
         cam_params_free(&params);
+        d->drive.start_time = start_time;
         if (cam_drive_set_state(&d->drive, state, &err) != CAM_OK) {
             d->drive = backup;
             return refuse(d, &err);
@@ -586,6 +588,7 @@ int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t siz
             cam_params_free(&params);
             return refuse(d, &err);
         }
+        fresh.start_time = start_time;
         if (cam_drive_set_state(&fresh, state, &err) != CAM_OK) {
             cam_drive_free(&fresh);
             cam_params_free(&params);

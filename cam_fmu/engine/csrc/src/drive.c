@@ -32,6 +32,19 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     return CAM_OK;
 }
 
+int cam_drive_set_start_time(CamDrive *d, double t0, CamError *err)
+{
+    char shown[40];
+    if (!(isfinite(t0) && fabs(t0) <= 1e15))
+        return cam_error(err, CAM_ERR_SIMULATION, "start time = %s s: allowed a finite time in [-1e15, 1e15] s",
+                         cam_num(t0, shown));
+    if (d->time != d->start_time || d->steps_taken != 0 || d->have_budget)
+        return cam_error(err, CAM_ERR_SIMULATION, "the start time is set before the first step (the drive is at "
+                         "t = %g s)", d->time);
+    d->time = d->start_time = t0;
+    return CAM_OK;
+}
+
 void cam_drive_free(CamDrive *d)
 {
     cam_model_free(&d->model);
@@ -101,6 +114,9 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
     long steps = 0;
     int status, verdict, opened = 0;
     CamEnergy opening;
+    if (!isfinite(t) || fabs(t - d->time) > CAM_TIME_SLACK(d->time))
+        return cam_error(err, CAM_ERR_SIMULATION, "communication point t = %.17g s is not where the drive is, "
+                         "t = %.17g s (allowed difference %.3g s)", t, d->time, CAM_TIME_SLACK(d->time));
     if (!(h > 0.0 && isfinite(h)))
         return cam_error(err, CAM_ERR_SIMULATION, "communication step size = %s s: allowed (0, inf)",
                         cam_num(h, shown));

@@ -319,6 +319,13 @@ static int check_compliant(const CamModel *model, CamError *err)
     return CAM_OK;
 }
 
+/* The sine or cosine `value` of a mounting angle [rad], exactly 0 where the angle makes it 0 to within a few of
+ * its rounding units (parameters.mounting_component; docs/model.md 4.1): sin(pi) = 1.2e-16 is no force. */
+static double mounting(double value, double angle)
+{
+    return fabs(value) <= CAM_MOUNTING_ZERO * fmax(1.0, fabs(angle)) ? 0.0 : value;
+}
+
 int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
 {
     const double *v;
@@ -346,9 +353,9 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->M_f = v[CAM_P_SHAFT_FRICTION] != 0.0 ? v[CAM_P_M_F] : 0.0;
     model->m = v[CAM_P_FOLLOWER_INERTIA] != 0.0 ? v[CAM_P_M] : 0.0;
     G = v[CAM_P_GRAVITY] != 0.0 ? v[CAM_P_G] : 0.0;
-    model->F_gx = G * sin(v[CAM_P_GAMMA]) * cos(v[CAM_P_BETA]);
-    model->G_y = G * sin(v[CAM_P_GAMMA]) * sin(v[CAM_P_BETA]);
-    model->N_g = fabs(G * cos(v[CAM_P_GAMMA]));
+    model->F_gx = G * mounting(sin(v[CAM_P_GAMMA]), v[CAM_P_GAMMA]) * mounting(cos(v[CAM_P_BETA]), v[CAM_P_BETA]);
+    model->G_y = G * mounting(sin(v[CAM_P_GAMMA]), v[CAM_P_GAMMA]) * mounting(sin(v[CAM_P_BETA]), v[CAM_P_BETA]);
+    model->N_g = fabs(G * mounting(cos(v[CAM_P_GAMMA]), v[CAM_P_GAMMA]));
     model->mu = v[CAM_P_GUIDE_FRICTION] != 0.0 ? v[CAM_P_MU] : 0.0;
     model->r_b = v[CAM_P_R_B];
     model->c = v[CAM_P_BACKLASH] != 0.0 ? v[CAM_P_C] : 0.0;

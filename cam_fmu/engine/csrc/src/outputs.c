@@ -1,5 +1,5 @@
 /* Outputs of the consistent formulation and the guards every published state passes: finite, the
- * follower within the clearance, the energy bound (physics/energy.py; docs/model.md section 9). */
+ * follower within the clearance, the energy bound (docs/model.md section 9). */
 #include <math.h>
 
 #include "cam_model.h"
@@ -107,9 +107,16 @@ void cam_energy_excess(const CamEnergy *e, const double out[], double *excess, d
     *tolerance = CAM_ENERGY_SLACK * scale;
 }
 
+int cam_energy_created(const CamEnergy *e, const double out[])
+{
+    double excess, tolerance;
+    cam_energy_excess(e, out, &excess, &tolerance);
+    return !(excess <= tolerance && isfinite(excess) && isfinite(tolerance));   /* an overflowed energy: created */
+}
+
 int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, double u, double h)
 {
-    double total = 0.0, excess, tolerance;
+    double total = 0.0;
     int k;
     for (k = 0; k < CAM_N_OUTPUTS; k++)
         total += out[k];
@@ -119,8 +126,7 @@ int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, do
         return CAM_PUBLISH_CLEARANCE;
     if (budget != NULL) {
         cam_energy_step(budget, u, h, out[CAM_O_THETA_M], out[CAM_O_I]);
-        cam_energy_excess(budget, out, &excess, &tolerance);
-        if (excess - tolerance > 0.0)
+        if (cam_energy_created(budget, out))
             return CAM_PUBLISH_ENERGY;
     }
     return CAM_PUBLISH_OK;

@@ -93,6 +93,9 @@ static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double ome
     (void)u;
     (void)omega_dot_ref;
     d->speed.speed = omega_ref;
+    if (omega_ref == 0.0)   /* at rest from now: the follower lies where the force along the stroke pushes it, as at
+                               the end of a step that stops (the reference: at every output time with omega = 0) */
+        d->speed.s = rest_position(&d->model, d->speed.theta, d->speed.s);
 }
 
 static int speed_advance(CamDrive *d, double h, double time, long *steps, CamError *err)

@@ -51,11 +51,122 @@ void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
 static const char *const ENTRY[] = {"version", "formulation", "time", "u", "omega_ref", "omega_dot_ref", "h_next",
                                     "steps_taken"};
 
+/* The entries into the drive, unchecked (cam_drive_set_state checks first). */
+static void apply_state(CamDrive *d, const double s[CAM_STATE_LEN], const CamMode *mode)
+{
+    d->stale = 1;
+    d->time = s[CAM_S_TIME];
+    d->u = s[CAM_S_U];
+    d->omega_ref = s[CAM_S_OMEGA_REF];
+    d->omega_dot_ref = s[CAM_S_OMEGA_DOT_REF];
+    d->solver.h_next = s[CAM_S_H_NEXT];
+    d->solver.k1_valid = 0;
+    d->steps_taken = (long)s[CAM_S_STEPS_TAKEN];
+    memcpy(d->x, s + CAM_S_X, sizeof d->x);
+    d->mode = *mode;
+    d->form_u = s[CAM_S_FORM_U];
+    d->paper.theta = s[CAM_S_PAPER + 0];
+    d->paper.omega = s[CAM_S_PAPER + 1];
+    d->paper.i = s[CAM_S_PAPER + 2];
+    d->paper.J = s[CAM_S_PAPER + 3];
+    d->paper.M = s[CAM_S_PAPER + 4];
+    d->paper.s = s[CAM_S_PAPER + 5];
+    d->paper.v = s[CAM_S_PAPER + 6];
+    d->paper.a = s[CAM_S_PAPER + 7];
+    d->paper.alpha = s[CAM_S_PAPER + 8];
+    d->paper.voltage = s[CAM_S_PAPER + 9];
+    d->paper.M_l = s[CAM_S_PAPER + 10];
+    d->speed.theta = s[CAM_S_SPEED + 0];
+    d->speed.s = s[CAM_S_SPEED + 1];
+    d->speed.speed = s[CAM_S_SPEED + 2];
+    d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
+    if (d->have_budget) {
+        const double *out = cam_drive_outputs(d);
+        cam_energy_init(&d->budget, &d->model, out);
+        d->budget.work_in = s[CAM_S_WORK_IN];
+        d->budget.work_abs = s[CAM_S_WORK_ABS];
+        d->budget.theta = s[CAM_S_BUDGET_THETA];
+        d->budget.i = s[CAM_S_BUDGET_I];
+        d->budget.e_mech0 = s[CAM_S_E_MECH0];
+        d->budget.e_mag0 = s[CAM_S_E_MAG0];
+    }
+}
+
+/* The entries against each other and against the drive's parameters (docs/fmu.md, saved states): each rule
+ * that fails is named. A state that passes every entry's own check can still be none the drive can be in. */
+static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], const CamMode *mode, CamError *err)
+{
+    const CamModel *m = &d->model;
+    const double *x = s + CAM_S_X;
+    char a[40], b[40];
+    if (s[CAM_S_TIME] < d->start_time - CAM_TIME_SLACK(d->start_time))
+        return cam_error(err, CAM_ERR_SIMULATION, "state time %s s is before the drive's start time %s s",
+                         cam_num(s[CAM_S_TIME], a), cam_num(d->start_time, b));
+    if (!m->has_current && x[CAM_CURRENT] != 0.0)
+        return cam_error(err, CAM_ERR_SIMULATION, "state current i = %s A, but this drive has no inductance "
+                         "(L = 0: the current is no state, its slot holds 0)", cam_num(x[CAM_CURRENT], a));
+    if (!m->compliant && (x[CAM_TWIST] != 0.0 || x[CAM_OMEGA_M] != 0.0))
+        return cam_error(err, CAM_ERR_SIMULATION, "state twist %s rad and rotor speed %s rad/s, but this drive's "
+                         "shaft is rigid (k_shaft = 0: their slots hold 0)", cam_num(x[CAM_TWIST], a),
+                         cam_num(x[CAM_OMEGA_M], b));
+    if (s[CAM_S_HAVE_BUDGET] != 0.0 && !d->form->energy_bounded)
+        return cam_error(err, CAM_ERR_SIMULATION, "state has an energy account, but the %s drive keeps none",
+                         d->form->name);
+    if (m->formulation != CAM_FORM_CONSISTENT)
+        return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */
+    if (mode->stuck && x[CAM_OMEGA] != 0.0)
+        return cam_error(err, CAM_ERR_SIMULATION, "state mode 'stuck' (held by static friction) with omega = %s "
+                         "rad/s: a held shaft has omega = 0", cam_num(x[CAM_OMEGA], a));
+    if (!mode->stuck && mode->direction * x[CAM_OMEGA] < 0.0)
+        return cam_error(err, CAM_ERR_SIMULATION, "state direction %+g with omega = %s rad/s: a moving shaft's "
+                         "direction is the sign of omega", mode->direction, cam_num(x[CAM_OMEGA], a));
+    if (!m->backlash && mode->contact != 1)
+        return cam_error(err, CAM_ERR_SIMULATION, "state contact %d, but this drive has no backlash (c = 0: the "
+                         "follower is always engaged, contact +1)", mode->contact);
+    if (mode->contact == 0) {
+        double dd[4];
+        cam_profile_eval(&m->profile, x[CAM_THETA], dd);
+        if (fabs(mode->s_free - dd[0]) > m->c * (1.0 + 1e-9) + 1e-12)
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower position s_free = %s m is %.6g m from the "
+                             "cam at theta = %g rad, beyond the clearance c = %g m", cam_num(mode->s_free, a),
+                             fabs(mode->s_free - dd[0]), x[CAM_THETA], m->c);
+    }
+    return CAM_OK;
+}
+
+/* The restored state as the guards of a step would see it: finite outputs, the follower within the clearance,
+ * no energy created (a copy of the account books nothing more: h = 0). */
+static int publishable_state(CamDrive *d, CamError *err)
+{
+    const double *out = cam_drive_outputs(d);
+    CamEnergy books = d->budget;
+    char shown[40];
+    int k, verdict = cam_publishable(&d->model, out, d->have_budget ? &books : NULL, d->u, 0.0);
+    if (verdict == CAM_PUBLISH_NOT_FINITE) {
+        for (k = 0; k < CAM_N_OUTPUTS - 1 && isfinite(out[k]); k++)
+            ;
+        return cam_error(err, CAM_ERR_SIMULATION, "the state's output '%s' = %s: the state is none the drive can "
+                         "reach (its entries are too large)", cam_output_spec(k)->name, cam_num(out[k], shown));
+    }
+    if (verdict == CAM_PUBLISH_CLEARANCE)
+        return cam_error(err, CAM_ERR_SIMULATION, "the state's follower is %.6g m from the cam, beyond the "
+                         "clearance c = %g m", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]), d->model.c);
+    if (verdict == CAM_PUBLISH_ENERGY) {
+        double excess, tolerance;
+        cam_energy_excess(&books, out, &excess, &tolerance);
+        return cam_error(err, CAM_ERR_SIMULATION, "the state holds %.6g J more energy than its account says the "
+                         "source delivered (tolerance %.3g J): its entries disagree", excess, tolerance);
+    }
+    return CAM_OK;
+}
+
 int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *err)
 {
     char shown[40];
-    int k;
-    CamMode mode;
+    int k, status;
+    CamMode mode, mode_before;
+    double before[CAM_STATE_LEN], values[CAM_N_OUTPUTS];
+    int stale;
     if (s[CAM_S_VERSION] != CAM_STATE_VERSION)
         return cam_error(err, CAM_ERR_SIMULATION, "state version %s: this engine reads version %g",
                         cam_num(s[CAM_S_VERSION], shown), CAM_STATE_VERSION);
@@ -83,45 +194,19 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
         || (s[CAM_S_HAVE_BUDGET] != 0.0 && s[CAM_S_HAVE_BUDGET] != 1.0))
         return cam_error(err, CAM_ERR_SIMULATION, "state mode (stuck %g, direction %g, contact %g, side %g) is not a "
                         "valid mode", s[CAM_S_STUCK], s[CAM_S_DIRECTION], s[CAM_S_CONTACT], s[CAM_S_SIDE]);
-    d->stale = 1;
-    d->time = s[CAM_S_TIME];
-    d->u = s[CAM_S_U];
-    d->omega_ref = s[CAM_S_OMEGA_REF];
-    d->omega_dot_ref = s[CAM_S_OMEGA_DOT_REF];
-    d->solver.h_next = s[CAM_S_H_NEXT];
-    d->solver.k1_valid = 0;
-    d->steps_taken = (long)s[CAM_S_STEPS_TAKEN];
-    memcpy(d->x, s + CAM_S_X, sizeof d->x);
-    if (!d->model.has_current)
-        d->x[CAM_CURRENT] = 0.0;
-    if (!d->model.compliant)
-        d->x[CAM_TWIST] = d->x[CAM_OMEGA_M] = 0.0;
-    d->mode = mode;
-    d->form_u = s[CAM_S_FORM_U];
-    d->paper.theta = s[CAM_S_PAPER + 0];
-    d->paper.omega = s[CAM_S_PAPER + 1];
-    d->paper.i = s[CAM_S_PAPER + 2];
-    d->paper.J = s[CAM_S_PAPER + 3];
-    d->paper.M = s[CAM_S_PAPER + 4];
-    d->paper.s = s[CAM_S_PAPER + 5];
-    d->paper.v = s[CAM_S_PAPER + 6];
-    d->paper.a = s[CAM_S_PAPER + 7];
-    d->paper.alpha = s[CAM_S_PAPER + 8];
-    d->paper.voltage = s[CAM_S_PAPER + 9];
-    d->paper.M_l = s[CAM_S_PAPER + 10];
-    d->speed.theta = s[CAM_S_SPEED + 0];
-    d->speed.s = s[CAM_S_SPEED + 1];
-    d->speed.speed = s[CAM_S_SPEED + 2];
-    d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
-    if (d->have_budget) {
-        const double *out = cam_drive_outputs(d);
-        cam_energy_init(&d->budget, &d->model, out);
-        d->budget.work_in = s[CAM_S_WORK_IN];
-        d->budget.work_abs = s[CAM_S_WORK_ABS];
-        d->budget.theta = s[CAM_S_BUDGET_THETA];
-        d->budget.i = s[CAM_S_BUDGET_I];
-        d->budget.e_mech0 = s[CAM_S_E_MECH0];
-        d->budget.e_mag0 = s[CAM_S_E_MAG0];
+    if ((status = consistent_entries(d, s, &mode, err)) != CAM_OK)
+        return status;
+    /* the drive as it is, to put back if the restored state fails the guards of a published one */
+    cam_drive_get_state(d, before);
+    mode_before = d->mode;
+    memcpy(values, d->values, sizeof values);
+    stale = d->stale;
+    apply_state(d, s, &mode);
+    if ((status = publishable_state(d, err)) != CAM_OK) {
+        apply_state(d, before, &mode_before);
+        memcpy(d->values, values, sizeof values);
+        d->stale = stale;
+        return status;
     }
     return CAM_OK;
 }
