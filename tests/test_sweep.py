@@ -90,6 +90,53 @@ def test_a_failing_case_keeps_every_row_and_is_named(cam_fmu_path, tmp_path, whe
     assert "Traceback" not in proc.stderr and "distributed" not in proc.stderr, proc.stderr
 
 
+def test_the_fmi3_fmu_sweeps_as_cam_fmu(serial, tmp_path):
+    """`sweep --fmu models/cam3.fmu` failed every case ("Cannot find shared library .../linux64/cam.so": an FMI 3.0
+    FMU run as 2.0). The same engine behind FMI 3.0: the same table to the bit; a failing case through it keeps
+    the FMU's own message (fmi3 logMessage), as through cam.fmu."""
+    from conftest import _build_fmu
+
+    cam3 = _build_fmu(tmp_path / "cam3.fmu", "cam3")
+    assert _sweep(cam3, tmp_path / "out", "--serial") == serial
+    out = tmp_path / "failing"
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(cam3), "--out", str(out),
+                           "--serial"], capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=600)
+    assert proc.returncode == 1, proc.stderr[-3000:]
+    with open(out / "paper_fig6_sweep.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert [r[2] for r in rows[1:]] == ["ok", "failed", "ok"] and "max_steps = 1 internal steps" in rows[2][3]
+
+
+def _rewritten(fmu: Path, dest: Path, change) -> Path:
+    """A copy of ``fmu`` whose modelDescription.xml is ``change(text)``."""
+    import zipfile
+
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(dest, "w") as out:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            out.writestr(item, change(data.decode()) if item.filename == "modelDescription.xml" else data)
+    return dest
+
+
+@pytest.mark.parametrize("kind, words", [
+    ("fmi1", "an FMI 1.0 FMU; runnable are FMI 2.0 and 3.0 co-simulation FMUs"),
+    ("model exchange only", "an FMI 2.0 FMU without co-simulation (Model Exchange only)"),
+])
+def test_an_fmu_that_cannot_run_is_refused_before_any_case_naming_its_version(cam_fmu_path, tmp_path, kind, words):
+    import re
+
+    if kind == "fmi1":
+        fmu = _rewritten(cam_fmu_path, tmp_path / "v1.fmu", lambda t: t.replace('fmiVersion="2.0"', 'fmiVersion="1.0"'))
+    else:
+        fmu = _rewritten(cam_fmu_path, tmp_path / "me.fmu",
+                         lambda t: re.sub(r"<CoSimulation.*?(/>|</CoSimulation>)", "", t, flags=re.S))
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(fmu), "--out", str(out),
+                           "--serial"], capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=300)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert words in proc.stderr and not out.exists()
+
+
 def test_vary_drive_is_checked_as_simulate_checks_it(tmp_path):
     """--vary drive=speed on a voltage scene: refused up front, with simulate's own message."""
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "sweep", "paper_fig6", "--vary",

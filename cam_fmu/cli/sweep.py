@@ -47,7 +47,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..experiments.fmu_file import ensure_fmu
+    from ..experiments.fmu_file import check_cam_variables, ensure_fmu
     from ..experiments.progress import ProgressBar
     from ..experiments.scenes import find_scene
     from ..experiments.sweep import (METRICS, SweepError, cases, check_cases, failed, parse_vary, plot_table,
@@ -69,7 +69,7 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {args.out!r} exists and is not a directory")
-    fmu = ensure_fmu(args.fmu, log=lambda m: print(m, file=sys.stderr))
+    fmu = check_cam_variables(ensure_fmu(args.fmu, log=lambda m: print(m, file=sys.stderr)))  # before any case
     scene_ref = str(scene.path.resolve()) if scene.path else args.scene
     engine = "serial" if args.serial else (args.scheduler or f"local cluster, {args.workers or 'one per core'} workers")
     print(f"# {scene.name}: {n_cases} cases on {engine}", file=sys.stderr)
