@@ -137,6 +137,43 @@ def test_an_fmu_that_cannot_run_is_refused_before_any_case_naming_its_version(ca
     assert words in proc.stderr and not out.exists()
 
 
+LONG = ["sweep", "paper_fig6", "--vary", "m=0.2:0.6:400", "--metric", "final_omega", "--stop-time", "10",
+        "--no-plot"]
+
+
+@pytest.mark.parametrize("where", [["--serial"], ["--workers", "2"]], ids=["serial", "workers"])
+def test_an_interrupt_keeps_the_finished_cases_and_says_so_on_one_line(cam_fmu_path, tmp_path, where):
+    """Ctrl-C (SIGINT to the process group, the dask workers included) once a few cases have finished: exit 130,
+    no traceback (KeyboardInterrupt, dask's CancelledError), one line naming what was kept, and the table holds
+    exactly the finished cases, each with the numbers a run of that case alone gives."""
+    from conftest import interrupt_after_progress
+
+    out = tmp_path / "out"
+    status, stderr = interrupt_after_progress([sys.executable, "-m", "cam_fmu.cli", *LONG, "--fmu",
+                                               str(cam_fmu_path), "--out", str(out), *where], 3, tmp_path, _env())
+    assert status == 130, stderr[-3000:]
+    assert "Traceback" not in stderr and "Error" not in stderr and "WARNING" not in stderr, stderr[-3000:]
+    last = stderr.strip().splitlines()[-1]
+    kept = int(last.split("interrupted: ")[1].split(" of ")[0])
+    assert last == f"cam-fmu sweep: interrupted: {kept} of 400 cases finished, kept in {out / 'paper_fig6_sweep.csv'}"
+    assert 3 <= kept < 400
+    with open(out / "paper_fig6_sweep.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["m [kg]", "final_omega [rad/s]", "status", "message"] and len(rows) == 1 + kept
+    masses = [float(r[0]) for r in rows[1:]]
+    assert masses == sorted(masses) and all(r[2] == "ok" for r in rows[1:])
+    if where == ["--serial"]:  # serial: the first cases, in order
+        assert masses == [float(v) for v in parse_vary("m=0.2:0.6:400").values[:kept]]
+    again = tmp_path / "again"  # two of the kept cases, run on their own
+    picked = f"m={rows[1][0]},{rows[-1][0]}"
+    subprocess.run([sys.executable, "-m", "cam_fmu.cli", *LONG[:2], "--vary", picked, *LONG[4:], "--fmu",
+                    str(cam_fmu_path), "--out", str(again), "--serial"], check=True, capture_output=True,
+                   env=_env(), cwd=tmp_path, timeout=600)
+    with open(again / "paper_fig6_sweep.csv", newline="") as fh:
+        alone = list(csv.reader(fh))[1:]
+    assert alone == [rows[1], rows[-1]]
+
+
 def test_vary_drive_is_checked_as_simulate_checks_it(tmp_path):
     """--vary drive=speed on a voltage scene: refused up front, with simulate's own message."""
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "sweep", "paper_fig6", "--vary",
