@@ -129,8 +129,7 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
                     u0: float | None = None) -> OperatingPoint:
     """The operating point: frozen at ``theta0`` [rad], else turning under ``u0`` [V] (module docstring). A speed
     drive is refused: its cam speed is the input omega_ref, u plays no part."""
-    drive = dict(params or {}).get("drive", "voltage")
-    if drive == "speed":
+    if dict(params or {}).get("drive", "voltage") != "voltage":  # the speed drive (the parameter's other choice)
         raise ValueError("drive = 'speed': the cam's speed is the input omega_ref and the voltage u plays no part, so "
                          "there is no response from u to measure; a speed drive's response is the voltage (and current) "
                          "it needs for a given omega_ref, its outputs 'voltage' and 'i' (cam-fmu simulate); use "
