@@ -174,6 +174,27 @@ def test_an_interrupt_keeps_the_finished_cases_and_says_so_on_one_line(cam_fmu_p
     assert alone == [rows[1], rows[-1]]
 
 
+def test_a_local_cluster_says_nothing_when_the_dashboard_port_is_taken(cam_fmu_path, tmp_path):
+    """Another dask cluster on the machine holds 8787 (distributed's default port for the scheduler's HTTP server):
+    the sweep's stderr carries only its own lines, no UserWarning about the port (seen while tests ran in parallel)."""
+    import socket
+
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen()
+    except OSError:  # already taken by another process: the very condition of this test
+        pass
+    try:
+        proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(cam_fmu_path), "--out",
+                               str(tmp_path / "out"), "--workers", "2"], capture_output=True, text=True, env=_env(),
+                              cwd=tmp_path, timeout=600)
+    finally:
+        holder.close()
+    assert proc.returncode == 1
+    assert all(line.startswith(("# ", "cam-fmu sweep: ")) for line in proc.stderr.strip().splitlines()), proc.stderr
+
+
 def test_vary_drive_is_checked_as_simulate_checks_it(tmp_path):
     """--vary drive=speed on a voltage scene: refused up front, with simulate's own message."""
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "sweep", "paper_fig6", "--vary",

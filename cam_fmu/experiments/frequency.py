@@ -2,14 +2,17 @@
 the operating points, the linearised drive and its analytic response; docs/control.md section 5).
 
 ``measured_response`` runs the C engine (DriveSimulator.run) with u = u0 + a sin(2 pi f t), held
-over HOLDS_PER_PERIOD steps per period, each split into OUTPUTS_PER_HOLD communication steps, lets
-it settle for the longer of SETTLE_PERIODS periods and SETTLE_TIME_CONSTANTS time constants of the
-slowest pole of the linear model, and fits a + c cos + d sin to the difference of the
+over HOLDS_PER_PERIOD steps per period, lets it settle for the longer of SETTLE_PERIODS periods and
+SETTLE_TIME_CONSTANTS time constants of the slowest pole of the linear model (one communication step
+per held value, in chunks, not kept), splits each held value of the measured periods into
+OUTPUTS_PER_HOLD communication steps, and fits a + c cos + d sin to the difference of the
 speeds with and without the sine over MEASURE_PERIODS periods (at a mean speed: at least two
 turns). The input's first harmonic is that of the staircase actually applied (exact), so the
 hold's half-step delay is not mistaken for the drive's. The amplitude (default 1 mV) must keep
 the response linear: the cam's angle excursion a |H_cam| / (2 pi f) small against the profile's
-detail (at 1 mV and 1 Hz on the shipped compliant scene, 6e-4 rad).
+detail (at 1 mV and 1 Hz on the shipped compliant scene, 6e-4 rad). The work is bounded before
+anything runs (OperatingPoint.reachable, MAX_HOLDS, MAX_INTERNAL_STEPS): a frequency out of reach
+is refused with the range the operating point reaches.
 """
 from __future__ import annotations
 

@@ -233,8 +233,10 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
             n = workers or os.cpu_count() or 1
             if n < 1:
                 raise SweepError(f"--workers {n}: allowed >= 1")
+            # no dashboard; the scheduler's own HTTP server on a free port (its default, 8787, may be taken by
+            # another cluster on the machine: distributed then warns on stderr)
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   host="127.0.0.1")
+                                   host="127.0.0.1", scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
             client = Client(cluster)
     futures: list = []
     try:
