@@ -224,6 +224,8 @@ def test_the_reachable_range_is_where_the_work_is_bounded(settle, window, h_max)
     assert work(hi * 1.001)[0] > MAX_HOLDS or (settle == window == 0.0 and hi > 1e11)  # nothing grows with f
     with pytest.raises(ValueError, match="out of reach"):
         point.check([hi * 1.01])
+    with pytest.raises(ValueError, match="no frequency is reachable"):  # settling alone beyond the internal steps
+        OperatingPoint({"h_max": h_max}, 0.0, 2.0 * MAX_INTERNAL_STEPS * h_max, window, "").check([1.0])
 
 
 def test_a_speed_drive_and_a_negative_amplitude_are_refused_with_their_reason(tmp_path):

@@ -90,13 +90,16 @@ class OperatingPoint:
         and why (``names``: what to call the lowest and the highest frequency in the message)."""
         f_lo, f_hi = self.reachable()
         h_max = float(self.params.get("h_max", _default("h_max")))
+        why = (f"the drive settles over {self.settle:.4g} s before each measurement, {HOLDS_PER_PERIOD} held inputs "
+               f"per period; one run holds at most {MAX_HOLDS:,} inputs and takes at most {MAX_INTERNAL_STEPS:,} "
+               f"internal steps of h_max = {h_max:g} s")
+        if f_lo > f_hi:
+            raise ValueError(f"no frequency is reachable at this operating point ({why}; a larger h_max shortens the "
+                             "work)")
         for name, fk, bad in ((names[0], min(f), min(f) < f_lo), (names[1], max(f), max(f) > f_hi)):
             if bad:
-                raise ValueError(
-                    f"{name} {fk:g} Hz is out of reach at this operating point: reachable {f_lo:.4g} to {f_hi:.4g} Hz "
-                    f"(the drive settles over {self.settle:.4g} s before each measurement, {HOLDS_PER_PERIOD} held "
-                    f"inputs per period; one run holds at most {MAX_HOLDS:,} inputs and takes at most "
-                    f"{MAX_INTERNAL_STEPS:,} internal steps of h_max = {h_max:g} s)")
+                raise ValueError(f"{name} {fk:g} Hz is out of reach at this operating point: reachable {f_lo:.4g} to "
+                                 f"{f_hi:.4g} Hz ({why})")
 
 
 def _default(name: str) -> float:
