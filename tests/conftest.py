@@ -88,3 +88,30 @@ def _no_python_fmu_in_pytest():
     yield
     loaded = [m for m in list(_sys.modules) if m.startswith("pythonfmu")]
     assert not loaded, f"a pythonfmu FMU was loaded into the pytest process ({loaded}): run it in a child process"
+
+
+def interrupt_after_progress(cmd: list[str], done: int, cwd: Path, env: dict, label: str = "") -> tuple[int, str]:
+    """Run ``cmd`` (a `cam-fmu` command drawing its progress bar: CAM_FMU_PROGRESS=1) in its own process group,
+    read its progress on stderr until the bar whose label ends with ``label`` reports ``done`` units finished,
+    then send SIGINT to the whole group, as
+    Ctrl-C in a terminal does. Returns (exit status, stderr). A run that ends before that is returned as it ended
+    (the caller's assertions on the status then fail)."""
+    import os
+    import re
+    import signal
+
+    proc = subprocess.Popen(cmd, cwd=cwd, env={**env, "CAM_FMU_PROGRESS": "1"}, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, start_new_session=True)
+    seen = b""
+    while proc.poll() is None:
+        chunk = os.read(proc.stderr.fileno(), 4096)
+        if not chunk:
+            break
+        seen += chunk
+        counts = [int(m) for m in re.findall(re.escape(label.encode()) + rb" \[[#.]*\] (\d+)/\d+ ", seen)]
+        if counts and counts[-1] >= done:
+            os.killpg(proc.pid, signal.SIGINT)
+            break
+    rest = proc.stderr.read()
+    proc.wait(timeout=600)
+    return proc.returncode, (seen + rest).decode("utf-8", "replace")

@@ -42,6 +42,7 @@ def test_model_description_complete(md_root):
     assert cs.get("canGetAndSetFMUstate") == "true" and cs.get("canSerializeFMUstate") == "true"
     exp = md_root.find("DefaultExperiment")
     assert (float(exp.get("startTime")), float(exp.get("stopTime")), float(exp.get("stepSize"))) == (0.0, 2.0, 1e-3)
+    assert float(exp.get("tolerance")) == parameters.BY_NAME["rtol"].default  # a Model Exchange host's rtol
     units = {u.get("name") for u in md_root.find("UnitDefinitions")}
     variables = md_root.find("ModelVariables").findall("ScalarVariable")
     by_name = {v.get("name"): v for v in variables}
@@ -147,3 +148,14 @@ def test_docs_variable_table_is_the_generated_one():
     from cam_fmu.fmu.model_description import markdown_table
     doc = (Path(__file__).resolve().parents[1] / "docs" / "fmu.md").read_text(encoding="utf-8")
     assert markdown_table().strip() in doc
+
+
+def test_every_fmu_the_project_builds_declares_the_engines_tolerance(cam_fmu_path, pi_speed_fmu_path, tmp_path):
+    """A host that integrates with its own solver reads the DefaultExperiment's tolerance and otherwise runs at
+    its own default (fmpy 1e-5, OMSimulator's own): every FMU declares the engine's rtol (docs/fmu.md)."""
+    from conftest import _build_fmu
+
+    for fmu in (cam_fmu_path, pi_speed_fmu_path, _build_fmu(tmp_path / "cam3.fmu", "cam3")):
+        with zipfile.ZipFile(fmu) as z:
+            exp = ET.fromstring(z.read("modelDescription.xml")).find("DefaultExperiment")
+        assert exp is not None and float(exp.get("tolerance")) == parameters.BY_NAME["rtol"].default, fmu.name

@@ -145,3 +145,33 @@ def test_cli_cosim_writes_csv_with_units_and_figure(ssp, reference, tmp_path):
         column = name.split(" [")[0]
         assert np.allclose(data[:, k], reference[column], rtol=1e-11, atol=1e-12), column
     assert (tmp_path / "speed_loop.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_an_interrupted_cosim_keeps_the_finished_runs_and_the_steps_done(ssp, tmp_path):
+    """Ctrl-C in the second of two runs (SIGINT to the process group; pi_speed.fmu runs Python in this process, where
+    a KeyboardInterrupt inside its doStep was a fatal FMU status and the rows were lost): exit 130, one line, no
+    traceback; the first run's CSV whole, the second's up to the last step, both equal to the in-process loop."""
+    from conftest import interrupt_after_progress
+
+    status, stderr = interrupt_after_progress(
+        [sys.executable, "-m", "cam_fmu.cli", "cosim", str(ssp), "--gains", "1:10,2:20", "--stop-time", "60",
+         "--no-plot", "--out", str(tmp_path)], 3000, tmp_path, {**os.environ, "PYTHONPATH": str(ROOT)},
+        label="kp=2 ki=20")
+    assert status == 130, stderr[-3000:]
+    assert "Traceback" not in stderr and "fatal" not in stderr, stderr[-3000:]
+    last = stderr.strip().splitlines()[-1]
+    second = tmp_path / "speed_loop__kp2_ki20.csv"
+    assert last.startswith("cam-fmu cosim: interrupted at t = ") and last.endswith(
+        f"of 60000 steps): kept in {second}; the 1 runs before it in {tmp_path}"), last
+    system = read_ssp(ssp)
+    for path, gains in ((tmp_path / "speed_loop__kp1_ki10.csv", (1.0, 10.0)), (second, (2.0, 20.0))):
+        with open(path, newline="") as fh:
+            rows = list(csv.reader(fh))
+        data = np.array(rows[1:], dtype=float)
+        steps = len(data) - 1
+        assert steps >= 3000 and (steps == 60000) == (path != second), path
+        assert np.allclose(data[:, 0], np.arange(steps + 1) * 1e-3, rtol=1e-11, atol=1e-12)  # no row lost or doubled
+        system.components["controller"].parameters.update(kp=gains[0], ki=gains[1])
+        twin = reference_loop(system, stop_time=steps * 1e-3)
+        for k, name in enumerate(rows[0][1:], start=1):
+            assert np.allclose(data[:, k], twin[name.split(" [")[0]], rtol=1e-11, atol=1e-12), (path.name, name)

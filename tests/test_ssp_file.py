@@ -112,3 +112,67 @@ def cosim(ssp: Path, cwd: Path) -> subprocess.CompletedProcess:
     assert proc.returncode == 2 and len(lines) == 1 and lines[0].startswith("cam-fmu cosim: error: "), proc.stderr
     assert "Traceback" not in proc.stderr and not (cwd / "out").exists()
     return proc
+
+
+def fmu_with_defaults(path: Path, fmi3: bool = False) -> Path:
+    """A zip that passes for an FMU whose model description declares the defaults drive = 'voltage' (a string),
+    J_m = 1e-5, backlash = false and kp = 1.0 (FMI 2.0 or 3.0 layout)."""
+    if fmi3:
+        variables = ('<String name="drive" causality="parameter"><Start value="voltage"/></String>'
+                     '<Float64 name="J_m" causality="parameter" start="1e-05"/>'
+                     '<Boolean name="backlash" causality="parameter" start="false"/>'
+                     '<Float64 name="kp" causality="parameter" start="1.0"/>')
+    else:
+        variables = ''.join(f'<ScalarVariable name="{n}" causality="parameter"><{k} start="{v}"/></ScalarVariable>'
+                            for n, k, v in (("drive", "String", "voltage"), ("J_m", "Real", "1e-05"),
+                                            ("backlash", "Boolean", "false"), ("kp", "Real", "1.0")))
+    with zipfile.ZipFile(path, "w") as z:
+        z.writestr("modelDescription.xml", f'<fmiModelDescription fmiVersion="{"3.0" if fmi3 else "2.0"}">'
+                                           f'<ModelVariables>{variables}</ModelVariables></fmiModelDescription>')
+    return path
+
+
+def _bindings(ssp: Path) -> dict[str, dict[str, tuple[str, str]]]:
+    """{component: {parameter: (ssv type, value)}} as written in the SSD."""
+    doc = etree.fromstring(zipfile.ZipFile(ssp).read("SystemStructure.ssd"))
+    ssv = "{http://ssp-standard.org/SSP1/SystemStructureParameterValues}"
+    return {c.get("name"): {p.get("name"): (p[0].tag.replace(ssv, ""), p[0].get("value"))
+                            for p in c.iter(f"{ssv}Parameter")}
+            for c in doc.iter(f"{SSD}Component")}
+
+
+@pytest.mark.parametrize("fmi3", [False, True], ids=["FMI 2.0", "FMI 3.0"])
+def test_a_binding_equal_to_the_fmus_default_is_not_written(tmp_path, fmi3):
+    """OMSimulator's importer refuses ssv:String in some versions ("Unknown ParameterBinding-type"): a value equal
+    to the FMU's own default is left out, whatever its type; a value that differs stays (it changes the system)."""
+    cam = fmu_with_defaults(tmp_path / "cam.fmu", fmi3)
+    pi = fmu_with_defaults(tmp_path / "pi.fmu", fmi3)
+    system = speed_loop_system({"drive": "voltage", "J_m": 1e-5, "backlash": False, "k_shaft": 50.0},
+                               {"kp": 1, "ki": 5.0})
+    written = _bindings(write_ssp(system, {"cam": cam, "controller": pi}, tmp_path / "loop.ssp"))
+    assert written["cam"] == {"k_shaft": ("Real", "50.0")}
+    assert written["controller"] == {"ki": ("Real", "5.0")}
+    changed = speed_loop_system({"drive": "speed", "J_m": 2e-5, "backlash": True})
+    written = _bindings(write_ssp(changed, {"cam": cam, "controller": pi}, tmp_path / "changed.ssp"))
+    assert written["cam"] == {"drive": ("String", "speed"), "J_m": ("Real", "2e-05"), "backlash": ("Boolean", "true")}
+
+
+@pytest.mark.parametrize("name, stop", [("compliant_loop", 2.0), ("speed_loop", 2.0)])
+def test_the_shipped_loops_bind_no_default_and_carry_their_own_experiment(name, stop):
+    """compliant_loop.ssp bound cam.fmu's drive = 'voltage' (its default) as an ssv:String, which OMSimulator could
+    not import; the SSD's ssd:DefaultExperiment holds the loop's start and stop time (a run given none takes them)."""
+    from cam_fmu.experiments.fmu_file import ensure_fmu, ensure_ssp
+    from cam_fmu.experiments.ssp import fmu_defaults
+
+    ssp = ensure_ssp(name)
+    written = _bindings(ssp)
+    defaults = {"cam": fmu_defaults(ensure_fmu(None, None, "cam")),
+                "controller": fmu_defaults(ensure_fmu(None, None, "pi_speed"))}
+    for comp, bound in written.items():
+        for pname, (kind, value) in bound.items():
+            assert kind != "String", (comp, pname)
+            assert float(value) != defaults[comp][pname], (comp, pname)
+    doc = etree.fromstring(zipfile.ZipFile(ssp).read("SystemStructure.ssd"))
+    experiment = doc.find(f"{SSD}DefaultExperiment")
+    assert (float(experiment.get("startTime")), float(experiment.get("stopTime"))) == (0.0, stop)
+    assert read_ssp(ssp).stop_time == stop

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 from typing import Sequence
 
@@ -33,13 +34,21 @@ SUBCOMMANDS: tuple[str, ...] = (
 )
 
 
+# A negative number in any notation (-1, -.5, -1e-3, -2.5E+4) is an option's value, not an option: argparse's own
+# test (before Python 3.13) knows no exponent, so `--amplitude -1e-3` was "expected one argument" instead of the
+# command's own range check. No option of cam-fmu looks like a number.
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="cam-fmu", description="Cam motion laws and an electromechanical cam drive FMU.")
+    parser._negative_number_matcher = NEGATIVE_NUMBER  # type: ignore[attr-defined]
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in SUBCOMMANDS:
         module = importlib.import_module(f"{__name__}.{name}")
         sub = module.add_parser(subparsers)
+        sub._negative_number_matcher = NEGATIVE_NUMBER  # type: ignore[attr-defined]
         sub.set_defaults(_run=module.run)
     return parser
 

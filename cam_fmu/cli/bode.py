@@ -6,9 +6,16 @@ small-signal simulation around an operating point: ``--theta DEG`` freezes the c
 angle (held at rest by the voltage that balances gravity; shaft and guide friction and
 backlash off), ``--u0 V`` lets it turn under that constant voltage (default: the frozen angle
 0). With a frozen angle the analytic response of the linearised two-mass system is computed
-beside the measurement, and the largest difference is printed. Writes DIR/<scene>_bode.csv and
-DIR/<scene>_bode.png; ``--json`` prints the summary (operating point, the peaks of |H| and
-where they are, the largest difference to the analytic response) as one JSON object.
+beside the measurement, and the largest difference is printed. Every resonance (local maximum of
+|H|) and anti-resonance (local minimum) of either output on the grid is located: refined on the
+engine by golden-section search to 1e-3 relative in f (control.frequency.locate_extrema), and,
+at a frozen angle, on the analytic curve beside it. Writes DIR/<scene>_bode.csv and
+DIR/<scene>_bode.png (the extrema marked); ``--json`` prints the summary (operating point, the
+extrema with their kind, the largest difference to the analytic response) as one JSON object.
+
+Frequencies out of reach are refused before anything runs, naming the reachable range
+(experiments.frequency.OperatingPoint.reachable: the work of one run is bounded); so is a speed
+drive (drive = 'speed'), whose u plays no part.
 """
 from __future__ import annotations
 
@@ -40,20 +47,29 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args) -> int:
     import numpy as np
 
-    from ..control.frequency import analytic_response
-    from ..experiments.frequency import measured_response
+    from ..control.frequency import EXTREMUM_TOLERANCE, analytic_response, locate_extrema, refine_extremum
+    from ..experiments.frequency import measured_response, operating_point
     from ..experiments.scenes import find_scene
     from .simulate import apply_sets
 
     if not (0.0 < args.fmin < args.fmax and math.isfinite(args.fmax)) or not 2 <= args.points <= 1000:
         raise ValueError(f"--fmin {args.fmin} --fmax {args.fmax} --points {args.points}: allowed "
                          "0 < fmin < fmax < inf and 2 <= points <= 1000")
+    if not (math.isfinite(args.amplitude) and args.amplitude > 0.0):
+        raise ValueError(f"--amplitude {args.amplitude!r} V: allowed > 0")
     scene = apply_sets(find_scene(args.scene), args.set)
     params = scene.primary.params
     f = np.geomspace(args.fmin, args.fmax, args.points)
     theta0 = None if args.u0 is not None else math.radians(args.theta or 0.0)
-    measured = measured_response(params, f, theta0=theta0, u0=args.u0, amplitude=args.amplitude)
+    try:
+        point = operating_point(params, theta0, args.u0)
+    except ValueError as exc:
+        raise ValueError(f"scene {scene.name}: {exc}") from None
+    point.check(f, names=("--fmin", "--fmax"))  # before anything runs or is allocated
+    measured = measured_response(params, f, amplitude=args.amplitude, point=point)
     analytic = analytic_response(params, theta0, f) if theta0 is not None else None
+    extrema = locate_extrema(measured, lambda fk: measured_response(params, [fk], amplitude=args.amplitude,
+                                                                    point=point))
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {args.out!r} exists and is not a directory")
@@ -75,11 +91,23 @@ def run(args) -> int:
     if not args.no_plot:
         from ..plots.bode import plot_bode
 
-        written.append(plot_bode(measured, analytic, f"{scene.name}: {measured.note}", out / f"{scene.name}_bode.png"))
-    summary = {"operating_point": measured.note, "u0": measured.u0, "amplitude": args.amplitude}
-    for name, H in (("motor", measured.motor), ("cam", measured.cam)):
-        k = int(np.argmax(np.abs(H)))
-        summary[f"{name}_peak_gain"], summary[f"{name}_peak_f"] = float(abs(H[k])), float(f[k])
+        curve = None  # the linearised drive's curve drawn densely, through its resonances' peaks
+        if analytic is not None:
+            dense = np.union1d(np.geomspace(args.fmin, args.fmax, 2000), [ex.f for ex in extrema])
+            curve = analytic_response(params, theta0, dense)
+        written.append(plot_bode(measured, curve, f"{scene.name}: {measured.note}", out / f"{scene.name}_bode.png",
+                                 extrema))
+    summary = {"operating_point": measured.note, "u0": measured.u0, "amplitude": args.amplitude,
+               "extremum_tolerance": EXTREMUM_TOLERANCE, "extrema": []}
+    for ex in extrema:
+        entry = {"output": ex.output, "kind": ex.kind, "f": ex.f, "gain": ex.gain}
+        if analytic is not None:  # the same search on the linearised drive's curve, a little wider than the engine's
+            def exact(fk: float, output: str = ex.output) -> float:
+                return abs(getattr(analytic_response(params, theta0, [fk]), output)[0])
+
+            entry["f_analytic"], entry["gain_analytic"], _ = refine_extremum(
+                exact, ex.f / (1.0 + 8 * EXTREMUM_TOLERANCE), ex.f * (1.0 + 8 * EXTREMUM_TOLERANCE), ex.kind, 1e-7)
+        summary["extrema"].append(entry)
     if analytic is not None:
         for name in ("motor", "cam"):
             exact, seen = getattr(analytic, name), getattr(measured, name)
@@ -88,11 +116,17 @@ def run(args) -> int:
         print(json.dumps(summary))
         return 0
     print(measured.note)
-    for name in ("motor", "cam"):
-        line = f"{name} speed: peak {summary[name + '_peak_gain']:.4g} (rad/s)/V at {summary[name + '_peak_f']:.4g} Hz"
-        if analytic is not None:
-            line += f"; largest difference to the analytic response {summary[name + '_difference']:.2e} of its peak"
+    for entry in summary["extrema"]:
+        line = (f"{entry['output']} speed: {entry['kind']} at {entry['f']:.5g} Hz, |H| = {entry['gain']:.4g} (rad/s)/V")
+        if "f_analytic" in entry:
+            line += f" (linearised: {entry['f_analytic']:.5g} Hz, {entry['gain_analytic']:.4g})"
         print(line)
+    if not summary["extrema"]:
+        print(f"no resonance or anti-resonance between {args.fmin:g} and {args.fmax:g} Hz")
+    if analytic is not None:
+        for name in ("motor", "cam"):
+            print(f"{name} speed: largest difference to the analytic response {summary[name + '_difference']:.2e} "
+                  "of its peak")
     for path in written:
         print(path)
     sys.stdout.flush()

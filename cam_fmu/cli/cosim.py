@@ -8,6 +8,10 @@ DIR/<system>.png (speed error and armature voltage). With --gains and/or
 ``kp=2 ki=20`` and ``kp=2 ki=20+ff``), writes one CSV per run, one figure and
 DIR/<system>_ripple.csv: the peak-to-peak speed ripple of each run over the
 second half of the run.
+
+An interrupt (Ctrl-C, SIGINT) stops the run at the next communication step and
+keeps what finished: the CSV files of the runs before it and the interrupted
+run's rows up to that step; one line on stderr says so; exit status 130.
 """
 from __future__ import annotations
 
@@ -99,7 +103,7 @@ def run(args) -> int:
 
     from ..control import pi
     from ..experiments.columns import write_csv
-    from ..experiments.cosim import ripple, simulate_system
+    from ..experiments.cosim import CosimInterrupted, ripple, simulate_system
     from ..experiments.fmu_file import ensure_ssp
     from ..experiments.ssp import read_ssp
     from ..physics.parameters import BY_NAME, resolve
@@ -157,9 +161,18 @@ def run(args) -> int:
         cam = sysk.components.get("cam")
         compliant = cam is not None and float(cam.parameters.get("k_shaft", 0.0)) > 0.0
         record = ["cam.omega", "cam.omega_m"] if compliant else None  # both sides of the shaft
-        result = simulate_system(sysk, stop, args.step_size, record=record, progress=bar)
         stem = label.replace("=", "").replace(" ", "_").replace("+", "_")
         name = system.name if not label else f"{system.name}__{stem}"
+        try:
+            result = simulate_system(sysk, stop, args.step_size, record=record, progress=bar)
+        except CosimInterrupted as stop_early:  # keep what finished: this run's rows so far, the runs before it
+            bar.close()
+            path = write_csv(stop_early.result, out / f"{name}.csv")
+            steps = len(stop_early.result["time"]) - 1
+            before = f"; the {len(runs)} runs before it in {out}" if runs else ""
+            print(f"cam-fmu cosim: interrupted at t = {stop_early.result['time'][-1]:.6g} s ({steps} of "
+                  f"{stop_early.steps} steps): kept in {path}{before}", file=sys.stderr)
+            return 130
         path = write_csv(result, out / f"{name}.csv")
         key = label or system.name
         runs[key] = result

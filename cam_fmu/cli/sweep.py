@@ -13,6 +13,10 @@ Every case is checked before any runs, as `simulate` checks a scene (exit 2 on
 the first bad one). A case that fails while it runs keeps its row (status
 "failed", its message, NaN metrics); the sweep goes on, names every failed case
 on stderr at the end and exits with status 1 (0: every case ran).
+
+An interrupt (Ctrl-C, SIGINT) stops the sweep and keeps what finished: the
+table holds the rows of the cases that finished (in case order, with their
+varied values), one line on stderr says how many of how many, exit status 130.
 """
 from __future__ import annotations
 
@@ -47,11 +51,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..experiments.fmu_file import ensure_fmu
+    from ..experiments.fmu_file import check_cam_variables, ensure_fmu
     from ..experiments.progress import ProgressBar
     from ..experiments.scenes import find_scene
-    from ..experiments.sweep import (METRICS, SweepError, cases, check_cases, failed, parse_vary, plot_table,
-                                     run_sweep, write_table)
+    from ..experiments.sweep import (METRICS, SweepError, SweepInterrupted, cases, check_cases, failed, parse_vary,
+                                     plot_table, run_sweep, write_table)
 
     scene = find_scene(args.scene)  # checked here: a bad scene fails before any worker starts
     if args.stop_time is not None:
@@ -69,13 +73,22 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise SweepError(f"--out {args.out!r} exists and is not a directory")
-    fmu = ensure_fmu(args.fmu, log=lambda m: print(m, file=sys.stderr))
+    fmu = check_cam_variables(ensure_fmu(args.fmu, log=lambda m: print(m, file=sys.stderr)))  # before any case
     scene_ref = str(scene.path.resolve()) if scene.path else args.scene
     engine = "serial" if args.serial else (args.scheduler or f"local cluster, {args.workers or 'one per core'} workers")
     print(f"# {scene.name}: {n_cases} cases on {engine}", file=sys.stderr)
     t0 = time.perf_counter()
-    rows = run_sweep(scene_ref, fmu, varies, metrics, workers=args.workers, scheduler=args.scheduler,
-                     serial=args.serial, stop_time=args.stop_time, progress=ProgressBar(f"sweep {scene.name}"))
+    bar = ProgressBar(f"sweep {scene.name}")
+    try:
+        rows = run_sweep(scene_ref, fmu, varies, metrics, workers=args.workers, scheduler=args.scheduler,
+                         serial=args.serial, stop_time=args.stop_time, progress=bar)
+    except SweepInterrupted as stop:  # keep what finished: their rows, in case order; one line, no traceback
+        bar.close()
+        out.mkdir(parents=True, exist_ok=True)
+        path = write_table(stop.rows, varies, metrics, out / f"{scene.name}_sweep.csv")
+        print(f"cam-fmu sweep: interrupted: {len(stop.rows)} of {stop.total} cases finished, kept in {path}",
+              file=sys.stderr)
+        return 130
     elapsed = time.perf_counter() - t0
     out.mkdir(parents=True, exist_ok=True)
     print(write_table(rows, varies, metrics, out / f"{scene.name}_sweep.csv"))

@@ -106,10 +106,86 @@ def analytic_response(params: Mapping[str, Any] | None, theta0: float, f: Sequen
     return Response(f, H[:, 0], H[:, 1], u0, f"linearised at rest at theta0 = {theta0:.6g} rad")
 
 
+# The extrema of |H| that count (resonances: local maxima; anti-resonances: local minima of a sampled |H|): those
+# whose prominence (scipy.signal.find_peaks, on ln |H|) is at least EXTREMUM_PROMINENCE, 1 % of |H|: a flat stretch
+# of a finely sampled curve has no extremum to report. Each is refined by golden-section search on ln f inside
+# the two grid intervals around its sample, until the bracket is narrower than EXTREMUM_TOLERANCE (relative).
+EXTREMUM_PROMINENCE = 0.01
+EXTREMUM_TOLERANCE = 1e-3
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+@dataclass
+class Extremum:
+    """A resonance (local maximum of |H|) or anti-resonance (local minimum) of one output's response."""
+
+    output: str  # 'motor' (omega_m) or 'cam' (omega)
+    kind: str  # 'resonance' or 'anti-resonance'
+    f: float  # Hz, within ``tolerance`` (relative) of the extremum of the curve searched
+    gain: float  # |H| there, (rad/s)/V
+    tolerance: float  # the bracket's relative width at the end of the search
+
+
+def grid_extrema(gain: Sequence[float], prominence: float = EXTREMUM_PROMINENCE) -> list[tuple[int, str]]:
+    """(index, kind) of the interior local extrema of a sampled |H| with a prominence of at least ``prominence``
+    (relative), in grid order; an end of the grid is no extremum."""
+    from scipy.signal import find_peaks
+
+    level = np.log(np.maximum(np.asarray(gain, dtype=float), np.finfo(float).tiny))
+    depth = math.log1p(prominence)
+    found = [(int(k), "resonance") for k in find_peaks(level, prominence=depth)[0]]
+    found += [(int(k), "anti-resonance") for k in find_peaks(-level, prominence=depth)[0]]
+    return sorted(found)
+
+
+def refine_extremum(gain_at, lo: float, hi: float, kind: str,
+                    tolerance: float = EXTREMUM_TOLERANCE) -> tuple[float, float, float]:
+    """(f [Hz], |H| there, relative width of the final bracket) of the extremum of ``gain_at(f)`` between lo and hi
+    [Hz]: golden-section search on ln f, to a bracket hi/lo - 1 below ``tolerance``; the best point evaluated."""
+    sign = -1.0 if kind == "resonance" else 1.0  # minimise sign * ln |H|
+    a, b = math.log(lo), math.log(hi)
+    seen: dict[float, float] = {}
+
+    def cost(x: float) -> float:
+        if x not in seen:
+            seen[x] = float(gain_at(math.exp(x)))
+        return sign * math.log(max(seen[x], np.finfo(float).tiny))
+
+    c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
+    while math.expm1(b - a) > tolerance:
+        if cost(c) < cost(d):
+            b, d = d, c
+            c = b - _GOLDEN * (b - a)
+        else:
+            a, c = c, d
+            d = a + _GOLDEN * (b - a)
+    x = min(seen, key=cost) if seen else 0.5 * (a + b)
+    if not seen:
+        seen[x] = float(gain_at(math.exp(x)))
+    return math.exp(x), seen[x], math.expm1(b - a)
+
+
+def locate_extrema(response: Response, response_at, tolerance: float = EXTREMUM_TOLERANCE) -> list[Extremum]:
+    """Every resonance and anti-resonance of the motor's and the cam's |H| sampled in ``response``, each refined by
+    ``response_at(f) -> Response`` at single frequencies [Hz] (grid_extrema, refine_extremum)."""
+    f = np.asarray(response.f, dtype=float)
+    found = []
+    for output in ("motor", "cam"):
+        gain = np.abs(getattr(response, output))
+        for k, kind in grid_extrema(gain):
+            def gain_at(fk: float, output: str = output) -> float:
+                return abs(getattr(response_at(fk), output)[0])
+
+            fk, gk, width = refine_extremum(gain_at, f[k - 1], f[k + 1], kind, tolerance)
+            found.append(Extremum(output, kind, fk, gk, width))
+    return found
+
+
 def settle_time(params: Mapping[str, Any] | None, theta0: float) -> float:
     """SETTLE_TIME_CONSTANTS time constants [s] of the slowest decaying pole of the linear model at theta0."""
     rates = [-ev.real for ev in np.linalg.eigvals(linear_model(params, theta0)[0]) if ev.real < -1e-9]
     return SETTLE_TIME_CONSTANTS / min(rates) if rates else 0.0
 
 
-__all__ = ["FROZEN_OFF", "Response", "analytic_response", "frozen_parameters", "linear_model", "settle_time"]
+__all__ = ["EXTREMUM_PROMINENCE", "EXTREMUM_TOLERANCE", "Extremum", "FROZEN_OFF", "Response", "analytic_response",
+           "frozen_parameters", "grid_extrema", "linear_model", "locate_extrema", "refine_extremum", "settle_time"]

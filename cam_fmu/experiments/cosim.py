@@ -30,6 +30,7 @@ The time grid is t_k = start + k h (no accumulated rounding).
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import tempfile
 from pathlib import Path
@@ -45,6 +46,34 @@ Progress = Callable[[int, int], None]
 
 class CosimError(RuntimeError):
     """A co-simulation that could not run; the message names the component and variable."""
+
+
+class CosimInterrupted(KeyboardInterrupt):
+    """An interrupt (SIGINT, Ctrl-C) during simulate_system: ``result`` holds the rows up to the last completed
+    communication step (the same columns as a whole run), of ``steps`` steps."""
+
+    def __init__(self, result: dict[str, np.ndarray], steps: int) -> None:
+        super().__init__(f"interrupted at t = {result['time'][-1]:g} s")
+        self.result, self.steps = result, steps
+
+
+@contextlib.contextmanager
+def _interrupt_flag():
+    """A list that gets an entry when SIGINT arrives inside the block, instead of KeyboardInterrupt: an exception
+    raised inside a Python FMU's doStep (pi_speed.fmu runs in this process) turns into its fatal status, and the
+    run's rows would be lost. The master checks the flag between communication steps."""
+    import signal
+    import threading
+
+    seen: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield seen
+        return
+    previous = signal.signal(signal.SIGINT, lambda signum, _frame: seen.append(signum))
+    try:
+        yield seen
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _n_steps(start: float, stop: float, h: float) -> int:
@@ -146,20 +175,27 @@ def simulate_system(ssp: str | Path | System, stop_time: float | None = None, st
 
     values = read()
     data[0] = [values[c] for c in columns]
-    for k in range(n):
-        t = start + k * h
-        for slave, vr, src in wires:
-            slave.fmu.setReal([vr], [values[src]])
-        for slave in slaves.values():
-            slave.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-        values = read()
-        data[k + 1] = [values[c] for c in columns]
-        if progress is not None:
-            progress(k + 1, n)
+    done = n
+    with _interrupt_flag() as interrupt:
+        for k in range(n):
+            if interrupt:
+                done = k
+                break
+            t = start + k * h
+            for slave, vr, src in wires:
+                slave.fmu.setReal([vr], [values[src]])
+            for slave in slaves.values():
+                slave.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+            values = read()
+            data[k + 1] = [values[c] for c in columns]
+            if progress is not None:
+                progress(k + 1, n)
     for slave in slaves.values():
         slave.fmu.terminate()  # no fmi2FreeInstance: see runner._fmu_runs (pythonfmu 0.7.0 at exit)
-    result = {"time": start + h * np.arange(n + 1)}
-    result.update({c: data[:, j] for j, c in enumerate(columns)})
+    result = {"time": start + h * np.arange(done + 1)}
+    result.update({c: data[:done + 1, j] for j, c in enumerate(columns)})
+    if done < n:
+        raise CosimInterrupted(result, n)
     return result
 
 

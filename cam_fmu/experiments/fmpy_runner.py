@@ -9,6 +9,9 @@ Every instance gets this runner's own logger: the FMU's error and discard
 messages are kept (``messages``), never printed (fmpy's default logger prints
 ``[ERROR] ...`` lines on stdout), and a failed run raises FmuRunError whose text
 is the FMU's own message (the cause), followed by fmpy's status line.
+
+FMI 2.0 and 3.0 co-simulation FMUs run alike (cam.fmu, cam3.fmu: fmpy's FMU2Slave or FMU3Slave); any
+other FMU is refused at construction with a message naming its FMI version and interfaces (``check_runnable``).
 """
 from __future__ import annotations
 
@@ -22,6 +25,20 @@ class FmuRunError(RuntimeError):
     """A run that failed or stopped early; the message is the FMU's own where it gave one."""
 
 
+SUPPORTED = ("2.0", "3.0")  # FMI versions run, co-simulation only
+
+
+def check_runnable(md: Any, where: str) -> None:
+    """FmuRunError unless the model description ``md`` (fmpy's) is an FMI 2.0 or 3.0 co-simulation FMU."""
+    version = str(md.fmiVersion)
+    if version not in SUPPORTED:
+        raise FmuRunError(f"{where}: an FMI {version} FMU; runnable are FMI 2.0 and 3.0 co-simulation FMUs "
+                          "(cam.fmu, cam3.fmu)")
+    if md.coSimulation is None:
+        raise FmuRunError(f"{where}: an FMI {version} FMU without co-simulation (Model Exchange only); runnable are "
+                          "co-simulation FMUs")
+
+
 class FmuRunner:
     """``simulate`` runs the FMU from 0 to stop_time through fmpy.simulate_fmu."""
 
@@ -31,6 +48,8 @@ class FmuRunner:
         self.name = name
         self.fmu_path = Path(fmu)
         self.md = read_model_description(str(fmu))
+        check_runnable(self.md, str(fmu))
+        self.fmi3 = str(self.md.fmiVersion) == "3.0"
         self._tmp = None
         if workdir is None:
             self._tmp = tempfile.TemporaryDirectory(prefix="cam_fmu_run_")
@@ -54,6 +73,19 @@ class FmuRunner:
         if self.fmu is not None:
             self.abandoned.append(self.fmu)
         self.count += 1
+        if self.fmi3:
+            from fmpy.fmi3 import FMU3Slave
+
+            self.fmu = FMU3Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
+                                 modelIdentifier=self.md.coSimulation.modelIdentifier,
+                                 instanceName=f"{self.name}{self.count}")
+            log3 = None
+            if logger is not None:  # fmi3LogMessageCallback(env, status, category, message): the same statuses
+                def log3(env: Any, status: int, category: Any, message: Any) -> None:
+                    logger(env, None, status, category, message)
+            self.fmu.instantiate(loggingOn=logging, logMessage=log3)
+            self.fresh = True
+            return
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier,
                              instanceName=f"{self.name}{self.count}")

@@ -7,9 +7,15 @@ ecos, libcosim (OSP) and fmpy all understand:
 - one ``ssd:System`` with ``ssd:Component`` elements (``source="resources/X.fmu"``),
   each with its ``ssd:Connectors`` (inputs/outputs used by the connections) and
   inline ``ssd:ParameterBindings`` (one ``ssv:ParameterSet`` of Real, Boolean and
-  String values: the values that differ from the FMU's defaults);
+  String values: only the values that differ from the FMU's defaults; ``write_ssp``
+  reads the defaults from each FMU's modelDescription.xml and drops a binding equal to
+  one. OMSimulator's importer knows no ``ssv:String`` in some versions ("Unknown
+  ParameterBinding-type"): a string equal to its default, such as cam.fmu's
+  ``drive = voltage``, is therefore never written; one that differs is kept, since
+  dropping it would change the system);
 - ``ssd:Connections`` (``startElement.startConnector -> endElement.endConnector``);
-- ``ssd:DefaultExperiment`` (startTime, stopTime) with the OSP annotation
+- ``ssd:DefaultExperiment`` (startTime, stopTime: the loop's own, which a run without a
+  stop time of its own takes) with the OSP annotation
   ``osp:FixedStepAlgorithm baseStepSize`` (the communication step), which
   libcosim reads; ecos takes the step on its command line;
 - inside ``ssd:System``, OMSimulator's vendor annotation (``org.openmodelica``:
@@ -135,13 +141,65 @@ def system_xml(system: System) -> bytes:
     return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
 
 
+def fmu_defaults(fmu: str | Path) -> dict[str, Any]:
+    """{name: start value} of the parameters an FMU (2.0 or 3.0) declares, typed as parse_ssd types them; {} for
+    a file that is no FMU (read_ssp refuses it, naming the component)."""
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            root = ET.fromstring(z.read("modelDescription.xml"))
+    except (zipfile.BadZipFile, KeyError, ET.ParseError):
+        return {}
+    variables = root.find("ModelVariables")
+    found: dict[str, Any] = {}
+    for v in (variables if variables is not None else []):
+        if v.get("causality") != "parameter":
+            continue
+        typed = v[0] if v.tag == "ScalarVariable" and len(v) else v  # FMI 2.0: <Real start=...>; 3.0: <Float64>
+        kind = typed.tag
+        start = typed.get("start")
+        if start is None and kind == "String":
+            child = typed.find("Start")  # FMI 3.0 strings: <Start value=.../>
+            start = child.get("value") if child is not None else None
+        if start is None:
+            continue
+        if kind in ("Real", "Float64", "Float32"):
+            found[v.get("name")] = float(start)
+        elif kind == "Boolean":
+            found[v.get("name")] = start.strip().lower() in ("true", "1")
+        elif kind.startswith("Int"):
+            found[v.get("name")] = int(start)
+        else:
+            found[v.get("name")] = start
+    return found
+
+
+def without_defaults(system: System, defaults: Mapping[str, Mapping[str, Any]]) -> System:
+    """A copy of ``system`` whose components keep only the parameter values that differ from ``defaults``
+    (component name -> {parameter: default}); a value of another type than its default is kept."""
+    import copy
+
+    pruned = copy.deepcopy(system)
+    for comp in pruned.components.values():
+        own = defaults.get(comp.name, {})
+        comp.parameters = {name: value for name, value in comp.parameters.items()
+                           if not (name in own and type(own[name]) is type(_typed(value)) and own[name] == _typed(value))}
+    return pruned
+
+
+def _typed(value: Any) -> Any:
+    """A binding's value as parse_ssd reads it back (int and float alike are Real)."""
+    return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
+
+
 def write_ssp(system: System, fmus: Mapping[str, str | Path], dest: str | Path) -> Path:
-    """Write ``dest`` (.ssp): SystemStructure.ssd plus each component's FMU (``fmus``: name -> file)."""
+    """Write ``dest`` (.ssp): SystemStructure.ssd plus each component's FMU (``fmus``: name -> file). A parameter
+    value equal to the FMU's own default is not written (module docstring)."""
     dest = Path(dest)
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.with_name(dest.name + ".tmp")
+    defaults = {comp.name: fmu_defaults(fmus[comp.name]) for comp in system.components.values()}
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", system_xml(system))
+        z.writestr("SystemStructure.ssd", system_xml(without_defaults(system, defaults)))
         written: set[str] = set()
         for comp in system.components.values():
             if comp.source not in written:

@@ -20,6 +20,7 @@ NaN metrics (``status`` = "ok" and an empty message otherwise).
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import itertools
 import math
@@ -36,6 +37,38 @@ from .limits import MAX_CASES
 
 class SweepError(ValueError):
     """Bad sweep specification; the message names the option and the allowed values."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """An interrupt (SIGINT, Ctrl-C) during a sweep: ``rows`` are the cases that finished, in case order
+    (``cases`` their numbers from 1), of ``total``."""
+
+    def __init__(self, rows: list[dict], cases: list[int], total: int) -> None:
+        super().__init__(f"interrupted after {len(rows)} of {total} cases")
+        self.rows, self.cases, self.total = rows, cases, total
+
+
+@contextlib.contextmanager
+def sigint_ignored():
+    """SIGINT ignored while the block starts processes: they inherit the disposition (Python and asyncio install
+    no KeyboardInterrupt handler where SIGINT is ignored), so a Ctrl-C to the terminal's process group reaches only
+    this process, which stops the sweep; dask's worker processes print no traceback."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _interrupted(rows: Sequence[dict | None]) -> SweepInterrupted:
+    done = [k for k, row in enumerate(rows) if row is not None]
+    return SweepInterrupted([rows[k] for k in done], [k + 1 for k in done], len(rows))  # type: ignore[misc]
 
 
 def _ripple(r: Mapping[str, np.ndarray]) -> float:
@@ -179,23 +212,33 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
     fmu = str(Path(fmu).resolve())
     rows: list[dict | None] = [None] * len(todo)
     if serial:
-        for k, case in enumerate(todo):
-            rows[k] = run_case(scene_ref, fmu, case, metrics, stop_time)
-            if progress:
-                progress(k + 1, len(todo))
+        try:
+            for k, case in enumerate(todo):
+                rows[k] = run_case(scene_ref, fmu, case, metrics, stop_time)
+                if progress:
+                    progress(k + 1, len(todo))
+        except KeyboardInterrupt:
+            raise _interrupted(rows) from None
         return rows  # type: ignore[return-value]
     from distributed import Client, LocalCluster, as_completed
 
     cluster = None
-    if scheduler:
-        client = Client(scheduler, timeout="30s")
-    else:
-        n = workers or os.cpu_count() or 1
-        if n < 1:
-            raise SweepError(f"--workers {n}: allowed >= 1")
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               host="127.0.0.1")
-        client = Client(cluster)
+    interrupted = False
+    # The worker processes ignore a Ctrl-C to the process group (sigint_ignored) and log errors only: closing the
+    # cluster after an interrupt cancels the cases they run, which each would report as a warning.
+    with sigint_ignored(), _environment(DASK_LOGGING__DISTRIBUTED="error"):
+        if scheduler:
+            client = Client(scheduler, timeout="30s")
+        else:
+            n = workers or os.cpu_count() or 1
+            if n < 1:
+                raise SweepError(f"--workers {n}: allowed >= 1")
+            # no dashboard; the scheduler's own HTTP server on a free port (its default, 8787, may be taken by
+            # another cluster on the machine: distributed then warns on stderr)
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   host="127.0.0.1", scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
+            client = Client(cluster)
+    futures: list = []
     try:
         futures = [client.submit(run_case, scene_ref, fmu, case, tuple(metrics), stop_time, pure=False, key=f"case-{k}-{os.getpid()}-{id(todo)}")
                    for k, case in enumerate(todo)]
@@ -204,11 +247,45 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
             rows[index[future.key]] = future.result()
             if progress:
                 progress(done, len(todo))
+    except KeyboardInterrupt:
+        interrupted = True
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        with sigint_ignored(), _quiet("distributed"):  # shutting down after an interrupt: no second one, no noise
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    if interrupted:
+        raise _interrupted(rows)
     return rows  # type: ignore[return-value]
+
+
+@contextlib.contextmanager
+def _environment(**values: str):
+    """os.environ with ``values`` inside the block (what processes started there inherit)."""
+    saved = {name: os.environ.get(name) for name in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+
+
+@contextlib.contextmanager
+def _quiet(logger: str):
+    """The logger ``logger`` and its children silent below CRITICAL inside the block."""
+    import logging
+
+    log = logging.getLogger(logger)
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        log.setLevel(level)
 
 
 def write_table(rows: Sequence[Mapping[str, Any]], varies: Sequence[Vary], metrics: Sequence[str],

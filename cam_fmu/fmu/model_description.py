@@ -126,6 +126,20 @@ def _fmt(value: Any) -> str:
     return str(value)
 
 
+# The relative tolerance every FMU's DefaultExperiment declares: the engine's own co-simulation rtol. A host that
+# integrates cam.fmu through Model Exchange with its own solver (OMSimulator picks Model Exchange when an FMU
+# offers both, fmpy's CVode) reads it; without it each host runs at its own default (fmpy 1e-5), far looser
+# than the co-simulation (docs/fmu.md, "Model Exchange"). Co-simulation ignores it (rtol is a parameter).
+DEFAULT_TOLERANCE = parameters.BY_NAME["rtol"].default
+
+
+def experiment_element(default_experiment: tuple) -> ET.Element:
+    """<DefaultExperiment> of (start, stop, step) [s] with the tolerance DEFAULT_TOLERANCE (FMI 2.0 and 3.0)."""
+    start, stop, step = default_experiment
+    return ET.Element("DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
+                      tolerance=_fmt(float(DEFAULT_TOLERANCE)), stepSize=_fmt(float(step)))
+
+
 def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Optional[str] = None,
                 rows: Optional[List[Dict[str, Any]]] = None) -> bytes:
     """Return the completed modelDescription.xml (``rows``: the model's variable table, default cam.fmu's)."""
@@ -158,10 +172,7 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
     # DefaultExperiment before ModelVariables.
     for old in root.findall("DefaultExperiment"):
         root.remove(old)
-    start, stop, step = default_experiment
-    experiment = ET.Element("DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
-                            stepSize=_fmt(float(step)))
-    root.insert(list(root).index(root.find("ModelVariables")), experiment)
+    root.insert(list(root).index(root.find("ModelVariables")), experiment_element(default_experiment))
 
     # Variables.
     variables = root.find("ModelVariables")

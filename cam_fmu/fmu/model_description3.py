@@ -14,7 +14,7 @@ from typing import Any, Dict, List, Tuple
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
-from .model_description import BASE_UNIT_ORDER, BASE_UNITS, LOG_CATEGORIES, _fmt
+from .model_description import BASE_UNIT_ORDER, BASE_UNITS, LOG_CATEGORIES, experiment_element
 
 # Display units: (name, factor) with display value = factor * SI value.
 DISPLAY_UNITS: Dict[str, Tuple[str, float]] = {"rad/s": ("rpm", 60.0 / (2.0 * math.pi)), "rad": ("deg", 180.0 / math.pi)}
@@ -50,9 +50,7 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
     categories = ET.SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES:
         ET.SubElement(categories, "Category", name=name, description=text.replace("fmi2", "fmi3"))
-    start, stop, step = experiment
-    ET.SubElement(root, "DefaultExperiment", startTime=_fmt(float(start)), stopTime=_fmt(float(stop)),
-                  stepSize=_fmt(float(step)))
+    root.append(experiment_element(experiment))
     variables = ET.SubElement(root, "ModelVariables")
     # the independent variable FMI 3.0 asks for, after the whole table (value reference TIME_VR)
     ET.SubElement(variables, "Float64", name="time", valueReference=str(time_vr), causality="independent",

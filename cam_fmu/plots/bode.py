@@ -2,11 +2,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 
-def plot_bode(measured: Any, analytic: Any, title: str, path: Path) -> Path:
-    """A Bode plot of control.frequency Responses: measured as markers, the analytic response as lines."""
+def plot_bode(measured: Any, analytic: Any, title: str, path: Path, extrema: Sequence[Any] = ()) -> Path:
+    """A Bode plot of control.frequency Responses: measured as markers, the analytic response as lines, each located
+    resonance (a triangle up) and anti-resonance (a triangle down) marked and labelled with its frequency."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -23,6 +24,16 @@ def plot_bode(measured: Any, analytic: Any, title: str, path: Path) -> Path:
             exact = getattr(analytic, name)
             gain.loglog(analytic.f, np.abs(exact), "-", color=color, linewidth=1.0, label=f"{label} (linearised)")
             phase.semilogx(analytic.f, np.degrees(np.unwrap(np.angle(exact))), "-", color=color, linewidth=1.0)
+    colors = {"motor": "tab:blue", "cam": "tab:orange"}
+    for ex in extrema:
+        up = ex.kind == "resonance"
+        gain.plot([ex.f], [ex.gain], "^" if up else "v", color=colors[ex.output], markersize=9,
+                  markeredgecolor="black", zorder=5)
+        gain.annotate(f"{ex.f:.4g} Hz", (ex.f, ex.gain), textcoords="offset points", xytext=(6, 8 if up else -14),
+                      fontsize=7, color=colors[ex.output])
+    if extrema:
+        gain.plot([], [], "^", color="grey", markeredgecolor="black", label="resonance (located)")
+        gain.plot([], [], "v", color="grey", markeredgecolor="black", label="anti-resonance (located)")
     gain.set_ylabel("|H| [(rad/s)/V]")
     gain.grid(True, which="both", alpha=0.3)
     gain.legend(fontsize=8)
