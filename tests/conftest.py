@@ -1,4 +1,14 @@
-"""Shared fixtures. Others may append fixtures below; keep existing ones intact."""
+"""Shared fixtures and the test layout's markers (tests/README.md).
+
+The tests sit in folders by layer (kinematics, physics, engine, fmu_cs, fmu_me, fmi3, hosts, cli, tools);
+the shared helpers (native_support.py, engine_profile.py, fmi_slave.py) and the C hosts beside this file.
+Markers, set here so that a module cannot forget them:
+- ``external``: every test of ``hosts/`` and of the modules in EXTERNAL (wine, qemu-user, valgrind,
+  sanitizers, other CPythons, native FMU hosts, zig's other platforms, the package index);
+- ``slow``: the modules in SLOW (measured at more than about 2 s a test on this machine, or a long fixture).
+``python -m pytest -m "not external and not slow"`` is the loop a developer runs while working; it builds the
+session's FMUs for this machine only (the system C compiler). CI runs everything.
+"""
 from __future__ import annotations
 
 import json
@@ -10,12 +20,40 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # the shared helpers, for the tests in the folders
+
+EXTERNAL = {  # outside hosts/: modules that need wine, qemu, valgrind, sanitizers or a C host
+    "test_engine_c_host", "test_engine_sanitize", "test_engine_state_fuzz", "test_engine_fmu_me_host", "test_fmi3",
+    "test_bench_floors", "test_bench_memory",
+}
+SLOW = {  # measured: a full run's --durations
+    "test_extremes", "test_extremes_property", "test_extremes_classes", "test_fmu_vs_reference", "test_scenes",
+    "test_sweep", "test_bench", "test_cross_check", "test_docs", "test_engine_fmu_me", "test_compliant_shaft",
+    "test_frequency", "test_reflect", "test_fmi_formulations", "test_plots", "test_cli_errors", "test_ssp_file",
+    "test_fmi_wrong_answers", "test_saved_states", "test_reference", "test_motion_table", "test_mounting",
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        path = Path(str(item.fspath))
+        if path.parent.name == "hosts" or path.stem in EXTERNAL:
+            item.add_marker(pytest.mark.external)
+        if path.stem in SLOW:
+            item.add_marker(pytest.mark.slow)
+
+
+def _fast_loop(config) -> bool:
+    """The session leaves out the external tests: no test needs another platform's binaries."""
+    return "not external" in (config.getoption("markexpr", "") or "")
 
 
 # --------------------------------------------------------------------------- cam.fmu
-def _build_fmu(dest: Path, model: str = "cam") -> Path:
-    """Build an FMU with build_fmu.py in a subprocess: the command users run, from this checkout."""
-    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", model, "--dest", str(dest)]
+def _build_fmu(dest: Path, model: str = "cam", host_only: bool = False) -> Path:
+    """Build an FMU with build_fmu.py in a subprocess: the command users run, from this checkout (every
+    platform; ``host_only``: this machine's binary, the system C compiler)."""
+    cmd = [sys.executable, str(ROOT / "build_fmu.py"), "--model", model, "--dest", str(dest),
+           *(["--platforms", "host"] if host_only else [])]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=300)
     if proc.returncode != 0 or not dest.is_file():
         pytest.fail(f"build_fmu.py --model {model} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
@@ -23,22 +61,17 @@ def _build_fmu(dest: Path, model: str = "cam") -> Path:
 
 
 @pytest.fixture(scope="session")
-def cam_fmu_path(tmp_path_factory) -> Path:
-    """cam.fmu built once per test session from this checkout (into a temporary folder).
-
-    Load it only in subprocesses (see ``run_fmu_script``): an FMU loaded into the
-    pytest process puts its extraction folder on sys.path and may bind the
-    top-level name ``cam_fmu`` to its bundled copy, which hides bugs in the bundle
-    and breaks later imports of unbundled modules in other tests.
-    """
-    return _build_fmu(tmp_path_factory.mktemp("cam_fmu_build") / "cam.fmu")
+def cam_fmu_path(tmp_path_factory, request) -> Path:
+    """cam.fmu built once per test session from this checkout (into a temporary folder). It is C: loading it
+    into the pytest process is safe."""
+    return _build_fmu(tmp_path_factory.mktemp("cam_fmu_build") / "cam.fmu", host_only=_fast_loop(request.config))
 
 
 @pytest.fixture(scope="session")
-def pi_speed_fmu_path(tmp_path_factory) -> Path:
-    """pi_speed.fmu built once per test session (build_fmu.py --model pi_speed): the Python FMU, with the
-    project's Python-hosting linux64 binary. Load it only in subprocesses, as a pythonfmu FMU."""
-    return _build_fmu(tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu", "pi_speed")
+def pi_speed_fmu_path(tmp_path_factory, request) -> Path:
+    """pi_speed.fmu built once per test session (build_fmu.py --model pi_speed): the PI controller in C."""
+    return _build_fmu(tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu", "pi_speed",
+                      host_only=_fast_loop(request.config))
 
 
 @pytest.fixture(scope="session")

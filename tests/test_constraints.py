@@ -37,6 +37,8 @@ def test_every_dependency_is_pinned_inside_its_range():
     locked = pins()
     assert "cam-fmu" not in locked, "the lock pins the project's dependencies, not the project"
     for req in required:
+        if req.marker is not None and not req.marker.evaluate():
+            continue  # a dependency of other Pythons only (tomli before 3.11): the lock is this Python's
         name = canonicalize_name(req.name)
         assert name in locked, f"{req.name} is not pinned in constraints/test.txt"
         assert req.specifier.contains(locked[name], prereleases=True), (req, locked[name])

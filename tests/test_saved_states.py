@@ -17,7 +17,7 @@ from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.errors import SimulationError
 from fmi_slave import ERROR, OK, Slave, extract
 
-STATE_LEN = S.STATE_LEN  # the drive's doubles, last in the serialised blob before the 4-byte CRC (no motion table)
+STATE_LEN = S.engine().cam_state_len()  # the drive's doubles, last in the serialised blob before the 4-byte CRC (no motion table)
 
 
 def _reseal(blob: bytearray) -> bytes:
@@ -65,7 +65,7 @@ def test_every_single_bit_flip_of_a_cam_fmu_state_is_refused_with_a_message(unzi
         assert slave.call("deSerializeFMUstate", bytes(bad)) == ERROR, bit
         texts = [text for status, _c, text in slave.messages[seen:] if status == ERROR]
         assert texts and texts[-1].startswith("fmi2DeSerializeFMUstate: "), (bit, texts)
-        assert "corrupt" in texts[-1] or "not a serialised cam.fmu state" in texts[-1], texts
+        assert "corrupt" in texts[-1] or "not a serialised cam state" in texts[-1], texts
     assert slave.get("theta", "omega", "s") == before  # nothing was restored
     slave.fmu.setFMUstate(slave.fmu.deSerializeFMUstate(blob))  # the true blob still restores
     assert slave.step(1e-3) == OK
@@ -97,7 +97,7 @@ def test_every_single_bit_flip_of_a_cam3_fmu_state_is_refused_with_a_message(unz
         assert refused.value.status == 3, bit  # fmi3Error
         texts = [text for status, text in log[seen:] if status == 3]
         assert texts and texts[-1].startswith("fmi3DeserializeFMUState: "), (bit, texts)
-        assert "corrupt" in texts[-1] or "not a serialised cam.fmu state" in texts[-1], texts
+        assert "corrupt" in texts[-1] or "not a serialised cam state" in texts[-1], texts
     fmu.setFMUState(fmu.deserializeFMUState(blob))
     fmu.doStep(0.05, 1e-3)
     fmu.terminate()

@@ -129,7 +129,7 @@ def test_an_fmu_that_cannot_run_is_refused_before_any_case_naming_its_version(ca
         fmu = _rewritten(cam_fmu_path, tmp_path / "v1.fmu", lambda t: t.replace('fmiVersion="2.0"', 'fmiVersion="1.0"'))
     else:
         fmu = _rewritten(cam_fmu_path, tmp_path / "me.fmu",
-                         lambda t: re.sub(r"<CoSimulation.*?(/>|</CoSimulation>)", "", t, flags=re.S))
+                         lambda t: re.sub(r"<CoSimulation\b[^>]*?(/>|>.*?</CoSimulation>)", "", t, flags=re.S))
     out = tmp_path / "out"
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(fmu), "--out", str(out),
                            "--serial"], capture_output=True, text=True, env=_env(), cwd=tmp_path, timeout=300)

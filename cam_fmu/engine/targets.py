@@ -29,23 +29,24 @@ class Target:
     runs: str  # native | qemu | wine | none
     system: str  # platform.system() of a machine that loads it
     machines: tuple[str, ...]  # platform.machine() spellings of that architecture
+    wheel: str  # the platform tag of the package's wheel for it (py3-none-<wheel>)
 
 
 GLIBC_FLOOR = (2, 17)  # the Linux rows link against glibc 2.17: no versioned symbol above it
 TARGETS: tuple[Target, ...] = (
     Target("x86_64-linux", "x86_64-linux-gnu.2.17", "linux64", "x86_64-linux", ".so", (), "native",
-           "Linux", ("x86_64", "amd64")),
+           "Linux", ("x86_64", "amd64"), "manylinux_2_17_x86_64.manylinux2014_x86_64"),
     # FMI 2.0 names no folder for aarch64 Linux: the FMI 3.0 tuple (docs/fmu.md, "What a target machine needs")
     Target("aarch64-linux", "aarch64-linux-gnu.2.17", "aarch64-linux", "aarch64-linux", ".so", (), "qemu",
-           "Linux", ("aarch64", "arm64")),
+           "Linux", ("aarch64", "arm64"), "manylinux_2_17_aarch64.manylinux2014_aarch64"),
     Target("x86_64-windows", "x86_64-windows-gnu", "win64", "x86_64-windows", ".dll", (), "wine",
-           "Windows", ("amd64", "x86_64")),
+           "Windows", ("amd64", "x86_64"), "win_amd64"),
     # macOS: the oldest release as the minimum (zig's default is its newest SDK's, 15.0): 10.13 on Intel, 11.0 (the
     # first) on Apple silicon
     Target("x86_64-darwin", "x86_64-macos.10.13", "darwin64", "x86_64-darwin", ".dylib", (), "none",
-           "Darwin", ("x86_64",)),
+           "Darwin", ("x86_64",), "macosx_10_13_x86_64"),
     Target("aarch64-darwin", "aarch64-macos.11.0", "darwin64", "aarch64-darwin", ".dylib", (), "none",
-           "Darwin", ("arm64", "aarch64")),
+           "Darwin", ("arm64", "aarch64"), "macosx_11_0_arm64"),
 )
 NAMES = tuple(t.name for t in TARGETS)
 

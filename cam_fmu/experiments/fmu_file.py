@@ -28,11 +28,21 @@ def source_checkout() -> Path | None:
     return root if (root / "build_fmu.py").is_file() and (root / "pyproject.toml").is_file() else None
 
 
+def shipped_path(name: str = "cam", suffix: str = ".fmu") -> Path | None:
+    """The prebuilt file a distribution wheel carries (``cam_fmu/shipped/<name><suffix>``), else None."""
+    path = PACKAGE_DIR / "shipped" / f"{name}{suffix}"
+    return path if path.is_file() else None
+
+
 def default_model_path(name: str = "cam", suffix: str = ".fmu") -> Path:
-    """models/<name><suffix> in a checkout, else the user-cache copy for this package version."""
+    """models/<name><suffix> in a checkout, the prebuilt file of an installed wheel, else the user-cache copy
+    for this package version."""
     root = source_checkout()
     if root is not None:
         return root / "models" / f"{name}{suffix}"
+    shipped = shipped_path(name, suffix)
+    if shipped is not None:
+        return shipped
     from .. import __version__
 
     cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"
@@ -72,8 +82,8 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
     from ..fmu.build import is_stale
 
     path = default_model_path(model)
-    if not is_stale(path, model=model):
-        return path
+    if path == shipped_path(model) or not is_stale(path, model=model):
+        return path  # a wheel's prebuilt FMU is its own: never rebuilt (it needs no compiler)
     if log is not None:
         log(f"# building {path} (missing or older than its sources)")
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -105,8 +115,10 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
             if not path.is_file():
                 raise FmuFileError(f"SSP file {str(path)!r} does not exist (shipped systems: {', '.join(SSP_NAMES)})")
             return path
-    fmus = {model: ensure_fmu(None, log, model) for model in ("cam", "pi_speed")}  # the loop's two FMUs
     path = default_model_path(name, ".ssp")
+    if path == shipped_path(name, ".ssp"):
+        return path  # a wheel's prebuilt SSP, with its prebuilt FMUs
+    fmus = {model: ensure_fmu(None, log, model) for model in ("cam", "pi_speed")}  # the loop's two FMUs
     from . import ssp as writer
 
     inputs = [*fmus.values(), Path(writer.__file__)]

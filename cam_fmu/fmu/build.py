@@ -39,12 +39,51 @@ def sources(model: str = "cam") -> list[Path]:
 
 
 def is_stale(fmu: Path, model: str = "cam") -> bool:
-    """True when ``fmu`` is missing or older than one of its sources."""
+    """True when ``fmu`` is missing or was built from other sources: its GUID (a hash of everything that
+    shapes it, ``engine_fmu.digest``) is not the one this checkout's sources give. The one staleness rule, a
+    content hash, as the engine library's file name is."""
+    import zipfile
+    from xml.etree import ElementTree as ET
+
     fmu = Path(fmu)
     if not fmu.is_file():
         return True
-    newest = max(p.stat().st_mtime for p in sources(model) if p.is_file())
-    return fmu.stat().st_mtime < newest
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            root = ET.fromstring(z.read("modelDescription.xml"))
+    except (zipfile.BadZipFile, KeyError, ET.ParseError):
+        return True
+    built = root.get("guid") or root.get("instantiationToken")
+    return built != engine_fmu.model_guid(ENGINE_MODELS[model][0])
+
+
+def shipped_files() -> list[Path]:
+    """The FMUs and SSPs a distribution wheel carries (``models/`` of this checkout, built first where stale)."""
+    from ..experiments.fmu_file import ensure_fmu, ensure_ssp
+
+    return [*(ensure_fmu(None, model=name) for name in MODELS), *(ensure_ssp(name) for name in SSP_NAMES)]
+
+
+def build_wheels(folder: Path, names: Sequence[str] | None = None) -> list[Path]:
+    """One wheel per target of engine/targets.py (``names``; default all) into ``folder``: py3-none-<platform>,
+    the engine library compiled by zig for it and the shipped FMUs and SSPs (setup.py). Returns the wheels."""
+    import os
+    import subprocess
+
+    folder = Path(folder).resolve()
+    folder.mkdir(parents=True, exist_ok=True)
+    shipped_files()  # built once here, not once per wheel
+    made = []
+    for name in names or targets.NAMES:
+        row = targets.get(name)
+        proc = subprocess.run([sys.executable, "-m", "pip", "wheel", ".", "--no-deps", "--no-build-isolation", "-q",
+                               "-w", str(folder)], cwd=PACKAGE_DIR.parent, capture_output=True, text=True,
+                              env={**os.environ, "CAM_FMU_ENGINE_TARGET": name}, timeout=1800)
+        wheels = sorted(folder.glob(f"cam_fmu-*-py3-none-{row.wheel}.whl"))
+        if proc.returncode != 0 or not wheels:
+            raise BuildError(f"the {name} wheel: pip wheel failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
+        made.append(wheels[0])
+    return made
 
 
 def build(dest: Path, model: str = "cam", platforms: Sequence[str] | None = None) -> Path:
@@ -79,12 +118,19 @@ def main(argv: List[str] | None = None) -> int:
                              "cam.fmu, cam3.fmu, pi_speed.fmu, speed_loop.ssp and compliant_loop.ssp into models/ in a "
                              "source checkout (else a user cache)")
     parser.add_argument("--model", choices=MODELS, default="cam", help="the FMU --dest builds")
+    parser.add_argument("--wheels", type=Path, default=None, metavar="DIR",
+                        help="build the package's wheels into DIR: one per platform of engine/targets.py (or those "
+                             "of --platforms), each with its engine library and the shipped FMUs and SSPs")
     parser.add_argument("--platforms", default="all",
                         help=f"the binaries: all (default; zig), {binaries.HOST} (this machine, the system "
                              f"C compiler) or a comma-separated list of {', '.join(targets.NAMES)}")
     args = parser.parse_args(argv)
     platforms = None if args.platforms == "all" else args.platforms.split(",")
     try:
+        if args.wheels is not None:
+            for wheel in build_wheels(args.wheels, platforms):
+                print(wheel)
+            return 0
         if args.dest is not None:
             print(build(args.dest, args.model, platforms))
             return 0

@@ -139,10 +139,11 @@ def binary_sources(model: str | CModel = "cam", fmi_version: int = 2) -> List[Pa
 
 
 def digest(model: str | CModel = "cam") -> str:
-    """12 hex digits of the model's C, the glue and its generated table: the binary's identity."""
+    """12 hex digits of everything that shapes the model's FMUs (``sources``: its C, the glue, the headers, the
+    build's Python) and of its generated table: the FMU's identity, in its GUID."""
     m = _model(model)
     h = hashlib.sha256()
-    for path in [*m.sources(), *glue_sources()]:
+    for path in sources(m):
         h.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     with tempfile.TemporaryDirectory(prefix="cam_gen_") as gen:
         for path in m.generate(Path(gen)):
