@@ -10,9 +10,9 @@ cd "$(dirname "$0")"
 #             platform come from zig (the ziglang wheel, pyproject.toml's build extra), not from apt;
 # - valgrind: the memcheck tests of the binary (tests/test_native_*.py);
 # - libtbb12: needed by the FMU host `ecos`;
-# - wine64:   runs the x86_64-windows binaries in the Windows test hosts (tests/test_engine_fmu_win64.py);
+# - wine64:   runs the x86_64-windows binaries in the Windows test hosts (tests/hosts/test_engine_fmu_win64.py);
 # - qemu-user-static, libc6-arm64-cross: run the aarch64-linux binaries in an aarch64 test host
-#             (qemu-aarch64-static -L /usr/aarch64-linux-gnu; tests/test_fmu_platforms.py).
+#             (qemu-aarch64-static -L /usr/aarch64-linux-gnu; tests/hosts/test_fmu_platforms.py).
 missing=()
 for pkg in gcc valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then

@@ -3,7 +3,7 @@
 ``EngineProfile.from_laws(...)`` and ``EngineProfile.from_table(text)`` build the C
 engine's ``CamProfile`` (csrc/include/cam_profile.h); refusals raise ValueError with the
 engine's message. The structures below mirror the header (their size is checked against
-``cam_profile_sizeof``). A test helper: tests/test_engine_profile.py holds the C program against
+``cam_profile_sizeof``). A test helper: tests/engine/test_engine_profile.py holds the C program against
 the Python model with it.
 """
 from __future__ import annotations

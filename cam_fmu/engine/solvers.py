@@ -1,7 +1,7 @@
 """What the engine's solvers (the parameter ``solver``; csrc/src/methods.c) are and promise, for tools.
 
 ``adaptive``: the step is chosen by error control on rtol and atol (the C method's
-``adaptive`` flag, which tests/test_engine_solvers.py reads back from the library).
+``adaptive`` flag, which tests/engine/test_engine_solvers.py reads back from the library).
 ``promised_relative``: the relative theta error a fixed-step method's stability and
 resolution limits keep a run within, measured at 100 and 400 V against the
 reference (docs/performance.md); an adaptive method promises about its rtol instead.

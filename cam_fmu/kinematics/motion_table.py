@@ -26,7 +26,7 @@ there (left limit); knot 0 ends the last piece.
 
 This module is the readable model: the engine's C parser and curve
 (cam_fmu/engine/csrc/src/motion_table.c) do the same operations in the same
-order (tests/test_engine_profile.py compares them). ``derivatives`` uses
+order (tests/engine/test_engine_profile.py compares them). ``derivatives`` uses
 ``math`` and ``bisect`` only; ``evaluate`` is its numpy twin.
 """
 

@@ -16,7 +16,7 @@ cosine over 3/16, the 1:3 ratio of the modified sine), the "MCV50" of Makino's
 universal cam curve tables (H. Makino, cam-mechanism handbooks; the same table
 is reproduced in index-drive makers' catalogues); these T reproduce its
 tabulated Vm = 1.28, Am = 8.01, Jm = 201.4, (AV)m = 5.73 (checked in
-tests/test_characteristics.py).  `paper` is the law of the paper's profile
+tests/kinematics/test_characteristics.py).  `paper` is the law of the paper's profile
 (the paper's section 2.1; docs/model.md section 2).
 
 This is the one table of named laws: the parameter choices of the FMU

@@ -84,7 +84,7 @@ class ParameterSpec:
 
 
 LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table
-# Checked against the registries (physics.formulations.FORMULATIONS, solvers.SOLVERS) by tests/test_layout.py.
+# Checked against the registries (physics.formulations.FORMULATIONS, solvers.SOLVERS) by tests/tools/test_layout.py.
 FORMULATIONS = ("consistent", "paper")
 DRIVES = ("voltage", "speed")
 SOLVERS = ("euler", "rk4", "rk45", "etdrk4")

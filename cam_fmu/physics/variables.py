@@ -59,7 +59,7 @@ STATES: tuple[tuple[str, str, str, str], ...] = (
 )
 # The outputs that depend directly on an input at a fixed state in Model Exchange, and those inputs: the
 # quasi-static current (L = 0) and the voltage follow u, the load torque and the follower's acceleration
-# follow the cam's acceleration, hence u (tests/test_engine_fmu_me.py measures it both ways).
+# follow the cam's acceleration, hence u (tests/fmu_me/test_engine_fmu_me.py measures it both ways).
 FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage")
 FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the

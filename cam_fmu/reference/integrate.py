@@ -289,7 +289,7 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
     return _collect(rows, grid)
 
 
-# The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/test_layout.py).
+# The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/tools/test_layout.py).
 REFERENCES = {"consistent": _consistent, "paper": _paper, "speed": _speed}
 
 __all__ = ["simulate_reference", "ENERGY", "OUTPUTS"]

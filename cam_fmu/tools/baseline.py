@@ -6,7 +6,7 @@
 Engine-agnostic: a case runs through the public in-process API only,
 ``DriveSimulator(params)``, ``set_inputs``, ``do_step(t, h, u, omega_ref, omega_dot_ref)``
 and ``outputs()``, so a new engine behind that API is compared with the old one's record
-(tests/test_engine_baseline.py).
+(tests/engine/test_engine_baseline.py).
 
 The cases:
 - every shipped scene (experiments/scene_files) x each of its runs x every solver x each
@@ -14,7 +14,7 @@ The cases:
   is its own formulation, run with every solver all the same), with the run's own parameters,
   the scene's input signals (``runner.input_signals``, what its FMU runs get), output interval
   and stop time. Runs that come out with the same parameters are recorded once;
-- 60 cases of the extremes property test (tests/test_extremes_property.py): its own
+- 60 cases of the extremes property test (tests/engine/test_extremes_property.py): its own
   ``extremes.draw``, with random.Random(seed) for seeds 0..59. Not the test's hypothesis draws
   themselves: those are not reproducible outside it (hypothesis mixes into its draws the
   constants of the modules imported so far: the same derandomised test draws other cases when
@@ -210,7 +210,7 @@ def _close(a: str, b: str) -> bool:
 # ------------------------------------------------------------------ files
 # The shipped scenes when the record was made (before the C engine replaced the Python one). Scenes added
 # since (the compliant shaft's) model what the former engine could not: they are checked against the
-# scipy reference instead (tests/test_compliant_shaft.py).
+# scipy reference instead (tests/physics/test_compliant_shaft.py).
 RECORDED_SCENES = ("backlash", "inductance", "paper_fig4", "paper_fig5a", "paper_fig5b", "paper_fig6",
                    "speed_drive", "tilted")
 def groups() -> Iterator[tuple[str, list[dict[str, Any]]]]:

@@ -6,7 +6,7 @@ draws parameters across their documented ranges (log-uniform where a range
 spans decades), a random solver, formulation, drive, communication step and
 input steps, runs the FMU's engine and checks the property below; it prints
 every failure and a summary. The test suite checks the same property on a
-fixed number of examples (tests/test_extremes_property.py).
+fixed number of examples (tests/engine/test_extremes_property.py).
 
 The property: a run either reaches stop_time with finite outputs that agree
 with the scipy reference to the tolerance its settings promise (``promised``),

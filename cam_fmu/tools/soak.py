@@ -4,7 +4,7 @@ Developer command (the issue's counts; about 4 minutes on 2 shared cores):
 
     python -m cam_fmu.tools.soak models/cam.fmu --fmpy-cli 200 --scipy-script 200 --ecos 50 --c-host 50
 
-The tests (tests/test_native_hosts.py) run the same functions with smaller counts.
+The tests (tests/hosts/test_native_hosts.py) run the same functions with smaller counts.
 A run fails on a non-zero exit status (an abort is -6, a segfault -11 / 139) or on a
 glibc heap message ("corrupted double-linked list", "double free", ...) in its output; a C host
 run also fails unless its own report says the model ran (the instance made, every call fmi2OK):

@@ -1,4 +1,4 @@
-/* A Model Exchange host in C for cam.fmu's FMI functions, linked with them (tests/test_engine_fmu_me_host.py):
+/* A Model Exchange host in C for cam.fmu's FMI functions, linked with them (tests/fmu_me/test_engine_fmu_me_host.py):
  * a fixed-step explicit Euler with event handling (a sign change of an indicator, or the FMU's request at
  * fmi2CompletedIntegratorStep, enters event mode and iterates fmi2NewDiscreteStates), then the refusals.
  *

@@ -1,4 +1,4 @@
-/* An FMI 3.0 co-simulation host for cam3.fmu's binary, in C (tests/test_fmi3.py runs it under valgrind on
+/* An FMI 3.0 co-simulation host for cam3.fmu's binary, in C (tests/fmi3/test_fmi3.py runs it under valgrind on
  * x86_64-linux, and cross-compiled by zig, under wine on x86_64-windows and qemu on aarch64-linux): instance cycles with a
  * parameter, initialisation, steps, FMU states (get, serialise, deserialise, restore) and refused calls (a NaN
  * input, a step at the wrong time, a call on NULL); one line per result.

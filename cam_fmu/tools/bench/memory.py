@@ -11,7 +11,7 @@ sample, taken after a warm-up of ``steps / 10`` steps, to the end.
 
 At 1 ms steps, 1e6 steps are 1000 s of simulated time (about 160 cam turns at
 3.5 V). A leak of one small Python object per step (~30-60 bytes) shows as
-tens of MB; the test (tests/test_bench_memory.py) bounds the growth per step.
+tens of MB; the test (tests/tools/test_bench_memory.py) bounds the growth per step.
 """
 from __future__ import annotations
 
