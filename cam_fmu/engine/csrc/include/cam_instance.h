@@ -55,7 +55,7 @@ int cam_instance_initialize(CamInstance *d, double start_time);
 int cam_instance_initialized(const CamInstance *d);
 
 /* Advance from t to t + h [s] with the inputs held; t must be where the drive is (to rounding).
- * CAM_DISCARD: the state is as before the step (restore or retry a shorter step). */
+ * CAM_ERR_REJECTED: the state is as before the step (restore or retry a shorter step). */
 int cam_instance_step(CamInstance *d, double t, double h);
 double cam_instance_time(const CamInstance *d);
 
@@ -64,7 +64,7 @@ double cam_instance_time(const CamInstance *d);
 CamDrive *cam_instance_drive(CamInstance *d);
 const double *cam_instance_inputs(const CamInstance *d);
 
-/* The outputs in table order (cam_variables.h), current for the state and inputs. */
+/* The outputs in table order (cam_params.h, generated), current for the state and inputs. */
 const double *cam_instance_outputs(CamInstance *d);
 
 /* The whole state as bytes: size, save into a buffer of that size, restore (validated whole:
