@@ -200,12 +200,12 @@ def generated() -> dict[str, str]:
     return {HEADER: header_text(), SOURCE: source_text()}
 
 
-def write(folder: Path) -> list[Path]:
-    """Write the generated files into folder (created); returns their paths."""
+def write_files(folder: Path, files: dict[str, str]) -> list[Path]:
+    """Write ``files`` (name -> text) into folder (created), leaving an unchanged file as it is; their paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
-    for name, text in generated().items():
+    for name, text in files.items():
         path = folder / name
         if not path.is_file() or path.read_text() != text:
             path.write_text(text)
@@ -213,14 +213,24 @@ def write(folder: Path) -> list[Path]:
     return paths
 
 
-def main(argv: list[str] | None = None) -> int:
+def write(folder: Path) -> list[Path]:
+    """Write the generated files into folder (created); returns their paths."""
+    return write_files(folder, generated())
+
+
+def run_main(write_into, prog: str, argv: list[str] | None = None) -> int:
+    """``python -m PROG FOLDER``: write a generator's files into FOLDER and print their paths."""
     args = sys.argv[1:] if argv is None else argv
     if len(args) != 1:
-        print("usage: python -m cam_fmu.engine.codegen FOLDER", file=sys.stderr)
+        print(f"usage: python -m {prog} FOLDER", file=sys.stderr)
         return 2
-    for path in write(Path(args[0])):
+    for path in write_into(Path(args[0])):
         print(path)
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_main(write, "cam_fmu.engine.codegen", argv)
 
 
 if __name__ == "__main__":

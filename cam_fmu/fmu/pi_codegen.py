@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from ..control import pi
-from ..engine.codegen import c_double, c_name, c_string
+from ..engine.codegen import c_double, c_name, c_string, run_main, write_files
 
 HEADER = "pi_params.h"
 SOURCE = "pi_params.c"
@@ -84,24 +84,11 @@ def generated() -> dict[str, str]:
 
 def write(folder: Path) -> list[Path]:
     """Write the generated files into folder (created); returns their paths."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for name, text in generated().items():
-        path = folder / name
-        path.write_text(text)
-        paths.append(path)
-    return paths
+    return write_files(folder, generated())
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = sys.argv[1:] if argv is None else argv
-    if len(args) != 1:
-        print("usage: python -m cam_fmu.fmu.pi_codegen FOLDER", file=sys.stderr)
-        return 2
-    for path in write(Path(args[0])):
-        print(path)
-    return 0
+    return run_main(write, "cam_fmu.fmu.pi_codegen", argv)
 
 
 if __name__ == "__main__":
