@@ -20,7 +20,11 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(Path(__file__).resolve().parent))  # the shared helpers, for the tests in the folders
+# the shared helpers, and the layers' modules that others import (a test of one layer may reuse another's
+# closed forms or hosts), whichever folders a session collects
+for _folder in (Path(__file__).resolve().parent, *sorted(p for p in Path(__file__).resolve().parent.iterdir()
+                                                         if p.is_dir() and any(p.glob("test_*.py")))):
+    sys.path.insert(0, str(_folder))
 
 EXTERNAL = {  # outside hosts/: modules that need wine, qemu, valgrind, sanitizers or a C host
     "test_engine_c_host", "test_engine_sanitize", "test_engine_state_fuzz", "test_engine_fmu_me_host", "test_fmi3",

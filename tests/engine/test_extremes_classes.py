@@ -370,7 +370,7 @@ def test_class10_custom_split_point_errors_name_the_parameters():
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, str(HERE.parent))
+    sys.path[:0] = [str(HERE.parent), str(HERE.parents[1]), str(HERE.parents[1] / "fmu_cs")]  # its layer, the helpers, fmu_cs
     print(json.dumps(globals()[f"scenario_{sys.argv[1]}"](sys.argv[2])))
     sys.stdout.flush()
     import os

@@ -45,7 +45,7 @@ def fmpy_omega(cam_fmu_path, tmp_path_factory):
     from conftest import run_fmu_script
     folder = tmp_path_factory.mktemp("fmpy_for_ecos")
     shutil.copyfile(cam_fmu_path, folder / "cam.fmu")
-    r = run_fmu_script(HERE / "test_fmu_interface.py", "omega", str(folder / "cam.fmu"), cwd=folder)
+    r = run_fmu_script(HERE / "fmu_cs" / "test_fmu_interface.py", "omega", str(folder / "cam.fmu"), cwd=folder)
     return np.array(r["time"]), np.array(r["omega"])
 
 
