@@ -66,6 +66,33 @@ def sigint_ignored():
         signal.signal(signal.SIGINT, previous)
 
 
+class _InterruptFlag:
+    """SIGINT sets ``event`` instead of raising KeyboardInterrupt (in the main thread; elsewhere nothing changes);
+    ``restore`` puts the former handler back."""
+
+    def __init__(self) -> None:
+        import signal
+        import threading
+
+        self.event = threading.Event()
+        self.previous = None
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, lambda signum, frame: self.event.set())
+
+    def is_set(self) -> bool:
+        return self.event.is_set()
+
+    def wait(self, seconds: float) -> None:
+        self.event.wait(seconds)
+
+    def restore(self) -> None:
+        import signal
+
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+            self.previous = None
+
+
 def _interrupted(rows: Sequence[dict | None]) -> SweepInterrupted:
     done = [k for k, row in enumerate(rows) if row is not None]
     return SweepInterrupted([rows[k] for k in done], [k + 1 for k in done], len(rows))  # type: ignore[misc]
@@ -239,17 +266,26 @@ def run_sweep(scene_ref: str, fmu: str | Path, varies: Sequence[Vary], metrics: 
                                    host="127.0.0.1", scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
             client = Client(cluster)
     futures: list = []
-    try:
+    stop = _InterruptFlag()  # Ctrl-C sets a flag: a KeyboardInterrupt inside the client's calls left dask's
+    try:                      # event loop logging tracebacks (a cancelled sync, the workers' heartbeats)
         futures = [client.submit(run_case, scene_ref, fmu, case, tuple(metrics), stop_time, pure=False, key=f"case-{k}-{os.getpid()}-{id(todo)}")
                    for k, case in enumerate(todo)]
         index = {f.key: k for k, f in enumerate(futures)}
-        for done, future in enumerate(as_completed(futures), start=1):
-            rows[index[future.key]] = future.result()
-            if progress:
-                progress(done, len(todo))
-    except KeyboardInterrupt:
+        finished, done = as_completed(futures), 0
+        while not finished.is_empty() and not stop.is_set():
+            batch = finished.next_batch(block=False)
+            if not batch:
+                stop.wait(0.05)
+            for future in batch:
+                rows[index[future.key]] = future.result()
+                done += 1
+                if progress:
+                    progress(done, len(todo))
+        interrupted = stop.is_set()
+    except KeyboardInterrupt:  # before the flag's handler was in place
         interrupted = True
     finally:
+        stop.restore()
         with sigint_ignored(), _quiet("distributed"):  # shutting down after an interrupt: no second one, no noise
             client.close()
             if cluster is not None:
