@@ -6,11 +6,6 @@ import pytest
 
 from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.engine.solvers import SOLVERS
-from cam_fmu.physics.parameters import BY_NAME
-
-
-def test_one_entry_per_choice_of_the_parameter():
-    assert tuple(SOLVERS) == BY_NAME["solver"].choices
 
 
 @pytest.mark.parametrize("name", list(SOLVERS))

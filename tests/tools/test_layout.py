@@ -2,18 +2,15 @@
 from __future__ import annotations
 
 import ast
-import math
 import re
 from pathlib import Path
 
 from cam_fmu.engine.solvers import SOLVERS
-from cam_fmu.fmu.engine_fmu import default_experiment
 from cam_fmu.fmu.model_description import BASE_UNITS
 from cam_fmu.kinematics.presets import PRESETS
 from cam_fmu.physics import parameters
 from cam_fmu.physics.formulations import FORMULATIONS
 from cam_fmu.physics.variables import INPUTS, OUTPUTS
-from cam_fmu.experiments.scenes import find_scene
 
 PACKAGE = Path(__file__).resolve().parents[2] / "cam_fmu"
 MODULES = sorted(p for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts)
@@ -36,14 +33,6 @@ def test_every_unit_in_use_has_base_units():
     units = {p.unit for p in parameters.PARAMETERS if p.kind == "real"}
     units |= {row[1] for row in INPUTS} | {row[1] for row in OUTPUTS}
     assert units - set(BASE_UNITS) == set()
-
-
-def test_default_experiment_is_the_paper_fig6_scene():
-    scene = find_scene("paper_fig6")
-    start, stop, step = default_experiment()
-    assert start == 0.0
-    assert math.isclose(stop, scene.stop_time)
-    assert math.isclose(step, scene.output_interval)
 
 
 def test_no_module_over_400_lines():
