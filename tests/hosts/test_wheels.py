@@ -7,7 +7,6 @@ Python fails the test.
 from __future__ import annotations
 
 import csv
-import os
 import re
 import struct
 import subprocess
