@@ -188,7 +188,7 @@ SLOTS = [S.S_TIME, S.S_X, S.S_X + 1, S.S_X + 2, S.S_STUCK, S.S_DIRECTION, S.S_CO
 def test_property_a_restored_state_is_one_the_drive_can_be_in_and_a_refused_one_changes_nothing(params, edits):
     """Any edit of up to three entries: the restore refuses it and the drive is as before, or the restored state
     keeps the rules (a moving shaft's direction is the sign of omega, a held shaft has omega = 0, a free follower
-    lies in the gap, no time before the start) and its outputs are finite."""
+    lies in the gap, no time before the start beyond rounding) and its outputs are finite."""
     sim = _moving(params)
     saved = sim.state_array()
     state = sim.state_array()
@@ -203,7 +203,7 @@ def test_property_a_restored_state_is_one_the_drive_can_be_in_and_a_refused_one_
     omega = s[S.S_X + 1]
     if params.get("drive") != "speed":
         assert (s[S.S_STUCK] == 1.0 and omega == 0.0) or (s[S.S_STUCK] == 0.0 and s[S.S_DIRECTION] * omega >= 0.0)
-    assert s[S.S_TIME] >= 0.0
+    assert s[S.S_TIME] >= -1e-9  # the start (0) less the rounding slack the step's time check allows, docs/fmu.md
     out = sim.outputs()
     assert all(math.isfinite(v) for v in out.values())
     assert abs(out["s"] - out["s_cam"]) <= params.get("c", 0.0) * (1 + 1e-9) + 1e-12
