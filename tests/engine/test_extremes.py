@@ -118,7 +118,7 @@ def runs(cam_fmu_path, tmp_path_factory):
 
 def _reference(name: str):
     from cam_fmu.reference import simulate_reference
-    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.signals import constant
     case = CASES[name]
     return simulate_reference(case["start"], case["stop"], case["step"], u=constant(case.get("u", 0.0)),
                               omega_ref=constant(case.get("omega_ref", 1.0)))

@@ -31,7 +31,7 @@ def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
 
 
 def _reference_theta(params, u, stop):
-    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.signals import constant
     from cam_fmu.reference import simulate_reference
 
     return float(simulate_reference(params, stop, 1e-3, u=constant(u))["theta"][-1])

@@ -11,8 +11,8 @@ import pytest
 
 from cam_fmu.control.reflect import reflected_map, summary
 from cam_fmu.experiments.cosim import reference_loop
-from cam_fmu.experiments.fmu_file import ensure_ssp
-from cam_fmu.experiments.ssp import read_ssp
+from cam_fmu.fmu.build import ensure_ssp
+from cam_fmu.fmu.ssp import read_ssp
 from conftest import run_fmu_script
 
 GAINS = {"quiet": (0.5, 5.0), "resonant": (2.0, 20.0)}
@@ -25,7 +25,7 @@ import json, sys
 sys.path.insert(0, sys.argv[4])  # this checkout's cam_fmu, installed or not
 import numpy as np
 from cam_fmu.experiments.cosim import simulate_system
-from cam_fmu.experiments.ssp import read_ssp
+from cam_fmu.fmu.ssp import read_ssp
 system = read_ssp(sys.argv[1])
 system.components["controller"].parameters.update(kp=float(sys.argv[2]), ki=float(sys.argv[3]))
 r = simulate_system(system, record=["cam.omega", "cam.omega_m"])

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 
 from cam_fmu.experiments.cosim import reference_loop
-from cam_fmu.experiments.ssp import PARAMETER_SET, read_ssp, speed_loop_system, write_ssp
+from cam_fmu.fmu.ssp import PARAMETER_SET, read_ssp, speed_loop_system, write_ssp
 from cam_fmu.tools import ecos_host
 
 ROOT = Path(__file__).resolve().parents[2]

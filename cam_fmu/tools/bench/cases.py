@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 from ...experiments.scenes import find_scene
-from ...experiments.signals import constant
+from ...physics.signals import constant
 from ...physics.parameters import defaults
 from ...physics.variables import INPUT_STARTS
 from ...engine.solvers import SOLVERS

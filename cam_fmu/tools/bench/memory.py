@@ -122,7 +122,7 @@ def format_report(r: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from ...experiments.fmu_file import ensure_fmu
+    from ...fmu.build import ensure_fmu
 
     p = argparse.ArgumentParser(prog="python -m cam_fmu.tools.bench.memory", description=__doc__.split("\n\n")[0])
     p.add_argument("--steps", type=int, default=1_000_000, help="communication steps after the warm-up")

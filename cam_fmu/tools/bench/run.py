@@ -61,7 +61,8 @@ import time
 from pathlib import Path
 from typing import Callable
 
-from ...experiments.fmu_file import check_cam_variables, ensure_fmu
+from ...experiments.fmu_file import check_cam_variables
+from ...fmu.build import ensure_fmu
 from .cases import CASES, COMM_STEPS, References, load_cases, settings_grid
 from .c_floor import build_c_floor_fmu
 from .floor import build_floor_fmu

@@ -149,7 +149,7 @@ if __name__ == "__main__":  # python -m cam_fmu.tools.bench.targets [cam.fmu]
     import sys
     import tempfile
 
-    from ...experiments.fmu_file import ensure_fmu
+    from ...fmu.build import ensure_fmu
 
     with tempfile.TemporaryDirectory() as folder:
         measured = measure(ensure_fmu(sys.argv[1] if len(sys.argv) > 1 else None), Path(folder))
