@@ -11,7 +11,6 @@ session's FMUs for this machine only (the system C compiler). CI runs everything
 """
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -84,36 +83,6 @@ def engine_fmu_path(cam_fmu_path) -> Path:
     """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
     pytest process is safe."""
     return cam_fmu_path
-
-
-def run_fmu_script(script: Path, *args: str, cwd: Path | None = None, timeout: float = 300,
-                   python_args: tuple[str, ...] = ()) -> dict:
-    """Run ``python [python_args] script args...`` and return the JSON object it prints last.
-
-    Fails the test (with the child's output) on a non-zero exit status: a crash of
-    the host process is a failure, not a skip.
-    """
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
-    proc = subprocess.run([sys.executable, *python_args, str(script), *args], capture_output=True, text=True,
-                          cwd=cwd, env=env, timeout=timeout)
-    if proc.returncode != 0:
-        pytest.fail(f"{script.name} {' '.join(args)} exited with {proc.returncode}\n"
-                    f"--- stdout\n{proc.stdout[-4000:]}\n--- stderr\n{proc.stderr[-4000:]}")
-    lines = [line for line in proc.stdout.splitlines() if line.startswith("{")]
-    if not lines:
-        pytest.fail(f"{script.name} printed no JSON result\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
-    result = json.loads(lines[-1])
-    result["_stderr"] = proc.stderr
-    return result
-
-
-def copy_fmu(cam_fmu_path: Path, tmp_path_factory, label: str) -> Path:
-    """A private copy of the session's cam.fmu in a fresh folder (a child process extracts it there)."""
-    import shutil
-    folder = tmp_path_factory.mktemp(label)
-    path = folder / "cam.fmu"
-    shutil.copyfile(cam_fmu_path, path)
-    return path
 
 
 @pytest.fixture(autouse=True)

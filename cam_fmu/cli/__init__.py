@@ -80,7 +80,7 @@ class CliError(Exception):
 def _expected_errors() -> tuple[type[BaseException], ...]:
     """Exceptions that mean bad input (files, values, scenes, FMUs), never a bug: one line, exit 2."""
     errors: list[type[BaseException]] = [CliError, OSError, UnicodeDecodeError, ValueError]
-    for module, name in (("..experiments.fmu_file", "FmuFileError"), ("..experiments.runner", "EngineError"),
+    for module, name in (("..fmu.build", "FmuFileError"), ("..experiments.runner", "EngineError"),
                          ("..experiments.cosim", "CosimError"), ("..fmu.build", "BuildError")):
         try:
             errors.append(getattr(importlib.import_module(module, __name__), name))

@@ -51,8 +51,8 @@ def controller_loop(controller: Path, folder: Path) -> Path:
     written into ``folder``; the connections follow the controller's inputs (M_load, J_load when it has them)."""
     from fmpy import read_model_description
 
-    from ..experiments.fmu_file import ensure_fmu
-    from ..experiments.ssp import SPEED_LOOP_CAM, speed_loop_system, write_ssp
+    from ..fmu.build import ensure_fmu
+    from ..fmu.ssp import SPEED_LOOP_CAM, speed_loop_system, write_ssp
 
     if not controller.is_file():
         raise ValueError(f"--controller {str(controller)!r}: no such FMU file")
@@ -104,8 +104,8 @@ def run(args) -> int:
     from ..control import pi
     from ..experiments.columns import write_csv
     from ..experiments.cosim import CosimInterrupted, ripple, simulate_system
-    from ..experiments.fmu_file import ensure_ssp
-    from ..experiments.ssp import read_ssp
+    from ..fmu.build import ensure_ssp
+    from ..fmu.ssp import read_ssp
     from ..physics.parameters import BY_NAME, resolve
 
     if args.controller and args.ssp:

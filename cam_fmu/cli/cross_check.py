@@ -29,7 +29,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args) -> int:
-    from ..experiments.fmu_file import ensure_fmu
+    from ..fmu.build import ensure_fmu
     from ..tools.cross_check import validate_entry, write_package
     from ..tools.cross_check.layout import shipped_fmus
 

@@ -1,2 +1,2 @@
-"""Experiments: input signals, scenes (shipped in scene_files/), the one fmpy runner,
-the one place that finds or builds cam.fmu, and running a scene on an engine."""
+"""Experiments: scenes (shipped in scene_files/), the one fmpy runner, running a scene on an engine,
+co-simulation of SSPs, frequency responses and sweeps."""

@@ -39,7 +39,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from .limits import check_steps
-from .ssp import System, SspError, extract_ssp, read_ssp
+from ..fmu.ssp import System, SspError, extract_ssp, read_ssp
 
 Progress = Callable[[int, int], None]
 

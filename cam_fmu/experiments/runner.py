@@ -6,7 +6,7 @@ holds 'time' and every name of physics.variables.OUTPUTS, in SI units.
 
 - ``reference``: reference.simulate_reference with the run's parameters and the
   scene's input signals (continuous in time, breaks located exactly).
-- ``fmu``: cam.fmu (fmu_file.ensure_fmu: built first when missing or stale)
+- ``fmu``: cam.fmu (fmu.build.ensure_fmu: built first when missing or stale)
   simulated through the one fmpy runner (fmpy_runner.FmuRunner): start values = the run's parameter overrides,
   input = the scene's signals as a table (fmpy applies them at each
   communication point and the FMU holds them over the step), communication
@@ -20,10 +20,10 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from ..fmu.build import FmuFileError, ensure_fmu
+from ..physics.signals import Signal, as_table, constant
 from ..physics.variables import INPUTS, OUTPUT_NAMES
-from .fmu_file import FmuFileError, ensure_fmu
 from .scenes import Run, Scene
-from .signals import Signal, as_table, constant
 
 ENGINES = ("reference", "fmu")
 

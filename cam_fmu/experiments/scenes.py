@@ -41,9 +41,10 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from ..physics import parameters as _parameters
+from ..physics.signals import OPTIONAL_KEYS, SIGNAL_KEYS, Signal, from_spec
 from ..physics.variables import INPUT_RANGES, UNITS
+from ..plots.scene import PLOTS  # the figure kinds' one table (matplotlib is imported only to draw)
 from .limits import check_steps
-from .signals import OPTIONAL_KEYS, SIGNAL_KEYS, Signal, from_spec
 
 TOP_KEYS = ("description", "drive", "u", "omega_ref", "parameters", "stop_time", "output_interval", "plot", "runs")
 SCENE_DIR = Path(__file__).resolve().parent / "scene_files"
@@ -153,8 +154,6 @@ def scene_from_dict(data: Mapping[str, Any], name: str, path: Path | None = None
     if output_interval > stop_time:
         raise SceneError(f"{where}: 'output_interval' = {output_interval} s exceeds 'stop_time' = {stop_time} s")
     check_steps(stop_time, output_interval, f"{where}: 'stop_time' / 'output_interval'", SceneError)
-
-    from ..plots.scene import PLOTS  # the figure kinds' one table (matplotlib is imported only to draw)
 
     plot = data.get("plot", "time")
     if plot not in PLOTS:

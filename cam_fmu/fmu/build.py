@@ -9,17 +9,28 @@ needs nothing but the C library (``engine_fmu``; docs/fmu.md):
 - cam.fmu (FMI 2.0, co-simulation and Model Exchange) and cam3.fmu (FMI 3.0
   co-simulation): the drive's C engine;
 - pi_speed.fmu (FMI 2.0 co-simulation): the PI speed controller (control/csrc);
-- speed_loop.ssp and compliant_loop.ssp: the two closing a loop (``experiments.ssp``).
+- speed_loop.ssp and compliant_loop.ssp: the two closing a loop (``ssp``).
+
+It is also the one place that finds or builds them for a run (``ensure_fmu``, ``ensure_ssp``): in a source
+checkout (a ``build_fmu.py`` beside the package) they are ``models/<name>``; in an installed package the
+wheel's prebuilt files (``cam_fmu/shipped``), else the user cache (``$XDG_CACHE_HOME/cam_fmu``, else
+``~/.cache/cam_fmu``), named by the package version. Either way an FMU is (re)built from the package's own
+sources when missing or built from other sources.
 """
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
 import sys
+import tempfile
+import zipfile
 from pathlib import Path
-from typing import List, Sequence
+from typing import Callable, List, Sequence
+from xml.etree import ElementTree as ET
 
 from ..engine import targets
-from . import binaries, engine_fmu
+from . import binaries, engine_fmu, ssp
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 # every FMU the project builds: name -> (its C model, FMI version)
@@ -42,9 +53,6 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     """True when ``fmu`` is missing or was built from other sources: its GUID (a hash of everything that
     shapes it, ``engine_fmu.digest``) is not the one this checkout's sources give. The one staleness rule, a
     content hash, as the engine library's file name is."""
-    import zipfile
-    from xml.etree import ElementTree as ET
-
     fmu = Path(fmu)
     if not fmu.is_file():
         return True
@@ -57,19 +65,125 @@ def is_stale(fmu: Path, model: str = "cam") -> bool:
     return built != engine_fmu.model_guid(ENGINE_MODELS[model][0])
 
 
+class FmuFileError(RuntimeError):
+    """The FMU could not be found or built; the message says why."""
+
+
+def source_checkout() -> Path | None:
+    """The repository root when the package runs from a checkout, else None."""
+    root = PACKAGE_DIR.parent
+    return root if (root / "build_fmu.py").is_file() and (root / "pyproject.toml").is_file() else None
+
+
+def shipped_path(name: str = "cam", suffix: str = ".fmu") -> Path | None:
+    """The prebuilt file a distribution wheel carries (``cam_fmu/shipped/<name><suffix>``), else None."""
+    path = PACKAGE_DIR / "shipped" / f"{name}{suffix}"
+    return path if path.is_file() else None
+
+
+def default_model_path(name: str = "cam", suffix: str = ".fmu") -> Path:
+    """models/<name><suffix> in a checkout, the prebuilt file of an installed wheel, else the user-cache copy
+    for this package version."""
+    root = source_checkout()
+    if root is not None:
+        return root / "models" / f"{name}{suffix}"
+    shipped = shipped_path(name, suffix)
+    if shipped is not None:
+        return shipped
+    from .. import __version__
+
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cam_fmu"
+    return cache / f"{name}-{__version__}{suffix}"
+
+
+def default_fmu_path() -> Path:
+    """models/cam.fmu in a checkout, else the user-cache copy for this package version."""
+    return default_model_path("cam")
+
+
+def check_fmu_file(path: Path) -> None:
+    """FmuFileError unless ``path`` is a zip archive with a modelDescription.xml (an FMU)."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            if "modelDescription.xml" not in z.namelist():
+                raise FmuFileError(f"{str(path)!r} is not an FMU: no modelDescription.xml inside")
+    except zipfile.BadZipFile:
+        raise FmuFileError(f"{str(path)!r} is not an FMU (not a zip archive)") from None
+
+
+def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None = None,
+               model: str = "cam") -> Path:
+    """The FMU to run: ``path`` as given (it must exist), or the default one, built when stale.
+
+    The build runs in a subprocess (``python -m cam_fmu.fmu.build``) and replaces the file atomically.
+    """
+    if path is not None:
+        path = Path(path)
+        if not path.is_file():
+            raise FmuFileError(f"FMU {str(path)!r} does not exist")
+        check_fmu_file(path)
+        return path
+    path = default_model_path(model)
+    if path == shipped_path(model) or not is_stale(path, model=model):
+        return path  # a wheel's prebuilt FMU is its own: never rebuilt (it needs no compiler)
+    if log is not None:
+        log(f"# building {path} (missing or older than its sources)")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="cam_fmu_build_", dir=path.parent) as tmp:
+        dest = Path(tmp) / f"{model}.fmu"
+        # a checkout's models/ get every platform (zig); the user cache of an installed package, this machine's
+        platforms = [] if source_checkout() is not None else ["--platforms", "host"]
+        proc = subprocess.run([sys.executable, "-m", "cam_fmu.fmu.build", "--model", model, "--dest", str(dest),
+                               *platforms],
+                              capture_output=True, text=True, cwd=str(PACKAGE_DIR.parent), timeout=600)
+        if proc.returncode != 0 or not dest.is_file():
+            raise FmuFileError(f"building {path} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+        os.replace(dest, path)  # atomic: a process reading the old file keeps it
+    return path
+
+
+def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
+    """A shipped SSP: ``path`` as given (it must exist; a shipped system's name, e.g. compliant_loop, names
+    models/<name>.ssp), or models/speed_loop.ssp, rebuilt when missing or older than one of its FMUs (which
+    ensure_fmu rebuilds when stale) or than fmu/ssp.py (its writer)."""
+    name = SSP_NAME
+    if path is not None:
+        if str(path) in SSP_NAMES and not Path(path).is_file():
+            name = str(path)
+        else:
+            path = Path(path)
+            if not path.is_file():
+                raise FmuFileError(f"SSP file {str(path)!r} does not exist (shipped systems: {', '.join(SSP_NAMES)})")
+            return path
+    path = default_model_path(name, ".ssp")
+    if path == shipped_path(name, ".ssp"):
+        return path  # a wheel's prebuilt SSP, with its prebuilt FMUs
+    fmus = {model: ensure_fmu(None, log, model) for model in ("cam", "pi_speed")}  # the loop's two FMUs
+    inputs = [*fmus.values(), Path(ssp.__file__)]
+    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in inputs):
+        return path
+    if log is not None:
+        log(f"# writing {path}")
+    return build_ssp(path, fmus["cam"], fmus["pi_speed"], name)
+
+
+def fmi_version(path: str | Path) -> str:
+    """The fmiVersion attribute of an FMU's modelDescription.xml ('?' where there is none to read)."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            return ET.fromstring(z.read("modelDescription.xml")).get("fmiVersion", "?")
+    except (zipfile.BadZipFile, KeyError, ET.ParseError, OSError):
+        return "?"
+
+
 def shipped_files() -> list[Path]:
     """The FMUs and SSPs a distribution wheel carries (``models/`` of this checkout, built first where stale)."""
-    from ..experiments.fmu_file import ensure_fmu, ensure_ssp
-
     return [*(ensure_fmu(None, model=name) for name in MODELS), *(ensure_ssp(name) for name in SSP_NAMES)]
 
 
 def build_wheels(folder: Path, names: Sequence[str] | None = None) -> list[Path]:
     """One wheel per target of engine/targets.py (``names``; default all) into ``folder``: py3-none-<platform>,
     the engine library compiled by zig for it and the shipped FMUs and SSPs (setup.py). Returns the wheels."""
-    import os
-    import subprocess
-
     folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
     shipped_files()  # built once here, not once per wheel
@@ -99,19 +213,15 @@ def build(dest: Path, model: str = "cam", platforms: Sequence[str] | None = None
 
 
 def build_ssp(dest: Path, cam: Path, pi_speed: Path, name: str = SSP_NAME) -> Path:
-    """models/<name>.ssp (one of SSP_NAMES) from the two built FMUs (experiments.ssp)."""
-    from ..experiments.ssp import (SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER, compliant_loop_system, speed_loop_system,
-                                   write_ssp)
-
+    """models/<name>.ssp (one of SSP_NAMES) from the two built FMUs (the systems of ``ssp``)."""
     if name not in SSP_NAMES:
         raise BuildError(f"system {name!r}: allowed {', '.join(map(repr, SSP_NAMES))}")
-    system = speed_loop_system(SPEED_LOOP_CAM, SPEED_LOOP_CONTROLLER) if name == SSP_NAME else compliant_loop_system()
-    return write_ssp(system, {"cam": cam, "controller": pi_speed}, dest)
+    system = ssp.speed_loop_system(ssp.SPEED_LOOP_CAM, ssp.SPEED_LOOP_CONTROLLER) if name == SSP_NAME \
+        else ssp.compliant_loop_system()
+    return ssp.write_ssp(system, {"cam": cam, "controller": pi_speed}, dest)
 
 
 def main(argv: List[str] | None = None) -> int:
-    from ..experiments.fmu_file import default_model_path
-
     parser = argparse.ArgumentParser(prog="build_fmu.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dest", type=Path, default=None,
                         help="build one FMU (--model, default cam) into this file; without --dest: "

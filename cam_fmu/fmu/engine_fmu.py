@@ -30,7 +30,7 @@ from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import build as engine_build
 from ..engine import codegen, targets
-from . import binaries, macho, model_description, model_description3, pi_codegen
+from . import binaries, macho, model_description, model_description3, pi_codegen, scene_data
 
 PACKAGE_DIR = engine_build.HERE.parent  # cam_fmu/
 FMI = engine_build.CSRC / "fmi"
@@ -68,10 +68,7 @@ class CModel:
 
 def default_experiment() -> tuple[float, float, float]:
     """(start, stop, step) [s] of the paper's fig. 6 scene: cam.fmu's default experiment."""
-    from ..experiments.scenes import find_scene
-
-    scene = find_scene("paper_fig6")
-    return 0.0, float(scene.stop_time), float(scene.output_interval)
+    return scene_data.experiment("paper_fig6")
 
 
 def controller_experiment() -> tuple[float, float, float]:

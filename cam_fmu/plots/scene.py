@@ -16,16 +16,22 @@ that overlap on the main axes (L = 1 mH vs 0, c = 0.5 mm vs 0) differ there.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import Any, Callable, Mapping, Protocol
 
 import numpy as np
 
 from . import save_figure
 
-if TYPE_CHECKING:
-    from ..experiments.scenes import Scene
-
 Results = Mapping[str, Mapping[str, np.ndarray]]
+
+
+class Scene(Protocol):
+    """What a figure reads of a scene (``experiments.scenes.Scene`` has it; plots import no experiments)."""
+
+    name: str
+    description: str
+    plot: str   # a key of PLOTS
+    drive: str  # 'voltage' or 'speed'
 
 
 def _fig4(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, list]:
@@ -132,7 +138,7 @@ PLOTS: dict[str, Callable[[Any, Results, str], tuple[Any, list]]] = {
 }
 
 
-def plot_scene(scene: "Scene", results: Results, path: str | Path, engine: str = "reference") -> Path:
+def plot_scene(scene: Scene, results: Results, path: str | Path, engine: str = "reference") -> Path:
     """Draw the scene's figure from ``results`` ({label: outputs}) into ``path`` (PNG)."""
     import matplotlib
     matplotlib.use("Agg")
@@ -146,7 +152,7 @@ def plot_scene(scene: "Scene", results: Results, path: str | Path, engine: str =
     return save_figure(plt, fig, path)
 
 
-def draw_scene(plt: Any, scene: "Scene", results: Results) -> Any:
+def draw_scene(plt: Any, scene: Scene, results: Results) -> Any:
     """The scene's matplotlib Figure (not saved), from ``PLOTS[scene.plot]``, grid and legends added."""
     fig, axes = PLOTS[scene.plot](plt, results, scene.drive)
     drawn = set()  # one legend per set of labels (main axes, difference axes)

@@ -21,7 +21,7 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..experiments.signals import Signal, constant
+from ..physics.signals import Signal, constant
 from ..physics.contact import follower_along, rest_position, speed_engaged
 from ..physics.drive import DriveModel
 from ..physics.formulations import formulation_name

@@ -125,7 +125,7 @@ def stride(n: int) -> int:
 
 def replay(case: dict[str, Any]) -> dict[str, Any]:
     """Run one case on the engine: the sampled outputs, the final outputs and the error (or None)."""
-    from ..experiments.signals import Signal
+    from ..physics.signals import Signal
     from ..fmu.engine import DriveSimulator
     from ..physics.variables import OUTPUT_NAMES
 

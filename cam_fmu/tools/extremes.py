@@ -138,7 +138,7 @@ def promised(case: Case, theta_span: float) -> float:
 
 
 def reference_thetas(case: Case, rtol: float = 1e-12) -> list[float]:
-    from ..experiments.signals import Signal, constant
+    from ..physics.signals import Signal, constant
     from ..reference import simulate_reference
 
     times = tuple(t for t, _u in case.u_steps)

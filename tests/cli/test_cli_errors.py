@@ -51,7 +51,7 @@ CASES = [
 @pytest.fixture(scope="module")
 def files(tmp_path_factory, cam_fmu_path) -> dict:
     """What the {placeholders} of CASES name: SSPs with extreme experiments, scenes, FMUs."""
-    from cam_fmu.experiments.ssp import speed_loop_system, write_ssp
+    from cam_fmu.fmu.ssp import speed_loop_system, write_ssp
 
     d = tmp_path_factory.mktemp("cli_inputs")
     fake = d / "fake.fmu"  # read_ssp checks the FMUs' form; the step bound is checked before any loads

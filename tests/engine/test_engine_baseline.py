@@ -31,12 +31,13 @@ def _off_the_paper_grid(case) -> bool:
     return round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * round(ratio)
 
 
-def _as_fixed(case, now) -> dict:
+def _as_fixed(case, now) -> dict | None:
     """The recorded result with the changes issue 19's fixes make on purpose, each checked first:
 
     - item 7: the paper formulation's voltage output before the first step is the input u (it was 0 V);
     - item 1: a paper-formulation step off its fixed grid of calculation steps T = h_max is refused at the
-      first step (it was computed with T = h / ceil(h / h_max), so the answer followed the host's steps).
+      first step (it was computed with T = h / ceil(h / h_max), so the answer followed the host's steps):
+      None, nothing of the record is left to compare.
     Everything else is held to the record unchanged."""
     recorded = copy.deepcopy(case["result"])
     p = resolve(case["params"])
@@ -45,7 +46,7 @@ def _as_fixed(case, now) -> dict:
             error = now["error"]
             assert error and error["class"] == "StepRejected" and error["step"] == 1, error
             assert "fixed grid of calculation steps" in error["message"] and "h_max" in error["message"]
-            return now
+            return None
         u0 = case["inputs"]["u"]["values"][0]
         assert recorded["outputs"]["voltage"][0] == 0.0 and now["outputs"]["voltage"][0] == u0
         recorded["outputs"]["voltage"][0] = u0
@@ -69,8 +70,10 @@ def _stiff_pole(case) -> bool:
 def test_the_engine_reproduces_its_baseline(case):
     now = baseline.replay(case)
     rtol = max(baseline.RTOL, 1e3 * resolve(case["params"])["rtol"]) if _stiff_pole(case) else baseline.RTOL
-    problems, _worst = baseline.compare(_as_fixed(case, now), now, rtol)
-    assert problems == [], f"{case['name']}: " + "\n".join(problems)
+    recorded = _as_fixed(case, now)
+    if recorded is not None:  # not the engine's result compared with itself
+        problems, _worst = baseline.compare(recorded, now, rtol)
+        assert problems == [], f"{case['name']}: " + "\n".join(problems)
 
 
 def test_the_intended_changes_are_few_and_named():
@@ -118,19 +121,14 @@ def test_a_rigid_drive_reports_its_rotor_with_the_cam(name):
     assert set(now["M_shaft"]) == {0.0} and max(abs(w) for w in now["omega"]) > 1.0
 
 
-def test_the_extremes_cases_are_recorded_with_their_errors():
-    cases = RECORDED["extremes"]["cases"]
-    assert len(cases) == baseline.EXTREMES
-    errors = [case["result"]["error"] for case in cases if case["result"]["error"]]
-    assert errors, "no extremes case ends in an error: the error path is not held"
-    assert all(e["class"] and e["step"] >= 0 and e["message"] for e in errors)
-
-
-def test_the_record_says_what_made_it():
+def test_the_record_was_made_by_the_former_engine():
+    """The record is the former engine's (its Cython kernel, named in every file's provenance), never a
+    re-record by the engine under test, which would make the replay above the engine against itself:
+    `baseline --write` now records a provenance without a kernel, which fails here."""
+    now = baseline.provenance()
+    assert "kernel" not in now and "cython" not in now
     for data in RECORDED.values():
-        about = data["recorded_with"]
-        assert {"python", "numpy", "scipy", "commit", "kernel"} <= set(about)
-        assert about["commit"] and len(about["commit"].split("+")[0]) == 40
+        assert data["recorded_with"]["kernel"] == "compiled" and data["recorded_with"]["cython"]
 
 
 def _a_run():

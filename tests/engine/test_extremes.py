@@ -1,26 +1,19 @@
 """cam.fmu at the extremes (issue 5): each case asserts physics, not just "no crash".
 
-Every FMU run happens in a child process that runs THIS file as a script
-(``python tests/engine/test_extremes.py FMU SPEC.json``), one fmpy instance reused with
-reset() between the cases that succeed and a fresh one for each case that must
-fail (FMI 2.0: no call after fmi2Fatal). The pytest side checks, per case: the
+cam.fmu is C (no Python inside): fmpy loads it into this process, as FMPy's own tests do, one instance
+reused with reset() between the cases. Per case: the
 stop time is reached or an FMI error is reported, the outputs are finite, an
 energy or momentum bound holds, and where the reference can run, the FMU agrees
 with it (simulate_reference, scipy, tight tolerances).
 """
 from __future__ import annotations
 
-import json
-import os
 import math
 import shutil
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).resolve()
 NAMES = ("time", "omega", "theta", "s", "i", "M", "J", "v", "a", "alpha", "s_cam")
 PI = math.pi
 
@@ -65,27 +58,23 @@ CASES: dict[str, dict] = {
 }
 
 
-# =========================================================================== child side
-def _run_cases(fmu: str, spec_path: str) -> dict:
+def _run_cases(fmu: str, cases: dict) -> dict:
+    """Every case through fmpy on one instance (reset between them): {name: {"error", "messages", output: array}}."""
     from fmpy import extract, instantiate_fmu, read_model_description, simulate_fmu
     from fmpy.fmi1 import FMICallException
 
-    cases = json.loads(Path(spec_path).read_text())
     md = read_model_description(fmu)
     unzipdir = extract(fmu)
-    shared = instantiate_fmu(unzipdir, md, fmi_type="CoSimulation")
+    messages: list[str] = []
+
+    def logger(component, instance, status, category, message):
+        messages.append(message.decode("utf-8", "replace"))
+
+    instance = instantiate_fmu(unzipdir, md, fmi_type="CoSimulation", debug_logging=True, logger=logger)
     out = {}
     for name, case in cases.items():
-        messages: list[str] = []
-
-        def logger(component, instance, status, category, message, _messages=messages):
-            _messages.append(message.decode("utf-8", "replace"))
-
-        fails = case.get("fails", False)
-        instance = instantiate_fmu(unzipdir, md, fmi_type="CoSimulation",
-                                   debug_logging=True, logger=logger) if fails else shared
-        if not fails:
-            instance.reset()
+        messages.clear()
+        instance.reset()
         inputs = [("u", case.get("u", 0.0)), ("omega_ref", case.get("omega_ref", 1.0))]
         table = np.array([(0.0, *[v for _, v in inputs]), (case["stop"], *[v for _, v in inputs])],
                          dtype=[("time", float)] + [(n, float) for n, _ in inputs])
@@ -94,31 +83,28 @@ def _run_cases(fmu: str, spec_path: str) -> dict:
             res = simulate_fmu(fmu, model_description=md, fmu_instance=instance, start_values=case["start"],
                                input=table, stop_time=case["stop"], output_interval=case["step"],
                                output=list(NAMES[1:]))
-            record.update({n: res[n].tolist() for n in NAMES})
+            record.update({n: np.array(res[n]) for n in NAMES})
         except FMICallException as exc:
             record["error"] = f"{exc.function} returned status {int(exc.status)}"
-        record["messages"] = messages
+        record["messages"] = list(messages)
         out[name] = record
+    instance.freeInstance()
+    _KEEP_ALIVE.append(instance)  # its logger's ctypes thunk: fmpy's logger proxy keeps a pointer to the last one
     shutil.rmtree(unzipdir, ignore_errors=True)
     return out
 
 
-# =========================================================================== pytest side
+_KEEP_ALIVE: list = []
+
+
 @pytest.fixture(scope="module")
-def runs(cam_fmu_path, tmp_path_factory):
-    from conftest import copy_fmu, run_fmu_script
-    fmu = copy_fmu(cam_fmu_path, tmp_path_factory, "extremes")
-    folder = fmu.parent
-    spec = folder / "cases.json"
-    spec.write_text(json.dumps(CASES))
-    result = run_fmu_script(HERE, str(fmu), str(spec), cwd=folder, timeout=900)
-    return {name: {k: (np.array(v) if isinstance(v, list) and k != "messages" else v) for k, v in rec.items()}
-            for name, rec in result.items() if not name.startswith("_")}
+def runs(cam_fmu_path):
+    return _run_cases(str(cam_fmu_path), CASES)
 
 
 def _reference(name: str):
     from cam_fmu.reference import simulate_reference
-    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.signals import constant
     case = CASES[name]
     return simulate_reference(case["start"], case["stop"], case["step"], u=constant(case.get("u", 0.0)),
                               omega_ref=constant(case.get("omega_ref", 1.0)))
@@ -307,10 +293,3 @@ def test_ten_thousand_revolutions_keep_theta_exact(runs):
     # every output lands on a whole number of revolutions: the follower is back at s(0) = 0
     assert np.max(np.abs(run["s"])) < 1e-9
 
-
-if __name__ == "__main__":
-    print(json.dumps(_run_cases(sys.argv[1], sys.argv[2])))
-    # Leave without interpreter teardown, which pythonfmu 0.7.0 can crash (see cam_fmu.cli.exit_after_fmu);
-    # cam_fmu itself may resolve to the FMU's bundled copy here, so no import of it.
-    sys.stdout.flush()
-    os._exit(0)

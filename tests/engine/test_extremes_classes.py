@@ -3,20 +3,15 @@
 Each test is named after its class and checks the class, not only the reported
 example: the run ends correct (against the reference or a closed form) or with
 an error whose message names the parameter, input or setting. The FMI-level
-classes (8-10) run cam.fmu in a child process that runs THIS file as a script.
+classes (8-10) run cam.fmu (C, no Python inside) through fmpy in this process, as FMPy's own tests do.
 """
 from __future__ import annotations
 
-import json
 import math
 import random
 import shutil
-import sys
-from pathlib import Path
 
 import pytest
-
-HERE = Path(__file__).resolve()
 
 
 def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
@@ -31,7 +26,7 @@ def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
 
 
 def _reference_theta(params, u, stop):
-    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.signals import constant
     from cam_fmu.reference import simulate_reference
 
     return float(simulate_reference(params, stop, 1e-3, u=constant(u))["theta"][-1])
@@ -244,7 +239,7 @@ def test_class11_the_side_force_kink_is_located():
 
 # ----------------------------------------------------------------------- FMI classes 8-10
 def scenario_fmi(fmu):
-    """Classes 8-10 through the FMU (this child process only)."""
+    """Classes 8-10 through the FMU: what each call returned and said, and whether the instance kept its state."""
     from fmpy.fmi1 import FMICallException
     from test_fmu_interface import Manual, _md, _unzip
 
@@ -252,6 +247,7 @@ def scenario_fmi(fmu):
     out = {}
     # 8: a second fmi2ExitInitializationMode mid-run is an error, never a silent rewind to t = 0.
     m = Manual(unzipdir, md, "exit2")
+    manuals = [m]
     m.init()
     m.step(100)
     theta = m.outputs()[1]
@@ -272,6 +268,7 @@ def scenario_fmi(fmu):
     import zlib
 
     m = Manual(unzipdir, md, "blob")
+    manuals.append(m)
     m.init()
     m.step(50)
     state = m.fmu.getFMUstate()
@@ -301,6 +298,7 @@ def scenario_fmi(fmu):
     out["blob_size"] = len(blob)
     # 10: messages name the cause: setting an output, u = 1e300.
     m = Manual(unzipdir, md, "msgs")
+    manuals.append(m)
     m.init()
     try:
         m.fmu.setReal([m.vr["omega"]], [1.0])
@@ -315,18 +313,15 @@ def scenario_fmi(fmu):
     except FMICallException as exc:
         out["u_huge"] = int(exc.status)
     out["msgs"] = [text for status, text in m.messages if status >= 3]
+    for instance in manuals:
+        instance.fmu.freeInstance()
     shutil.rmtree(unzipdir, ignore_errors=True)
     return out
 
 
 @pytest.fixture(scope="module")
-def fmi_result(cam_fmu_path, tmp_path_factory):
-    from conftest import run_fmu_script
-
-    folder = tmp_path_factory.mktemp("extreme_classes")
-    fmu = folder / "cam.fmu"
-    shutil.copyfile(cam_fmu_path, fmu)
-    return run_fmu_script(HERE, "fmi", str(fmu), cwd=folder)
+def fmi_result(cam_fmu_path):
+    return scenario_fmi(str(cam_fmu_path))
 
 
 def test_class8_a_second_exit_initialization_is_an_error(fmi_result):
@@ -368,10 +363,3 @@ def test_class10_custom_split_point_errors_name_the_parameters():
     with pytest.raises(ParameterError, match="rise_T1"):
         DriveModel({"rise_law": "custom", "rise_T3": 0.0, "rise_T2": 0.0, "rise_T1": 0.0})
 
-
-if __name__ == "__main__":
-    sys.path[:0] = [str(HERE.parent), str(HERE.parents[1]), str(HERE.parents[1] / "fmu_cs")]  # its layer, the helpers, fmu_cs
-    print(json.dumps(globals()[f"scenario_{sys.argv[1]}"](sys.argv[2])))
-    sys.stdout.flush()
-    import os
-    os._exit(0)

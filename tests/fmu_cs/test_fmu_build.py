@@ -31,7 +31,7 @@ def test_validate_fmu_reports_no_problem(cam_fmu_path):
 
 
 def test_default_build_target_is_models_cam_fmu():
-    from cam_fmu.experiments.fmu_file import default_fmu_path
+    from cam_fmu.fmu.build import default_fmu_path
     assert default_fmu_path() == ROOT / "models" / "cam.fmu"
 
 

@@ -1,26 +1,22 @@
 """cam.fmu through fmpy: default experiment, state, instances, reset, inputs, errors.
 
-Every FMU run happens in a child process that runs THIS file as a script
-(``python tests/fmu_cs/test_fmu_interface.py SCENARIO FMU``): the pytest process never
-loads the FMU (see conftest.cam_fmu_path). Each scenario prints one JSON object;
-the tests below check it. Every run checks that it reached its stop time:
-pythonfmu turns a falsy do_step return into fmi2Discard, which makes fmpy stop
-early without an exception.
+cam.fmu is C (no Python inside): fmpy loads it into this process, as FMPy's own tests do. Each scenario
+returns one dict (what the FMU returned and said; the binary's own stderr output is kept as ``_stderr``);
+the tests below check it. Every run checks that it reached its stop time: a falsy do_step return is
+fmi2Discard, which makes fmpy stop early without an exception.
 """
 from __future__ import annotations
 
 import csv
-import json
-import os
 import math
+import os
 import shutil
 import subprocess
 import sys
-from pathlib import Path
+import tempfile
 
 import pytest
 
-HERE = Path(__file__).resolve()
 OUTPUT_NAMES = ("omega", "theta", "s", "i", "M", "J", "v", "a", "alpha", "s_cam")  # at least these; omega first
 H = 1e-3  # communication step of the manual loops [s]
 
@@ -51,14 +47,14 @@ ERROR_CASES = {
 }
 
 
-# =========================================================================== child side
+# =========================================================================== scenarios
 def _md(fmu):
     from fmpy import read_model_description
     return read_model_description(fmu)
 
 
 class Manual:
-    """One FMU2Slave instance driven step by step (the child process only)."""
+    """One FMU2Slave instance driven step by step."""
 
     def __init__(self, unzipdir, md, name="inst", logging=False):
         from fmpy.fmi2 import FMU2Slave
@@ -365,9 +361,20 @@ SCENARIOS = {name[len("scenario_"):]: f for name, f in list(globals().items()) i
 
 
 # =========================================================================== tests (pytest side)
-def run_scenario(name, fmu, cwd):
-    from conftest import run_fmu_script
-    return run_fmu_script(HERE, name, str(fmu), cwd=cwd)
+def run_scenario(name, fmu):
+    """The scenario's dict, with what the FMU's binary wrote to this process's stderr (file descriptor 2)."""
+    with tempfile.TemporaryFile() as err:
+        sys.stderr.flush()
+        saved = os.dup(2)
+        os.dup2(err.fileno(), 2)
+        try:
+            result = SCENARIOS[name](str(fmu))
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        err.seek(0)
+        result["_stderr"] = err.read().decode("utf-8", "replace")
+    return result
 
 
 @pytest.fixture(scope="module")
@@ -379,7 +386,7 @@ def fmu_copy(cam_fmu_path, tmp_path_factory):
 
 
 def test_default_experiment_simulate_fmu(fmu_copy):
-    r = run_scenario("default", fmu_copy, fmu_copy.parent)
+    r = run_scenario("default", fmu_copy)
     assert r["stop"] == pytest.approx(2.0, abs=1e-12), "simulate_fmu stopped before the default stop time"
     assert r["stop_1ms"] == pytest.approx(2.0, abs=1e-12)
     assert r["n_1ms"] == 2001
@@ -410,7 +417,7 @@ def test_default_experiment_fmpy_cli(fmu_copy, tmp_path):
 
 @pytest.fixture(scope="module")
 def state_result(fmu_copy):
-    return run_scenario("state", fmu_copy, fmu_copy.parent)
+    return run_scenario("state", fmu_copy)
 
 
 @pytest.mark.parametrize("case", sorted(STATE_CASES))
@@ -425,7 +432,7 @@ def test_state_get_set_serialize_bit_identical(state_result, case):
 
 
 def test_two_instances_independent(fmu_copy):
-    r = run_scenario("instances", fmu_copy, fmu_copy.parent)
+    r = run_scenario("instances", fmu_copy)
     assert r["end_time"] == pytest.approx(0.4, abs=1e-12)
     assert r["finite"]
     assert r["a_differs_b"]
@@ -434,7 +441,7 @@ def test_two_instances_independent(fmu_copy):
 
 
 def test_reset_rerun_identical(fmu_copy):
-    r = run_scenario("reset", fmu_copy, fmu_copy.parent)
+    r = run_scenario("reset", fmu_copy)
     assert r["end_time"] == pytest.approx(0.6, abs=1e-12)
     assert r["finite"]
     assert r["identical"], "reset and re-run gave a different result"
@@ -443,7 +450,7 @@ def test_reset_rerun_identical(fmu_copy):
 
 
 def test_time_varying_u_honoured(fmu_copy):
-    r = run_scenario("inputs", fmu_copy, fmu_copy.parent)
+    r = run_scenario("inputs", fmu_copy)
     for key in ("stop_step", "stop_ramp", "stop_const"):
         assert r[key] == pytest.approx(1.0, abs=1e-12), key
     # fmpy's input signal gives the same run as setting u by hand before every step
@@ -458,7 +465,7 @@ def test_time_varying_u_honoured(fmu_copy):
 
 @pytest.fixture(scope="module")
 def error_result(fmu_copy):
-    return run_scenario("errors", fmu_copy, fmu_copy.parent)
+    return run_scenario("errors", fmu_copy)
 
 
 @pytest.mark.parametrize("case", sorted(ERROR_CASES))
@@ -488,10 +495,3 @@ def test_outputs_never_nan_after_rejected_input(error_result):
     assert error_result["manual_after_reset_finite"]
     assert error_result["manual_outputs_unchanged"] and error_result["manual_outputs_finite"]
 
-
-if __name__ == "__main__":
-    print(json.dumps(SCENARIOS[sys.argv[1]](sys.argv[2])))
-    # Leave without interpreter teardown, which pythonfmu 0.7.0 can crash (see cam_fmu.cli.exit_after_fmu);
-    # cam_fmu itself may resolve to the FMU's bundled copy here, so no import of it.
-    sys.stdout.flush()
-    os._exit(0)

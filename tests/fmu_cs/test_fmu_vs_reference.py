@@ -1,7 +1,7 @@
 """cam.fmu through fmpy against the scipy reference, for every scene and run, at two communication steps.
 
-The FMU runs in a child process (this file as a script; an FMU must not be
-loaded into pytest: see conftest). Tolerances follow from the solver settings:
+cam.fmu is C (no Python inside): fmpy loads it into this process, as FMPy's own tests do.
+Tolerances follow from the solver settings:
 
 - consistent formulation, rk45 (default rtol 1e-10, atol 1e-12): the global
   theta error measured on fig. 6 is 2.8e-9 rad at 1 ms and 10 ms, up to 2.4e-7 rad
@@ -18,16 +18,11 @@ loaded into pytest: see conftest). Tolerances follow from the solver settings:
 from __future__ import annotations
 
 import dataclasses
-import json
-import os
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).resolve()
-from cam_fmu.experiments.scenes import SCENE_DIR as MODELS  # noqa: E402  (the shipped scenes)
+from cam_fmu.experiments.scenes import SCENE_DIR as MODELS  # the shipped scenes
 SCENE_NAMES = sorted(p.stem for p in MODELS.glob("*.toml"))
 FACTORS = (1, 10)  # communication step = the scene's output_interval times this
 
@@ -38,21 +33,12 @@ def _scene(name: str, factor: int):
     return dataclasses.replace(scene, output_interval=scene.output_interval * factor)
 
 
-def _child(fmu: str) -> dict:
-    from cam_fmu.experiments.runner import run_scene
-    out = {}
-    for name in SCENE_NAMES:
-        for factor in FACTORS:
-            runs = run_scene(_scene(name, factor), "fmu", fmu)
-            out[f"{name}@{factor}"] = {label: {k: v.tolist() for k, v in r.items()} for label, r in runs.items()}
-    return out
-
-
 @pytest.fixture(scope="module")
-def fmu_runs(cam_fmu_path, tmp_path_factory):
-    from conftest import copy_fmu, run_fmu_script
-    fmu = copy_fmu(cam_fmu_path, tmp_path_factory, "fmu_vs_reference")
-    return run_fmu_script(HERE, str(fmu), cwd=HERE.parents[1], timeout=900)
+def fmu_runs(cam_fmu_path):
+    """Every scene at every factor through fmpy: {"<scene>@<factor>": {label: {output: array}}}."""
+    from cam_fmu.experiments.runner import run_scene
+    return {f"{name}@{factor}": run_scene(_scene(name, factor), "fmu", str(cam_fmu_path))
+            for name in SCENE_NAMES for factor in FACTORS}
 
 
 def _tolerance(params: dict) -> tuple[float, float]:
@@ -75,7 +61,7 @@ def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, fact
     ref = run_scene(scene, "reference")
     assert set(fmu) == set(ref) == {run.label for run in scene.runs}
     for run in scene.runs:
-        f, r = {k: np.array(v) for k, v in fmu[run.label].items()}, ref[run.label]
+        f, r = fmu[run.label], ref[run.label]
         assert f["time"][-1] == pytest.approx(scene.stop_time), f"{name}/{run.label}: the FMU stopped early"
         assert np.allclose(f["time"], r["time"], rtol=0, atol=1e-12)
         theta_tol, omega_rel = _tolerance(run.params)
@@ -93,8 +79,3 @@ def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, fact
             for out in ("s", "i", "M", "J", "v", "a", "alpha", "s_cam"):
                 assert np.allclose(f[out], r[out], rtol=1e-9, atol=1e-12), f"{name}/{run.label}: {out}"
 
-
-if __name__ == "__main__":
-    print(json.dumps(_child(sys.argv[1])))
-    sys.stdout.flush()
-    os._exit(0)  # no interpreter teardown after loading a pythonfmu FMU (see cam_fmu.cli.exit_after_fmu)

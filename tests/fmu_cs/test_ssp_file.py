@@ -18,7 +18,7 @@ import fmpy
 import pytest
 from lxml import etree
 
-from cam_fmu.experiments.ssp import OMS, Connection, SspError, read_ssp, speed_loop_system, write_ssp
+from cam_fmu.fmu.ssp import OMS, Connection, SspError, read_ssp, speed_loop_system, write_ssp
 
 ROOT = Path(__file__).resolve().parents[2]
 SCHEMA = Path(fmpy.__file__).parent / "ssp" / "schema" / "SystemStructureDescription.xsd"
@@ -51,7 +51,7 @@ def test_ssd_is_valid_ssp_and_carries_omsimulators_annotation(tmp_path, step):
 
 
 def test_the_shipped_ssp_is_valid_and_annotated():
-    from cam_fmu.experiments.fmu_file import ensure_ssp
+    from cam_fmu.fmu.build import ensure_ssp
 
     doc = etree.fromstring(zipfile.ZipFile(ensure_ssp()).read("SystemStructure.ssd"))
     assert etree.XMLSchema(etree.parse(str(SCHEMA))).validate(doc)
@@ -161,8 +161,8 @@ def test_a_binding_equal_to_the_fmus_default_is_not_written(tmp_path, fmi3):
 def test_the_shipped_loops_bind_no_default_and_carry_their_own_experiment(name, stop):
     """compliant_loop.ssp bound cam.fmu's drive = 'voltage' (its default) as an ssv:String, which OMSimulator could
     not import; the SSD's ssd:DefaultExperiment holds the loop's start and stop time (a run given none takes them)."""
-    from cam_fmu.experiments.fmu_file import ensure_fmu, ensure_ssp
-    from cam_fmu.experiments.ssp import fmu_defaults
+    from cam_fmu.fmu.build import ensure_fmu, ensure_ssp
+    from cam_fmu.fmu.ssp import fmu_defaults
 
     ssp = ensure_ssp(name)
     written = _bindings(ssp)
@@ -176,3 +176,15 @@ def test_the_shipped_loops_bind_no_default_and_carry_their_own_experiment(name, 
     experiment = doc.find(f"{SSD}DefaultExperiment")
     assert (float(experiment.get("startTime")), float(experiment.get("stopTime"))) == (0.0, stop)
     assert read_ssp(ssp).stop_time == stop
+
+
+def test_the_numbers_the_fmus_read_from_scene_files_are_the_scenes():
+    """fmu.scene_data reads two shipped scene files as plain TOML (the fmu layer imports no experiments):
+    cam.fmu's default experiment and compliant_loop.ssp's drive equal what the scene parser makes of them."""
+    from cam_fmu.experiments.scenes import find_scene
+    from cam_fmu.fmu import engine_fmu, ssp
+
+    fig6 = find_scene("paper_fig6")
+    assert engine_fmu.default_experiment() == (0.0, fig6.stop_time, fig6.output_interval)
+    shaft = find_scene("compliant_shaft")
+    assert ssp.compliant_loop_system().components["cam"].parameters == {**shaft.parameters, **shaft.runs[0].overrides}

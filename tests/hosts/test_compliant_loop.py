@@ -4,50 +4,28 @@ map predicts; the FMUs agree with the same loop run in-process."""
 from __future__ import annotations
 
 import copy
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cam_fmu.control.reflect import reflected_map, summary
-from cam_fmu.experiments.cosim import reference_loop
-from cam_fmu.experiments.fmu_file import ensure_ssp
-from cam_fmu.experiments.ssp import read_ssp
-from conftest import run_fmu_script
+from cam_fmu.experiments.cosim import reference_loop, simulate_system
+from cam_fmu.fmu.build import ensure_ssp
+from cam_fmu.fmu.ssp import read_ssp
 
 GAINS = {"quiet": (0.5, 5.0), "resonant": (2.0, 20.0)}
 
 
-# The FMU loop runs in a child process: pi_speed.fmu is a pythonfmu FMU, which must not be loaded into pytest
-# (conftest's guard fails a test that does).
-CHILD = """
-import json, sys
-sys.path.insert(0, sys.argv[4])  # this checkout's cam_fmu, installed or not
-import numpy as np
-from cam_fmu.experiments.cosim import simulate_system
-from cam_fmu.experiments.ssp import read_ssp
-system = read_ssp(sys.argv[1])
-system.components["controller"].parameters.update(kp=float(sys.argv[2]), ki=float(sys.argv[3]))
-r = simulate_system(system, record=["cam.omega", "cam.omega_m"])
-print(json.dumps({k: np.asarray(v).tolist() for k, v in r.items()}))
-sys.stdout.flush()
-import os
-os._exit(0)
-"""
-
-
 @pytest.fixture(scope="module")
-def loops(tmp_path_factory):
-    path = ensure_ssp("compliant_loop")
-    system = read_ssp(path)
-    script = tmp_path_factory.mktemp("compliant_loop") / "loop.py"
-    script.write_text(CHILD)
+def loops():
+    """Both FMUs are C: the loop runs in this process through fmpy, once per pair of gains."""
+    system = read_ssp(ensure_ssp("compliant_loop"))
     runs = {}
     for label, (kp, ki) in GAINS.items():
         variant = copy.deepcopy(system)
         variant.components["controller"].parameters.update(kp=kp, ki=ki)
-        result = run_fmu_script(script, str(path), str(kp), str(ki), str(Path(__file__).resolve().parents[2]))
-        runs[label] = (variant, {k: np.asarray(v) for k, v in result.items() if not k.startswith("_")})
+        result = simulate_system(variant, record=["cam.omega", "cam.omega_m"])
+        runs[label] = (variant, {k: np.asarray(v) for k, v in result.items()})
     return system, runs
 
 

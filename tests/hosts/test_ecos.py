@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +16,6 @@ import pytest
 
 from cam_fmu.tools import ecos_host
 
-HERE = Path(__file__).resolve().parents[1]
 RUNS = 4
 STOP, STEP = 2.0, 1e-3  # the default experiment (fig. 6)
 # ecos writes its CSV with 6 decimals: |omega| < 100 rad/s gives at most 5e-7 rad/s of rounding.
@@ -41,11 +39,9 @@ def test_ecos_and_libtbb_available():
 
 
 @pytest.fixture(scope="module")
-def fmpy_omega(cam_fmu_path, tmp_path_factory):
-    from conftest import run_fmu_script
-    folder = tmp_path_factory.mktemp("fmpy_for_ecos")
-    shutil.copyfile(cam_fmu_path, folder / "cam.fmu")
-    r = run_fmu_script(HERE / "fmu_cs" / "test_fmu_interface.py", "omega", str(folder / "cam.fmu"), cwd=folder)
+def fmpy_omega(cam_fmu_path):
+    from test_fmu_interface import scenario_omega  # fmpy in this process (cam.fmu is C)
+    r = scenario_omega(str(cam_fmu_path))
     return np.array(r["time"]), np.array(r["omega"])
 
 

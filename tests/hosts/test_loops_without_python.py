@@ -22,8 +22,8 @@ import pytest
 from cam_fmu.engine import targets
 from cam_fmu.engine.build import fmi_headers
 from cam_fmu.experiments.cosim import simulate_system
-from cam_fmu.experiments.fmu_file import ensure_ssp
-from cam_fmu.experiments.ssp import read_ssp
+from cam_fmu.fmu.build import ensure_ssp
+from cam_fmu.fmu.ssp import read_ssp
 from native_support import require, runner, zig_host
 
 HERE = Path(__file__).resolve().parents[1]

@@ -6,8 +6,9 @@
 - ecos (native C++, reading the SSP file itself) and libcosim (OSP, reading the SSP file)
   against the master, to their output precision.
 
-FMUs are loaded only in child processes. These tests FAIL (never skip) when ecos or
-libcosimpy is missing: the CI installs both.
+Both FMUs are C: the project's master runs them in this process through fmpy; ecos, libcosim (an isolated
+Python) and the CLI run in their own processes. These tests FAIL (never skip) when ecos or libcosimpy is
+missing: the CI installs both.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ import numpy as np
 import pytest
 
 from cam_fmu.experiments.cosim import reference_loop
-from cam_fmu.experiments.ssp import PARAMETER_SET, read_ssp, speed_loop_system, write_ssp
+from cam_fmu.fmu.ssp import PARAMETER_SET, read_ssp, speed_loop_system, write_ssp
 from cam_fmu.tools import ecos_host
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -53,19 +54,10 @@ def ssp(cam_fmu_path, tmp_path_factory) -> Path:
     return write_ssp(system, {"cam": cam_fmu_path, "controller": pi_fmu}, folder / "speed_loop.ssp")
 
 
-MASTER = """
-import json, os, sys
-from cam_fmu.experiments.cosim import simulate_system
-r = simulate_system(sys.argv[1], record=["cam.gamma", "controller.integral"])
-print(json.dumps({k: v.tolist() for k, v in r.items()}))
-sys.stdout.flush(); os._exit(0)  # pythonfmu 0.7.0 may abort at interpreter teardown
-"""
-
-
 @pytest.fixture(scope="module")
 def master(ssp) -> dict:
-    out = _child(["-c", MASTER, str(ssp)], cwd=ssp.parent).stdout
-    return {k: np.array(v) for k, v in json.loads(out.strip().splitlines()[-1]).items()}
+    from cam_fmu.experiments.cosim import simulate_system
+    return {k: np.asarray(v) for k, v in simulate_system(str(ssp), record=["cam.gamma", "controller.integral"]).items()}
 
 
 @pytest.fixture(scope="module")

@@ -268,7 +268,7 @@ def _engine_run(params, u, stop, h):
 
 
 def _reference_vs_engine(table, gamma, beta, mu, u, stop):
-    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.signals import constant
     from cam_fmu.reference.integrate import simulate_reference
 
     params = dict(motion_table=table, gamma=gamma, beta=beta, G=1.0, mu=mu, rtol=1e-13, atol=1e-14)

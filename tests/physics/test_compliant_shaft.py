@@ -12,7 +12,7 @@ from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.errors import StepRejected
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.experiments.scenes import find_scene
-from cam_fmu.experiments.signals import constant
+from cam_fmu.physics.signals import constant
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.variables import OUTPUT_NAMES
 from cam_fmu.reference import simulate_reference

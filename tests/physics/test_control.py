@@ -9,7 +9,7 @@ from hypothesis import given, settings, strategies as st
 
 from cam_fmu.control.pi import PiSpeedController, resolve
 from cam_fmu.experiments.cosim import reference_loop, ripple
-from cam_fmu.experiments.ssp import Connection, parse_ssd, speed_loop_system, system_xml
+from cam_fmu.fmu.ssp import Connection, parse_ssd, speed_loop_system, system_xml
 from cam_fmu.physics.parameters import ParameterError
 
 

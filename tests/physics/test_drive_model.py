@@ -21,7 +21,7 @@ from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.physics.formulations.paper import PaperScheme
 from cam_fmu.reference import simulate_reference
-from cam_fmu.experiments.signals import constant
+from cam_fmu.physics.signals import constant
 from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import A, DEFAULTS, friction_fixed_point, paper_profile, sgn
 

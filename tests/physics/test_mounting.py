@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cam_fmu.engine.simulator import DriveSimulator
-from cam_fmu.experiments.signals import Signal, constant
+from cam_fmu.physics.signals import Signal, constant
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.parameters import MOUNTING_ZERO
 from cam_fmu.reference.integrate import simulate_reference

@@ -25,7 +25,7 @@ from cam_fmu.physics.formulations import consistent as hybrid_module
 from cam_fmu.physics.drive import DriveModel, break_away_voltage
 from cam_fmu.physics.formulations.consistent import ENGAGE_DOWN, ENGAGE_UP, HybridDrive, Mode
 from cam_fmu.reference import simulate_reference
-from cam_fmu.experiments.signals import constant
+from cam_fmu.physics.signals import constant
 from cam_fmu.fmu.engine import DriveSimulator
 from test_drive_closed_form import DEFAULTS, H, friction_fixed_point, paper_profile
 

@@ -1,10 +1,11 @@
 """docs/architecture.md's import rules, checked against the code (every import, parsed with ast).
 
 - the layer table ("may import"): no layer imports one it does not list;
+- the table is a stack: its rows run from the bottom up and no layer may import one of a later row;
+- the graph of the layers' imports, read from the code alone (every import, deferred ones and those for
+  type hints included), has no cycle;
 - the leaf modules the text names import nothing of the package;
-- the four layers the FMU bundles import nothing outside themselves and `errors`;
-- the upward imports the table calls "inside functions" or "for type hints only" are not executed at
-  import time.
+- the layers the FMU bundles import nothing outside themselves and `errors`.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "cam_fmu"
 DOC = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
 BUNDLED = {"kinematics", "physics", "control"}
-LEAVES = ("physics.variables", "experiments.signals", "errors")
+LEAVES = ("physics.variables", "physics.signals", "errors")
 
 
 def modules() -> dict[str, Path]:
@@ -53,11 +54,42 @@ def layer(module: str) -> str:
 
 
 def rule_table() -> dict[str, set[str]]:
+    """layer -> the layers it may import, in the table's order (from the bottom up)."""
     section = DOC[DOC.index("## Dependency direction"):DOC.index("## What the FMUs carry")]
     table = {}
     for row in re.findall(r"^\| `(\w+)` \|([^|]*)\|", section, flags=re.M):
         table[row[0]] = set(re.findall(r"`(\w+)`", row[1]))
     return table
+
+
+def layer_graph() -> dict[str, set[str]]:
+    """layer -> the other layers its modules import, from the code."""
+    graph: dict[str, set[str]] = {}
+    for module, path in modules().items():
+        if module and not module.startswith("__"):
+            for target, _ in imports(module, path):
+                if target and layer(target) not in (layer(module), "__version__"):
+                    graph.setdefault(layer(module), set()).add(layer(target))
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Cycles of a directed graph, one per back edge of a depth-first search (none: the graph is acyclic)."""
+    found, state = [], {}
+
+    def visit(node: str, path: list[str]) -> None:
+        state[node] = "open"
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == "open":
+                found.append(path[path.index(nxt):] + [nxt])
+            elif nxt not in state:
+                visit(nxt, path + [nxt])
+        state[node] = "done"
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node, [node])
+    return found
 
 
 def layers() -> set[str]:
@@ -80,6 +112,23 @@ def test_a_layer_imports_only_what_the_table_allows(name):
     assert not found, f"docs/architecture.md does not let {name!r} import: {found}"
 
 
+def test_the_table_is_a_stack():
+    order = list(rule_table())
+    upward = {name: sorted(allowed - set(order[:order.index(name)])) for name, allowed in rule_table().items()}
+    assert not {k: v for k, v in upward.items() if v}, f"layers listing a layer of their own row or a later one: {upward}"
+
+
+def test_no_cycle_between_layers():
+    assert cycles(layer_graph()) == []
+
+
+def test_the_cycle_check_finds_cycles():
+    """The check above could fail: the finder sees a two-layer cycle, a longer one, and none in a stack."""
+    assert cycles({"fmu": {"experiments"}, "experiments": {"fmu", "physics"}}) == [["experiments", "fmu", "experiments"]]
+    assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c", "a"]]
+    assert cycles({"cli": {"tools", "physics"}, "tools": {"physics"}}) == []
+
+
 @pytest.mark.parametrize("leaf", LEAVES)
 def test_leaf_modules_import_nothing_of_the_package(leaf):
     assert f"`{leaf}`" in DOC
@@ -91,13 +140,6 @@ def test_leaf_modules_import_nothing_of_the_package(leaf):
 def test_the_bundled_layers_stay_among_themselves():
     for name in BUNDLED:
         assert rule_table()[name] <= BUNDLED | {"errors"}, name
-
-
-@pytest.mark.parametrize("importer,target", [("fmu.build", "experiments"), ("fmu.engine_fmu", "experiments"), ("plots.scene", "experiments"),
-                                             ("experiments.scenes", "plots")])
-def test_upward_imports_are_not_run_at_import_time(importer, target):
-    found = [(t, top) for t, top in imports(importer, modules()[importer]) if layer(t) == target]
-    assert found and not any(top for _, top in found), found
 
 
 def test_every_test_file_the_code_and_docs_cite_exists():

@@ -1,7 +1,6 @@
-"""The bench's C floor FMU, and its report functions (Pareto front, ratios, goal verdict) on synthetic rows.
+"""The bench's C floor FMU, its report functions (Pareto front, ratios) on synthetic rows, its loops and registry.
 
-The C floor is a plain C library (no Python inside), so unlike cam.fmu and the
-pythonfmu floor it is loaded in the pytest process. No timing is asserted.
+The C floor, like cam.fmu, is C: both are loaded in the pytest process. No timing is asserted.
 """
 from __future__ import annotations
 
@@ -13,7 +12,7 @@ import pytest
 
 from cam_fmu.physics.parameters import EFFECTS
 from cam_fmu.physics.variables import INPUT_STARTS, INPUTS, OUTPUT_NAMES
-from cam_fmu.tools.bench import perstep, report
+from cam_fmu.tools.bench import effects, loops, report, scenes
 
 
 @pytest.fixture(scope="module")
@@ -102,61 +101,57 @@ def test_pareto_keeps_only_the_non_dominated_settings_per_scene_and_comm_step():
     assert "rtol=1e-10*" in text and "etdrk4" not in text
 
 
-def _scene_row(cam, py, c, scene="paper_fig6", record="theta,omega"):
-    row = dict(scene=scene, drive="voltage", record=record, comm_step=1e-3, n_steps=2000, stop_time=2.0,
-               cam_us=cam, py_floor_us=py, c_floor_us=c, repeats=5, error="")
-    row["cam_py_ratio"] = cam / py
-    row["cam_c_ratio"] = cam / c
-    return row
+def test_the_loops_report_ratios_to_baselines_of_the_same_run():
+    lines = loops.report(dict(c_host_us=1.0, c_host_floor_us=0.02, fmpy_us=4.5, fmpy_floor_us=4.0, fmpy_ratio=1.125,
+                              in_process_ms=2.2, theta_end=13.2))
+    assert len(lines) == 3
+    assert "1.000 us/step" in lines[0] and "0.020 us" in lines[0] and "model 0.980 us" in lines[0]
+    assert "1.125x the C floor FMU (4.00 us)" in lines[1]
+    assert "2.20 ms = 1.10x the C host's 2000 steps" in lines[2]
 
 
-def test_goal_verdict_states_both_ratios():
-    rows = [_scene_row(130.0, 25.0, 18.0, record="all"),   # another record: not the one reported
-            _scene_row(24.0, 20.0, 10.0)]
-    text = report.goal_verdict(rows)
-    assert "fig6" in text and "theta+omega" in text
-    assert "cam.fmu 24.0 us/step (best of 5 rounds) = 1.20x the pythonfmu floor (20.0 us), 2.40x the C floor " \
-        "(10.0 us)" in text
-    assert "no fig6 row" in report.goal_verdict([_scene_row(1.0, 1.0, 1.0, scene="backlash")])
-
-
-def test_the_targets_verdict_says_met_or_not_with_the_figures():
-    from cam_fmu.tools.bench import targets
-
-    fast = dict(c_host_us=0.4, c_host_floor_us=0.01, fmpy_us=4.5, fmpy_floor_us=4.0, fmpy_ratio=1.125,
-                in_process_ms=1.5, theta_end=13.2)
-    lines = targets.verdict(fast)
-    assert len(lines) == 3 and all(line.endswith(": met") for line in lines), lines
-    assert "0.400 us/step" in lines[0] and "1.125x" in lines[1] and "1.50 ms" in lines[2]
-    slow = dict(fast, c_host_us=1.2, fmpy_ratio=1.3, in_process_ms=2.7)
-    assert all(line.endswith("NOT met") for line in targets.verdict(slow))
-
-
-def test_the_targets_are_measured_as_positive_finite_numbers(cam_fmu_path, tmp_path):
-    """A quick measurement of every target (timing values are not asserted, only that they are measured,
+def test_the_loops_are_measured_as_positive_finite_numbers(cam_fmu_path, c_floor, tmp_path):
+    """A quick measurement of every loop (timing values are not asserted, only that they are measured,
     and that the C host ran the model: theta moved)."""
-    from cam_fmu.tools.bench import targets
-
-    measured = targets.measure(cam_fmu_path, tmp_path, quick=True)
+    measured = loops.measure(cam_fmu_path, c_floor, tmp_path, quick=True)
     for key in ("c_host_us", "c_host_floor_us", "fmpy_us", "fmpy_floor_us", "fmpy_ratio", "in_process_ms"):
         assert math.isfinite(measured[key]) and measured[key] > 0.0, (key, measured)
     assert measured["theta_end"] > 1.0
 
 
-def test_scene_and_effect_rows_print_their_ratios():
-    line = report.format_scene_row(_scene_row(130.0, 25.0, 18.0))
+def test_scene_and_effect_rows_print_their_ratio():
+    row = dict(scene="paper_fig6", record="theta,omega", cam_us=130.0, c_floor_us=18.0, cam_c_ratio=130.0 / 18.0,
+               error="")
+    line = scenes.format_row(row)
     assert line.split()[:2] == ["paper_fig6", "theta,omega"]
-    assert [float(x) for x in line.split()[2:]] == pytest.approx([130.0, 25.0, 18.0, 5.2, 7.22], abs=0.006)
-    effects = [dict(config="defaults", change="fig. 6 as shipped", us_per_step=130.0, delta_us=0.0, py_ratio=5.2,
-                    c_ratio=7.2, error=""),
-               dict(config="all off", change="every effect false", us_per_step=100.0, delta_us=-30.0, py_ratio=4.0,
-                    c_ratio=5.5, error="")]
-    text = report.format_effects(effects)
-    assert "-30.0" in text and "all off" in text
+    assert [float(x) for x in line.split()[2:]] == pytest.approx([130.0, 18.0, 7.22], abs=0.006)
+    rows = [dict(config="defaults", change="fig. 6 as shipped", us_per_step=130.0, delta_us=0.0, c_ratio=7.2, error=""),
+            dict(config="all off", change="every effect false", us_per_step=100.0, delta_us=-30.0, c_ratio=5.5,
+                 error="")]
+    text = effects.format_effects(rows)
+    assert "-30.0" in text and "all off" in text and "5.50" in text
+
+
+def test_a_benchmark_is_a_module_with_run_and_a_registry_line():
+    """Every entry of BENCHMARKS names a module of tools/bench with run(ctx), and every module with run(ctx)
+    is an entry (a new benchmark: one module, one line)."""
+    import importlib
+    import inspect
+    from pathlib import Path
+
+    from cam_fmu.tools import bench
+
+    registered = {module for module, _default, _what in bench.BENCHMARKS.values()}
+    with_run = {p.stem for p in Path(bench.__file__).parent.glob("*.py")
+                if "\ndef run(ctx" in p.read_text(encoding="utf-8")}
+    assert registered == with_run
+    for module in registered:
+        assert list(inspect.signature(importlib.import_module(f"cam_fmu.tools.bench.{module}").run).parameters)[0] == "ctx"
+    assert set(bench.DEFAULT) == {"grid", "scenes", "effects", "loops"}
 
 
 def test_effect_configs_switch_each_effect_once():
-    configs = perstep.effect_configs()
+    configs = effects.effect_configs()
     names = [c[0] for c in configs]
     assert names[0] == "defaults" and names[-1] == "all off" and len(set(names)) == len(names)
     for effect in EFFECTS:
@@ -169,9 +164,9 @@ def test_effect_configs_switch_each_effect_once():
 def test_every_shipped_scene_is_in_the_full_scene_table():
     from cam_fmu.experiments.scenes import scene_names
 
-    full = perstep.scene_list(quick=False)
+    full = scenes.scene_list(quick=False)
     assert full[0] == "paper_fig6" and sorted(full) == sorted(scene_names())
-    assert perstep.scene_list(quick=True) == ["paper_fig6"]
-    speed = perstep.load_scene_case("speed_drive")
+    assert scenes.scene_list(quick=True) == ["paper_fig6"]
+    speed = scenes.load_scene_case("speed_drive")
     assert speed.drive == "speed" and "solver" not in speed.start_values
     assert set(speed.inputs.dtype.names) == {"time", *INPUT_STARTS}

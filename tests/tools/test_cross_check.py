@@ -110,10 +110,10 @@ def test_one_folder_per_interface_and_binary(package):
 def test_by_default_the_fmus_of_the_drive(monkeypatch):
     """Without --fmu: every model fmu.build builds on the drive's C model (cam.fmu, cam3.fmu): the folders'
     experiment is a step of the drive's u, which pi_speed.fmu does not have."""
-    import cam_fmu.experiments.fmu_file as fmu_file
+    import cam_fmu.fmu.build as fmu_build
     from cam_fmu.fmu.build import MODELS
     from cam_fmu.tools.cross_check.layout import shipped_fmus
-    monkeypatch.setattr(fmu_file, "ensure_fmu", lambda path, log=None, model="cam": Path(f"{model}.fmu"))
+    monkeypatch.setattr(fmu_build, "ensure_fmu", lambda path, log=None, model="cam": Path(f"{model}.fmu"))
     names = [p.stem for p in shipped_fmus()]
     assert names == ["cam", "cam3"] and "pi_speed" in MODELS
 
@@ -214,7 +214,7 @@ def test_the_reference_agrees_with_the_scipy_reference(package):
     test_fmu_vs_reference's rk45 tolerances (theta 1e-6 rad, omega 1e-4 of its peak); every folder
     passes fmpy's importer criterion against it."""
     from cam_fmu.experiments.scenes import find_scene
-    from cam_fmu.experiments.signals import Signal
+    from cam_fmu.physics.signals import Signal
     from cam_fmu.reference import simulate_reference
     from cam_fmu.tools.cross_check.experiment import STEP_TIME
 

@@ -1,1 +1,75 @@
-"""`cam-fmu bench`: the speed-accuracy trade of cam.fmu, measured through fmpy (see run.py)."""
+"""`cam-fmu bench`: what cam.fmu costs per communication step and how accurate each solver setting is.
+
+Each benchmark is one module with ``run(ctx: Context) -> int`` (0, or 1 when a run went wrong without an
+error) and one line in ``BENCHMARKS``. A benchmark reports ratios against a baseline measured in the same
+run (the C floor FMU, the defaults, the gcc build): timings on a shared machine move, their ratios less.
+"""
+from __future__ import annotations
+
+import importlib
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Sequence
+
+# name: (module, in a plain `cam-fmu bench`, what it measures)
+BENCHMARKS = {
+    "grid": ("grid", True, "theta error and cost ratio of every solver setting x comm step (fig6, backlash, "
+                           "inductance)"),
+    "scenes": ("scenes", True, "us per step of cam.fmu and the C floor on every shipped scene at the defaults"),
+    "effects": ("effects", True, "us per step of fig. 6 with each effect switched"),
+    "loops": ("loops", True, "tight loops: a C host, fmpy's FMU2Slave, one in-process run"),
+    "memory": ("memory", False, "RSS over a long run through FMU2Slave"),
+    "toolchain": ("toolchain", False, "cam.fmu's binary from zig against the system gcc's"),
+}
+DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
+
+
+@dataclass
+class Context:
+    """What every benchmark is given: the FMU measured, the output folder, a temporary folder, the C floor."""
+
+    fmu: Path
+    out: Path
+    tmp: Path
+    quick: bool
+    say: Callable[[str], None]
+    _runners: dict = field(default_factory=dict)
+
+    def c_floor(self) -> Path:
+        """The C floor FMU (``c_floor.py``), built once per run."""
+        if "c_floor_fmu" not in self._runners:
+            from .c_floor import build_c_floor_fmu
+            self._runners["c_floor_fmu"] = build_c_floor_fmu(self.tmp)
+        return self._runners["c_floor_fmu"]
+
+    def runner(self, name: str):
+        """A TimedRunner of 'cam' (the FMU measured) or 'c_floor', one per run (its instance is reused)."""
+        if name not in self._runners:
+            from .timing import TimedRunner
+            self._runners[name] = TimedRunner(self.fmu if name == "cam" else self.c_floor(), self.tmp, name)
+        return self._runners[name]
+
+
+def run(names: Sequence[str], out: Path, quick: bool = False, fmu_path: Path | None = None,
+        log: Callable[[str], None] | None = None) -> int:
+    """Run the benchmarks ``names`` (keys of BENCHMARKS, in their order) into ``out``; 0, or 1 when one says so."""
+    from ...experiments.fmu_file import check_cam_variables
+    from ...fmu.build import ensure_fmu
+
+    def say(text: str) -> None:
+        (log or print)(text)
+        sys.stdout.flush()
+
+    fmu = check_cam_variables(ensure_fmu(fmu_path, log=say))  # another FMU: refused before any run
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    status = 0
+    with tempfile.TemporaryDirectory(prefix="cam_bench_") as tmp:
+        ctx = Context(fmu, out, Path(tmp), quick, say)
+        for name in names:
+            say(f"\n# {name}: {BENCHMARKS[name][2]}")
+            status |= importlib.import_module(f".{BENCHMARKS[name][0]}", __name__).run(ctx)
+        ctx._runners.clear()  # the instances go before their folder
+    return status

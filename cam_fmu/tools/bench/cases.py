@@ -6,8 +6,8 @@ from dataclasses import dataclass
 from typing import Any, Sequence
 
 from ...experiments.scenes import find_scene
-from ...experiments.signals import constant
 from ...physics.parameters import defaults
+from ...physics.signals import constant
 from ...physics.variables import INPUT_STARTS
 from ...engine.solvers import SOLVERS
 
@@ -17,8 +17,6 @@ RK45_RTOL = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)  # atol = rtol / 100 (1e-10 is the d
 COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s
 CASES = ("fig6", "backlash", "inductance")
 LEVELS = (1e-3, 1e-6, 1e-8)  # rad: accuracy levels of the choice table
-TARGET_ERR = 1e-6  # rad: the project's accuracy target at 1 ms on fig. 6
-TARGET_RATIO = 3.0  # the cheapest setting meeting TARGET_ERR costs at most this x the floor
 
 CASE_SCENES = {"fig6": "paper_fig6", "backlash": "backlash", "inductance": "inductance"}  # shipped scenes
 

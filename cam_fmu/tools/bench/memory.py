@@ -1,5 +1,6 @@
 """Peak RSS of a long cam.fmu run: does memory stay flat over 1e6 communication steps?
 
+    cam-fmu bench memory [--quick]          # 1e6 steps (--quick: 2e4)
     python -m cam_fmu.tools.bench.memory [--steps 1000000] [--fmu FILE] [--comm 1e-3] [--json]
 
 Runs cam.fmu (fig. 6 at the defaults, u = 3.5 V) through fmpy's ``FMU2Slave``
@@ -121,8 +122,14 @@ def format_report(r: dict) -> str:
     return "\n".join(lines)
 
 
+def run(ctx) -> int:
+    """The benchmark ``memory`` of ``cam-fmu bench``: 1e6 steps (--quick: 2e4)."""
+    ctx.say(format_report(run_memory(ctx.fmu, 20_000 if ctx.quick else 1_000_000)))
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
-    from ...experiments.fmu_file import ensure_fmu
+    from ...fmu.build import ensure_fmu
 
     p = argparse.ArgumentParser(prog="python -m cam_fmu.tools.bench.memory", description=__doc__.split("\n\n")[0])
     p.add_argument("--steps", type=int, default=1_000_000, help="communication steps after the warm-up")

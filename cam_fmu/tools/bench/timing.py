@@ -4,7 +4,6 @@ from __future__ import annotations
 import gc
 import math
 import time
-from pathlib import Path
 
 from ...experiments.fmpy_runner import FmuRunner
 

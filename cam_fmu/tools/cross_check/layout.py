@@ -100,7 +100,6 @@ def shipped_fmus() -> list[Path]:
     """The project's FMUs of the drive (every model fmu.build builds on the drive's C model: cam.fmu,
     cam3.fmu), each built first when missing or stale. The experiment every folder records is the drive's
     (fig. 6 after a step of u); pi_speed.fmu, the controller, has no input u and is left out."""
-    from ...experiments.fmu_file import ensure_fmu
-    from ...fmu.build import ENGINE_MODELS
+    from ...fmu.build import ENGINE_MODELS, ensure_fmu
 
     return [ensure_fmu(None, model=name) for name, (c_model, _v) in ENGINE_MODELS.items() if c_model == "cam"]

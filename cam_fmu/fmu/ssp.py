@@ -29,7 +29,7 @@ declared with the right kind (output or input at its start, input at its end),
 no input is fed by two connections, and each component's source is an FMU (a zip
 with a modelDescription.xml); the error names the component or connection.
 
-Standard library only.
+Standard library only (and the scene files' numbers, ``scene_data``).
 """
 from __future__ import annotations
 
@@ -40,6 +40,8 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
+
+from . import scene_data
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -369,9 +371,5 @@ def compliant_loop_system() -> System:
     """models/compliant_loop.ssp: the PI loop on the cam's speed (an encoder on the cam shaft) around the
     compliant_shaft scene's drive (resonance 207-363 Hz), sampled at 5 kHz; its gains (kp 0.5 V/(rad/s),
     ki 5 V/rad) keep the loop's bandwidth below the anti-resonance (docs/control.md section 5)."""
-    from .scenes import find_scene
-
-    scene = find_scene("compliant_shaft")
-    cam = {**scene.parameters, **scene.runs[0].overrides}
-    return speed_loop_system(cam, {"omega_set": 3.0, "kp": 0.5, "ki": 5.0}, stop_time=2.0, step_size=2e-4,
-                             feedforward_connections=False, name="compliant_loop", measured="omega")
+    return speed_loop_system(scene_data.primary_parameters("compliant_shaft"), {"omega_set": 3.0, "kp": 0.5, "ki": 5.0},
+                             stop_time=2.0, step_size=2e-4, feedforward_connections=False, name="compliant_loop", measured="omega")
