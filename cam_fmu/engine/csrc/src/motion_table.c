@@ -254,30 +254,29 @@ void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *compar
 }
 
 /* "motion table line L (row R): " */
-static int row_fail(char *err, size_t err_len, size_t line, size_t row, const char *what)
+static int row_fail(CamError *err, size_t line, size_t row, const char *what)
 {
-    return cam_fail(err, err_len, "motion table line %lu (row %lu): %s", (unsigned long)line, (unsigned long)row,
+    return cam_error(err, CAM_ERR_PARAMETER, "motion table line %lu (row %lu): %s", (unsigned long)line, (unsigned long)row,
                     what);
 }
 
 /* The number in field f (named name) or a refusal. */
-static int field_value(Span f, const char *name, size_t line, size_t row, double *value, char *err,
-                       size_t err_len)
+static int field_value(Span f, const char *name, size_t line, size_t row, double *value, CamError *err)
 {
     char msg[MSG], q[200];
     int kind = classify(f);
     cam_quote(f.s, f.n, q, sizeof q);
     if (kind == NOT_NUMBER) {
         snprintf(msg, sizeof msg, "the %s field is not a number: %s", name, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, msg);
     }
     if (f.n > CAM_TABLE_MAX_NUMBER) {
         snprintf(msg, sizeof msg, "the %s field has more than %d characters: %s", name, CAM_TABLE_MAX_NUMBER, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, msg);
     }
     if (to_double(f, kind, value)) {
         snprintf(msg, sizeof msg, "the %s field could not be read as a number: %s", name, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, msg);
     }
     return 0;
 }
@@ -288,7 +287,7 @@ typedef struct {
     double degrees, radians, mm;
 } RowInfo;
 
-static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err_len)
+static int parse(const char *text, size_t len, Rows *rows, CamError *err)
 {
     char msg[MSG], q1[200], q2[200];
     size_t pos = 0, line = 0, row = 0;
@@ -350,7 +349,7 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
         if (closed) {
             snprintf(msg, sizeof msg, "no row may follow the closing row at 360 deg (row %lu, line %lu)",
                      (unsigned long)closing.row, (unsigned long)closing.line);
-            return row_fail(err, err_len, line, row, msg);
+            return row_fail(err, line, row, msg);
         }
         if (n_fields != 2) {
             size_t a = start, b = stop;
@@ -363,30 +362,30 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
             cam_quote(text + a, b - a, q1, sizeof q1);
             snprintf(msg, sizeof msg, "expected 2 fields 'angle_deg, lift_mm', got %lu: %s", (unsigned long)n_fields,
                      q1);
-            return row_fail(err, err_len, line, row, msg);
+            return row_fail(err, line, row, msg);
         }
         memset(&r, 0, sizeof r);
         r.line = line;
         r.row = row;
         r.angle = field[0];
         r.lift = field[1];
-        if (field_value(r.angle, "angle_deg", line, row, &r.degrees, err, err_len) ||
-            field_value(r.lift, "lift_mm", line, row, &r.mm, err, err_len)) {
-            return 1;
+        if (field_value(r.angle, "angle_deg", line, row, &r.degrees, err) ||
+            field_value(r.lift, "lift_mm", line, row, &r.mm, err)) {
+            return CAM_ERR_PARAMETER;
         }
         if (!(isfinite(r.degrees) && r.degrees >= 0.0 && r.degrees <= 360.0)) {
             cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
             snprintf(msg, sizeof msg, "angle_deg must lie in [0, 360) (or be 360 in a closing row), got %s", q1);
-            return row_fail(err, err_len, line, row, msg);
+            return row_fail(err, line, row, msg);
         }
         if (!(isfinite(r.mm) && r.mm >= 0.0 && r.mm <= CAM_TABLE_MAX_LIFT_MM)) {
             cam_quote(r.lift.s, r.lift.n, q1, sizeof q1);
             snprintf(msg, sizeof msg, "lift_mm must be a number in [0, 10000], got %s", q1);
-            return row_fail(err, err_len, line, row, msg);
+            return row_fail(err, line, row, msg);
         }
         if (r.degrees == 360.0) {
             if (rows->n == 0 || first.degrees != 0.0) {
-                return row_fail(err, err_len, line, row, "a row at 360 deg closes the period: it must come last, "
+                return row_fail(err, line, row, "a row at 360 deg closes the period: it must come last, "
                                 "after a first row at 0 deg");
             }
             if (fabs(r.mm - first.mm) > 1e-9 * fmax(1.0, fabs(first.mm))) {
@@ -394,7 +393,7 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
                 cam_quote(r.lift.s, r.lift.n, q2, sizeof q2);
                 snprintf(msg, sizeof msg, "the closing row at 360 deg must repeat the lift of row %lu (line %lu), "
                          "%s mm, got %s mm", (unsigned long)first.row, (unsigned long)first.line, q1, q2);
-                return row_fail(err, err_len, line, row, msg);
+                return row_fail(err, line, row, msg);
             }
             closed = 1;
             closing = r;
@@ -408,22 +407,22 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
                 snprintf(msg, sizeof msg, "angle %s deg %s %s deg of row %lu (line %lu); angles must increase strictly",
                          q1, r.degrees == prev.degrees ? "repeats" : "is below", q2, (unsigned long)prev.row,
                          (unsigned long)prev.line);
-                return row_fail(err, err_len, line, row, msg);
+                return row_fail(err, line, row, msg);
             }
             if (r.degrees - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
                 cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
                 cam_quote(prev.angle.s, prev.angle.n, q2, sizeof q2);
                 snprintf(msg, sizeof msg, "angle %s deg is closer than 1e-06 deg to %s deg of row %lu (line %lu)",
                          q1, q2, (unsigned long)prev.row, (unsigned long)prev.line);
-                return row_fail(err, err_len, line, row, msg);
+                return row_fail(err, line, row, msg);
             }
         }
         if (rows->n >= CAM_TABLE_MAX_ROWS) {
-            return cam_fail(err, err_len, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
+            return cam_error(err, CAM_ERR_PARAMETER, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
                             (unsigned long)line);
         }
         if (push(rows, r.radians, r.mm * 1e-3)) {
-            return cam_fail(err, err_len, "motion table: out of memory at row %lu", (unsigned long)row);
+            return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory at row %lu", (unsigned long)row);
         }
         if (rows->n == 1) {
             first = r;
@@ -431,7 +430,7 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
         prev = r;
     }
     if (rows->n < 2) {
-        return cam_fail(err, err_len, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing row at "
+        return cam_error(err, CAM_ERR_PARAMETER, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing row at "
                         "360 deg not counted), got %lu", (unsigned long)rows->n);
     }
     if ((first.degrees + 360.0) - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
@@ -440,33 +439,34 @@ static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err
         snprintf(msg, sizeof msg, "motion table line %lu (row %lu): angle %s deg is closer than 1e-06 deg to %s deg "
                  "+ 360 deg of row %lu (line %lu), where the period starts again", (unsigned long)prev.line,
                  (unsigned long)prev.row, q1, q2, (unsigned long)first.row, (unsigned long)first.line);
-        return cam_fail(err, err_len, "%s", msg);
+        return cam_error(err, CAM_ERR_PARAMETER, "%s", msg);
     }
     return 0;
 }
 
-int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, char *err, size_t err_len)
+int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, CamError *err)
 {
     Rows rows;
     CamTable *t;
     double *block;
     size_t n, i;
+    int status;
     memset(p, 0, sizeof *p);
     memset(&rows, 0, sizeof rows);
     if (text == NULL && text_len > 0) {
-        return cam_fail(err, err_len, "motion table: no text");
+        return cam_error(err, CAM_ERR_PARAMETER, "motion table: no text");
     }
-    if (parse(text, text_len, &rows, err, err_len)) {
+    if ((status = parse(text, text_len, &rows, err)) != CAM_OK) {
         free(rows.angle);
         free(rows.lift);
-        return 1;
+        return status;
     }
     n = rows.n;
     block = malloc(7 * n * sizeof *block);
     if (block == NULL) {
         free(rows.angle);
         free(rows.lift);
-        return cam_fail(err, err_len, "motion table: out of memory for %lu rows", (unsigned long)n);
+        return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory for %lu rows", (unsigned long)n);
     }
     t = &p->table;
     t->n = n;

@@ -16,7 +16,7 @@
 
 #define TWO_PI (2.0 * 3.141592653589793)
 
-static int check_program(double lift, const double angle[4], char *err, size_t err_len)
+static int check_program(double lift, const double angle[4], CamError *err)
 {
     static const char *const names[4] = {"rise_angle", "upper_dwell", "return_angle", "lower_dwell"};
     char list[512], r[CAM_REPR_LEN];
@@ -25,7 +25,7 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
     int k;
     if (!(isfinite(lift) && lift > 0.0)) {
         cam_repr(lift, r);
-        return cam_fail(err, err_len, "lift must be a finite number > 0 [m], got %s", r);
+        return cam_error(err, CAM_ERR_PARAMETER, "lift must be a finite number > 0 [m], got %s", r);
     }
     list[0] = '\0';
     for (k = 0; k < 4; k++) {
@@ -35,7 +35,7 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
         }
     }
     if (pos) {
-        return cam_fail(err, err_len, "angles must be finite and >= 0 [rad]: %s", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "angles must be finite and >= 0 [rad]: %s", list);
     }
     for (k = 0; k < 4; k += 2) {
         if (angle[k] < CAM_MIN_STROKE_ANGLE) {
@@ -44,14 +44,14 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
         }
     }
     if (pos) {
-        return cam_fail(err, err_len, "rise and return angles must be >= 0.000174533 rad (0.01 deg) [rad]: %s", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "rise and return angles must be >= 0.000174533 rad (0.01 deg) [rad]: %s", list);
     }
     total = angle[0] + angle[1] + angle[2] + angle[3];
     if (fabs(total - TWO_PI) > 1e-9) {
         char two_pi[CAM_REPR_LEN];
         cam_repr(total, r);
         cam_repr(TWO_PI, two_pi);
-        return cam_fail(err, err_len, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' "
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' "
                         "= %s rad must equal 2 pi = %s rad (to 1e-9 rad)", r, two_pi);
     }
     return 0;
@@ -110,7 +110,7 @@ static double law_feature(const CamLaw *law, double beta, double best)
 
 int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double return_T[6], double lift,
                           double rise_angle, double upper_dwell, double return_angle, double lower_dwell,
-                          char *err, size_t err_len)
+                          CamError *err)
 {
     double angle[4], pts[16], beta, h;
     size_t n;
@@ -120,10 +120,10 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     angle[1] = upper_dwell;
     angle[2] = return_angle;
     angle[3] = lower_dwell;
-    if (cam_law_init(&p->rise, rise_T, "rise", err, err_len) ||
-        cam_law_init(&p->ret, return_T, "return", err, err_len) || check_program(lift, angle, err, err_len)) {
+    if (cam_law_init(&p->rise, rise_T, "rise", err) ||
+        cam_law_init(&p->ret, return_T, "return", err) || check_program(lift, angle, err)) {
         memset(p, 0, sizeof *p);
-        return 1;
+        return CAM_ERR_PARAMETER;
     }
     p->lift = lift;
     p->b1 = rise_angle;
@@ -144,7 +144,7 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     p->points = malloc(n * sizeof *p->points);
     if (p->points == NULL) {
         memset(p, 0, sizeof *p);
-        return cam_fail(err, err_len, "cam program: out of memory");
+        return cam_error(err, CAM_ERR_MEMORY, "cam program: out of memory");
     }
     memcpy(p->points, pts, n * sizeof *pts);
     p->n_points = n;
