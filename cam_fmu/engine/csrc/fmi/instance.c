@@ -465,111 +465,143 @@ static int same_params(const CamParams *a, const CamParams *b)
     return memcmp(a->v, b->v, sizeof a->v) == 0 && strcmp(ta, tb) == 0;
 }
 
-int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t size)
+/* The blob's header: this format, and sizes that agree with size; the flag and the table's length out. */
+static int decode_header(CamInstance *d, const unsigned char *buffer, size_t size, uint64_t *flag,
+                         uint64_t *length)
 {
-    CamParams params;
-    CamDrive fresh;
-    double state[CAM_STATE_LEN], inputs[CAM_N_INPUTS], start_time;
-    const unsigned char *p = buffer + HEADER_BYTES;
     uint64_t initialized, n;
-    size_t k;
-    int status;
-    if (size < HEADER_BYTES + 8 * FIXED_DOUBLES || get_u64(buffer) != ((uint64_t)BLOB_MAGIC | ((uint64_t)BLOB_VERSION << 32)))
+    if (size < HEADER_BYTES + 8 * FIXED_DOUBLES
+        || get_u64(buffer) != ((uint64_t)BLOB_MAGIC | ((uint64_t)BLOB_VERSION << 32)))
         return cam_error(&d->error, CAM_ERR_SIMULATION, "the state is not a saved state of this cam.fmu (format 1)");
     initialized = get_u64(buffer + 8);
     n = get_u64(buffer + 16);
     if (initialized > 1 || n != size - HEADER_BYTES - 8 * FIXED_DOUBLES)
         return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state is truncated or corrupt (its sizes disagree)");
-    start_time = get_double(p);
-    p += 8;
-    for (k = 0; k < CAM_N_INPUTS; k++, p += 8) {
-        inputs[k] = get_double(p);
+    *flag = initialized;
+    *length = n;
+    return CAM_OK;
+}
+
+/* The start time and the inputs at p, each input checked as if a host had set it. */
+static int decode_inputs(CamInstance *d, const unsigned char *p, double *start_time, double inputs[CAM_N_INPUTS])
+{
+    size_t k;
+    int status;
+    *start_time = get_double(p);
+    for (k = 0; k < CAM_N_INPUTS; k++) {
+        inputs[k] = get_double(p + 8 * (1 + k));
         if ((status = check_real(d, (unsigned)k, inputs[k], &d->error)) != CAM_OK)
             return status;
     }
-    if (!isfinite(start_time))
+    if (!isfinite(*start_time))
         return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's start time is not finite");
-    /* the parameters, each checked as if a host had set it */
-    cam_params_defaults(&params);
-    for (k = 0; k < CAM_N_PARAMS; k++, p += 8) {
+    return CAM_OK;
+}
+
+/* The parameters at p into params (at their defaults), each checked as if a host had set it. */
+static int decode_params(CamInstance *d, const unsigned char *p, CamParams *params)
+{
+    size_t k;
+    int status;
+    for (k = 0; k < CAM_N_PARAMS; k++) {
         const CamParamSpec *s = cam_param_spec((int)k);
-        double v = get_double(p);
+        double v = get_double(p + 8 * k);
         if (s->kind == CAM_KIND_STRING) {
-            if (s->n_choices && !(v >= 0.0 && v < s->n_choices && v == floor(v))) {
-                cam_params_free(&params);
+            if (s->n_choices && !(v >= 0.0 && v < s->n_choices && v == floor(v)))
                 return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's parameter '%s' is not one of "
                                  "its choices", s->name);
-            }
             if (s->n_choices)
-                params.v[k] = v;
+                params->v[k] = v;
             continue;
         }
-        if (s->kind == CAM_KIND_BOOLEAN && v != 0.0 && v != 1.0) {
-            cam_params_free(&params);
+        if (s->kind == CAM_KIND_BOOLEAN && v != 0.0 && v != 1.0)
             return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's parameter '%s' is not a boolean",
                              s->name);
-        }
-        if ((status = cam_params_set_real(&params, (int)k, v, &d->error)) != CAM_OK) {
-            cam_params_free(&params);
+        if ((status = cam_params_set_real(params, (int)k, v, &d->error)) != CAM_OK)
             return status;
-        }
     }
-    for (k = 0; k < CAM_STATE_LEN; k++, p += 8)
-        state[k] = get_double(p);
-    if (n) {
-        int table = -1;
-        for (k = 0; k < CAM_N_PARAMS; k++)
-            if (cam_param_spec((int)k)->kind == CAM_KIND_STRING && cam_param_spec((int)k)->n_choices == 0)
-                table = (int)k;
-        if (table < 0)
-            status = cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state has a table and no table parameter");
-        else
-            status = cam_params_set_string(&params, table, (const char *)p, (size_t)n, &d->error);
-        if (status != CAM_OK) {
-            cam_params_free(&params);
-            return status;
-        }
-    }
-    if (!initialized) {
-        if (d->initialized)
-            cam_drive_free(&d->drive);
-        cam_params_free(&d->params);
-        d->params = params;
-        memcpy(d->inputs, inputs, sizeof inputs);
-        d->start_time = start_time;
-        d->initialized = 0;
-        d->preview_valid = 0;
-        return CAM_OK;
-    }
-    if (d->initialized && same_params(&d->params, &params)) {
+    return CAM_OK;
+}
+
+/* The motion table's n bytes at p into params' table parameter. */
+static int decode_table(CamInstance *d, const unsigned char *p, size_t n, CamParams *params)
+{
+    int table = -1, k;
+    for (k = 0; k < CAM_N_PARAMS; k++)
+        if (cam_param_spec(k)->kind == CAM_KIND_STRING && cam_param_spec(k)->n_choices == 0)
+            table = k;
+    if (table < 0)
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state has a table and no table parameter");
+    return cam_params_set_string(params, table, (const char *)p, n, &d->error);
+}
+
+/* The drive of params (taken over: kept or freed) in the saved state: the instance's own drive when the
+ * parameters are its own, else a new one; on refusal the instance is as before. */
+static int restore_drive(CamInstance *d, CamParams *params, const double state[CAM_STATE_LEN], double start_time)
+{
+    CamDrive fresh;
+    int status;
+    if (d->initialized && same_params(&d->params, params)) {
         /* the usual case, a state of this instance: the drive's program is kept, not built again */
         CamDrive backup = d->drive;
-        cam_params_free(&params);
+        cam_params_free(params);
         d->drive.start_time = start_time;
-        if ((status = cam_drive_set_state(&d->drive, state, &d->error)) != CAM_OK) {
+        if ((status = cam_drive_set_state(&d->drive, state, &d->error)) != CAM_OK)
             d->drive = backup;
+        return status;
+    }
+    if ((status = cam_params_check(params, &d->error)) != CAM_OK ||
+        (status = cam_drive_init(&fresh, params, &d->error)) != CAM_OK) {
+        cam_params_free(params);
+        return status;
+    }
+    fresh.start_time = start_time;
+    if ((status = cam_drive_set_state(&fresh, state, &d->error)) != CAM_OK) {
+        cam_drive_free(&fresh);
+        cam_params_free(params);
+        return status;
+    }
+    if (d->initialized)
+        cam_drive_free(&d->drive);
+    cam_params_free(&d->params);
+    d->params = *params;
+    d->drive = fresh;
+    return CAM_OK;
+}
+
+int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t size)
+{
+    const unsigned char *p = buffer + HEADER_BYTES;
+    const unsigned char *p_params = p + 8 * (1 + CAM_N_INPUTS), *p_state = p_params + 8 * CAM_N_PARAMS;
+    CamParams params;
+    double state[CAM_STATE_LEN], inputs[CAM_N_INPUTS], start_time;
+    uint64_t initialized = 0, n = 0;   /* set by decode_header (initialised for the compiler) */
+    size_t k;
+    int status;
+    if ((status = decode_header(d, buffer, size, &initialized, &n)) != CAM_OK
+        || (status = decode_inputs(d, p, &start_time, inputs)) != CAM_OK)
+        return status;
+    cam_params_defaults(&params);
+    if ((status = decode_params(d, p_params, &params)) == CAM_OK && n)
+        status = decode_table(d, p_state + 8 * CAM_STATE_LEN, (size_t)n, &params);
+    if (status != CAM_OK) {
+        cam_params_free(&params);
+        return status;
+    }
+    for (k = 0; k < CAM_STATE_LEN; k++)
+        state[k] = get_double(p_state + 8 * k);
+    if (initialized) {
+        if ((status = restore_drive(d, &params, state, start_time)) != CAM_OK)
             return status;
-        }
     } else {
-        if ((status = cam_params_check(&params, &d->error)) != CAM_OK ||
-            (status = cam_drive_init(&fresh, &params, &d->error)) != CAM_OK) {
-            cam_params_free(&params);
-            return status;
-        }
-        fresh.start_time = start_time;
-        if ((status = cam_drive_set_state(&fresh, state, &d->error)) != CAM_OK) {
-            cam_drive_free(&fresh);
-            cam_params_free(&params);
-            return status;
-        }
         if (d->initialized)
             cam_drive_free(&d->drive);
         cam_params_free(&d->params);
         d->params = params;
-        d->drive = fresh;
+        d->preview_valid = 0;
     }
     memcpy(d->inputs, inputs, sizeof inputs);
     d->start_time = start_time;
-    d->initialized = 1;
+    d->initialized = (int)initialized;
     return CAM_OK;
 }
