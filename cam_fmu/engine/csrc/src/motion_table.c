@@ -9,7 +9,6 @@
  * of a dwell), otherwise at most 3 times the smaller chord slope. Each piece is then monotone
  * between its two lifts: no overshoot, and a run of equal lifts is exactly flat.
  */
-#include "cam_profile.h"
 #include "cam_table.h"
 #include "cam_text.h"
 
@@ -509,14 +508,13 @@ static int parse(const char *text, size_t len, Rows *rows, CamError *err)
     return check_period(&ps, rows, err);
 }
 
-int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, CamError *err)
+int cam_table_init(CamTable *t, const char *text, size_t text_len, CamError *err)
 {
     Rows rows;
-    CamTable *t;
     double *block;
-    size_t n, i;
+    size_t n;
     int status;
-    memset(p, 0, sizeof *p);
+    memset(t, 0, sizeof *t);
     memset(&rows, 0, sizeof rows);
     if (text == NULL && text_len > 0) {
         return cam_error(err, CAM_ERR_PARAMETER, "motion table: no text");
@@ -533,7 +531,6 @@ int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, Cam
         free(rows.lift);
         return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory for %lu rows", (unsigned long)n);
     }
-    t = &p->table;
     t->n = n;
     t->angle = block;
     t->lift = block + n;
@@ -547,19 +544,11 @@ int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, Cam
     free(rows.angle);
     free(rows.lift);
     build(t);
-    p->kind = CAM_PROGRAM_TABLE;
-    p->points = t->angle;
-    p->n_points = n;
-    p->feature_angle = t->width[0];
-    for (i = 1; i < n; i++) {
-        if (t->width[i] < p->feature_angle) {
-            p->feature_angle = t->width[i];
-        }
-    }
-    for (i = 0; i < n; i++) {
-        if (t->lift[i] > p->lift) {
-            p->lift = t->lift[i];  /* the largest lift [m], as TableProgram.lift */
-        }
-    }
-    return 0;
+    return CAM_OK;
+}
+
+void cam_table_free(CamTable *t)
+{
+    free(t->angle);  /* the table's one allocation */
+    memset(t, 0, sizeof *t);
 }

@@ -3,7 +3,8 @@
  * cam_profile_init_laws checks as kinematics/cam_program.py's CamProgram (and physics/parameters.py for
  * the sum of the angles) and computes what kinematics.cam_program.CamProgram does; cam_profile_eval is
  * CamProgram.derivatives (same operations, same order: the same doubles); breakpoints and the
- * feature angle are CamProgram.breakpoints() and CamProgram.feature_angle(). Tables: motion_table.c.
+ * feature angle are CamProgram.breakpoints() and CamProgram.feature_angle(). A table program is built here
+ * around the CamTable that motion_table.c parses, interpolates and frees (cam_table.h).
  */
 #include "cam_profile.h"
 #include "cam_table.h"
@@ -152,13 +153,39 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     return 0;
 }
 
+int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, CamError *err)
+{
+    const CamTable *t = &p->table;
+    size_t i;
+    int status;
+    memset(p, 0, sizeof *p);
+    if ((status = cam_table_init(&p->table, text, text_len, err)) != CAM_OK) {
+        return status;
+    }
+    p->kind = CAM_PROGRAM_TABLE;
+    p->points = t->angle;
+    p->n_points = t->n;
+    p->feature_angle = t->width[0];
+    for (i = 1; i < t->n; i++) {
+        if (t->width[i] < p->feature_angle) {
+            p->feature_angle = t->width[i];
+        }
+    }
+    for (i = 0; i < t->n; i++) {
+        if (t->lift[i] > p->lift) {
+            p->lift = t->lift[i];  /* the largest lift [m], as TableProgram.lift */
+        }
+    }
+    return CAM_OK;
+}
+
 void cam_profile_free(CamProfile *p)
 {
     if (p == NULL) {
         return;
     }
     if (p->kind == CAM_PROGRAM_TABLE) {
-        free(p->table.angle);  /* the table's one allocation; points is table.angle */
+        cam_table_free(&p->table);  /* points is the table's array of angles */
     } else {
         free(p->points);
     }
