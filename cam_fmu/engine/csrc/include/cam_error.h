@@ -3,7 +3,8 @@
  * Python binding raises it, the FMI glue logs it through the host's logger).
  *
  * Messages name the parameter, input or setting and what to change, with numbers and a user's text quoted
- * as cam_text.h writes them, so that they read text-for-text as the Python engine's. C99, no globals.
+ * as cam_text.h writes them, so that they read text-for-text as the Python model's (physics/, kinematics/).
+ * C99, no globals.
  */
 #ifndef CAM_ERROR_H
 #define CAM_ERROR_H
