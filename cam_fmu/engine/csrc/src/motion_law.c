@@ -187,11 +187,12 @@ int cam_law_init(CamLaw *law, const double T[6], const char *name, CamError *err
         }
         snprintf(list + pos, sizeof list - pos, ")");
         if (name != NULL && name[0] != '\0') {
-            return cam_error(err, CAM_ERR_PARAMETER, "%.20s law: split points %.20s_T1..%.20s_T6 = %s are too close to make a "
-                            "finite curve (acceleration or deceleration phase of length ~0)", name, name, name, list);
+            return cam_error(err, CAM_ERR_PARAMETER, "%.20s law: split points %.20s_T1..%.20s_T6 = %s are too close "
+                             "to make a finite curve (acceleration or deceleration phase of length ~0)", name, name,
+                             name, list);
         }
         return cam_error(err, CAM_ERR_PARAMETER, "split points %s are too close to make a finite curve "
-                        "(acceleration or deceleration phase of length ~0)", list);
+                         "(acceleration or deceleration phase of length ~0)", list);
     }
     for (i = 0; i < CAM_LAW_SEGMENTS; i++) {
         double *seg;

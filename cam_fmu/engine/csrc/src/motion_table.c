@@ -404,8 +404,8 @@ static int close_period(Parser *ps, const Rows *rows, const RowInfo *r, CamError
                         "after a first row at 0 deg");
     }
     if (fabs(r->mm - first->mm) > 1e-9 * fmax(1.0, fabs(first->mm))) {
-        return row_fail(err, ps->line, ps->row, "the closing row at 360 deg must repeat the lift of row %lu (line %lu), "
-                        "%s mm, got %s mm", (unsigned long)first->row, (unsigned long)first->line,
+        return row_fail(err, ps->line, ps->row, "the closing row at 360 deg must repeat the lift of row %lu "
+                        "(line %lu), %s mm, got %s mm", (unsigned long)first->row, (unsigned long)first->line,
                         cam_text(first->lift.s, first->lift.n, q1, sizeof q1),
                         cam_text(r->lift.s, r->lift.n, q2, sizeof q2));
     }

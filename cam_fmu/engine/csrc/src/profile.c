@@ -45,15 +45,16 @@ static int check_program(double lift, const double angle[4], CamError *err)
         }
     }
     if (pos) {
-        return cam_error(err, CAM_ERR_PARAMETER, "rise and return angles must be >= 0.000174533 rad (0.01 deg) [rad]: %s", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "rise and return angles must be >= 0.000174533 rad (0.01 deg) "
+                         "[rad]: %s", list);
     }
     total = angle[0] + angle[1] + angle[2] + angle[3];
     if (fabs(total - TWO_PI) > 1e-9) {
         char two_pi[CAM_REPR_LEN];
         cam_repr(total, r);
         cam_repr(TWO_PI, two_pi);
-        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' "
-                        "= %s rad must equal 2 pi = %s rad (to 1e-9 rad)", r, two_pi);
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + "
+                         "'lower_dwell' = %s rad must equal 2 pi = %s rad (to 1e-9 rad)", r, two_pi);
     }
     return 0;
 }
