@@ -12,11 +12,11 @@ import ctypes
 from typing import Sequence
 
 from cam_fmu.engine.library import load
+from cam_fmu.engine.simulator import CamError
 
 __all__ = ["EngineProfile", "law_segments", "SEGMENT_FIELDS"]
 
 SEGMENT_FIELDS = 7
-_ERR = 1024
 _D = ctypes.c_double
 _PD = ctypes.POINTER(_D)
 _SIZE = ctypes.c_size_t
@@ -44,13 +44,13 @@ def _lib() -> ctypes.CDLL:
         lib.cam_profile_sizeof.argtypes = []
         if lib.cam_profile_sizeof() != ctypes.sizeof(CamProfile):
             raise RuntimeError("engine_profile: CamProfile differs from cam_profile.h")
-        lib.cam_law_init.argtypes = [ctypes.POINTER(CamLaw), _D * 6, ctypes.c_char_p, ctypes.c_char_p, _SIZE]
+        lib.cam_law_init.argtypes = [ctypes.POINTER(CamLaw), _D * 6, ctypes.c_char_p, ctypes.POINTER(CamError)]
         lib.cam_law_eval.argtypes = [ctypes.POINTER(CamLaw), _D, _D * 4]
         lib.cam_law_eval.restype = None
         lib.cam_profile_init_laws.argtypes = [ctypes.POINTER(CamProfile), _D * 6, _D * 6] + [_D] * 5 + [
-            ctypes.c_char_p, _SIZE]
+            ctypes.POINTER(CamError)]
         lib.cam_profile_init_table.argtypes = [ctypes.POINTER(CamProfile), ctypes.c_char_p, _SIZE,
-                                               ctypes.c_char_p, _SIZE]
+                                               ctypes.POINTER(CamError)]
         lib.cam_profile_free.argtypes = [ctypes.POINTER(CamProfile)]
         lib.cam_profile_free.restype = None
         lib.cam_profile_eval_counted.argtypes = [ctypes.POINTER(CamProfile), _D, _D * 4, ctypes.POINTER(_SIZE)]
@@ -64,17 +64,17 @@ def _lib() -> ctypes.CDLL:
 def law_segments(T: Sequence[float], name: str | None = None) -> tuple[tuple[float, ...], ...]:
     """The engine's non-empty segments of the law with split points T (7 floats each, as
     ``MotionLaw.segments()``); ValueError with the engine's message when refused."""
-    lib, law, err = _lib(), CamLaw(), ctypes.create_string_buffer(_ERR)
-    if lib.cam_law_init(ctypes.byref(law), (_D * 6)(*T), None if name is None else name.encode(), err, _ERR):
-        raise ValueError(err.value.decode())
+    lib, law, err = _lib(), CamLaw(), CamError()
+    if lib.cam_law_init(ctypes.byref(law), (_D * 6)(*T), None if name is None else name.encode(), ctypes.byref(err)):
+        raise ValueError(err.message.decode())
     return tuple(tuple(law.segments[SEGMENT_FIELDS * k:SEGMENT_FIELDS * (k + 1)]) for k in range(law.n_segments))
 
 
 def law_eval(T: Sequence[float], t: float) -> tuple[float, float, float, float]:
     """(S, V, A, J) of the engine's law with split points T at t."""
-    lib, law, err, out = _lib(), CamLaw(), ctypes.create_string_buffer(_ERR), (_D * 4)()
-    if lib.cam_law_init(ctypes.byref(law), (_D * 6)(*T), None, err, _ERR):
-        raise ValueError(err.value.decode())
+    lib, law, err, out = _lib(), CamLaw(), CamError(), (_D * 4)()
+    if lib.cam_law_init(ctypes.byref(law), (_D * 6)(*T), None, ctypes.byref(err)):
+        raise ValueError(err.message.decode())
     lib.cam_law_eval(ctypes.byref(law), t, out)
     return tuple(out)
 
@@ -91,20 +91,20 @@ class EngineProfile:
     def from_laws(cls, rise_T: Sequence[float], return_T: Sequence[float], lift: float, rise_angle: float,
                   upper_dwell: float, return_angle: float, lower_dwell: float) -> "EngineProfile":
         """Two laws with dwells (angles [rad] summing to 2 pi, lift [m])."""
-        self, err = cls(), ctypes.create_string_buffer(_ERR)
+        self, err = cls(), CamError()
         if self._lib.cam_profile_init_laws(ctypes.byref(self._p), (_D * 6)(*rise_T), (_D * 6)(*return_T), lift,
-                                           rise_angle, upper_dwell, return_angle, lower_dwell, err, _ERR):
-            raise ValueError(err.value.decode())
+                                           rise_angle, upper_dwell, return_angle, lower_dwell, ctypes.byref(err)):
+            raise ValueError(err.message.decode())
         self._live = True
         return self
 
     @classmethod
     def from_table(cls, text: str | bytes) -> "EngineProfile":
         """A motion table's CSV text (str is encoded as UTF-8)."""
-        self, err = cls(), ctypes.create_string_buffer(_ERR)
+        self, err = cls(), CamError()
         data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
-        if self._lib.cam_profile_init_table(ctypes.byref(self._p), data, len(data), err, _ERR):
-            raise ValueError(err.value.decode())
+        if self._lib.cam_profile_init_table(ctypes.byref(self._p), data, len(data), ctypes.byref(err)):
+            raise ValueError(err.message.decode())
         self._live = True
         return self
 

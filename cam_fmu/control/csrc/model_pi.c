@@ -111,9 +111,8 @@ static int check_parameter(const PiParamSpec *s, double value, char *text, size_
     return MODEL_OK;
 }
 
-static int check_real(const void *m, unsigned vr, double value, char *text, size_t len)
+static int check_value(const Pi *c, unsigned vr, double value, char *text, size_t len)
 {
-    const Pi *c = m;
     ModelKind kind;
     const char *name;
     if (!variable(vr, &kind, &name) || kind != MODEL_REAL) {
@@ -138,10 +137,17 @@ static int check_real(const void *m, unsigned vr, double value, char *text, size
     return check_parameter(pi_param_spec((int)(vr - PI_VR_PARAMS)), value, text, len);
 }
 
+/* The model's check_real: the refusal's message in message(m). */
+static int check_real(void *m, unsigned vr, double value)
+{
+    Pi *c = m;
+    return check_value(c, vr, value, c->message, sizeof c->message);
+}
+
 static int set_real(void *m, unsigned vr, double value)
 {
     Pi *c = m;
-    if (check_real(c, vr, value, c->message, sizeof c->message) != MODEL_OK)
+    if (check_real(c, vr, value) != MODEL_OK)
         return MODEL_ERROR;
     if (vr < PI_VR_OUTPUTS)
         c->in[vr] = value;

@@ -22,11 +22,12 @@ static int fail(CamExchange *e, int status, const char *fmt, ...)
 #endif
     ;
 
+/* A refusal: its message into the instance's error, the status returned. */
 static int fail(CamExchange *e, int status, const char *fmt, ...)
 {
     va_list args;
     va_start(args, fmt);
-    vsnprintf(e->message, sizeof e->message, fmt, args);
+    cam_verror(cam_instance_error(e->instance), (CamStatus)status, fmt, args);
     va_end(args);
     return status;
 }
@@ -36,11 +37,6 @@ void cam_exchange_init(CamExchange *e, CamInstance *instance)
     memset(e, 0, sizeof *e);
     e->instance = instance;
     e->target = NAN;
-}
-
-const char *cam_exchange_message(const CamExchange *e)
-{
-    return e->message;
 }
 
 /* The next breakpoint ahead of theta in the direction of travel [rad], NaN if the profile has none. */

@@ -43,7 +43,6 @@ typedef struct {
     int requested;              /* a completed step asked for event mode, not entered since */
     int iterations;             /* event updates at this event instant */
     int broke_away;             /* the break-away's transition was applied at this event instant */
-    char message[CAM_MESSAGE_LEN];
 } CamExchange;
 
 /* A transition applied by an event update (code -1: none), for the host's log. */
@@ -55,9 +54,8 @@ typedef struct {
 
 void cam_exchange_init(CamExchange *e, CamInstance *instance);
 /* After initialisation or a restored state: refuse what is no ODE here (formulation 'paper', drive
- * 'speed'), take the drive. CAM_OK or an error with cam_exchange_message. */
+ * 'speed'), take the drive. Every refusal of this layer is the instance's error (cam_instance_error). */
 int cam_exchange_attach(CamExchange *e);
-const char *cam_exchange_message(const CamExchange *e);
 const char *cam_exchange_event_name(int code);
 
 /* The inputs the host set, into the drive (outputs and derivatives follow them). */

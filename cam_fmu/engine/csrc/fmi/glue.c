@@ -144,7 +144,7 @@ int glue_exit_initialization(Glue *g, const char *call)
     status = glue_model_status(g, g->model->initialize(g->m, g->start_time), call);
     if (status == GLUE_OK && g->exchange) {   /* Model Exchange starts in event mode */
         if (g->model->exchange->attach(g->m) != MODEL_OK) {
-            glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->exchange->message(g->m));
+            glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->message(g->m));
             g->state = GLUE_ERROR_STATE;
             return GLUE_ERROR;
         }
@@ -259,13 +259,12 @@ int glue_get_strings(Glue *g, const unsigned vr[], size_t nvr, const char *value
 
 int glue_set_reals(Glue *g, const unsigned vr[], size_t nvr, const double value[], const char *call)
 {
-    char text[MESSAGE_MAX];
     size_t k;
     if (!glue_allowed(g, GLUE_SET_STATES, call) || !check_references(g, vr, nvr, value, MODEL_REAL, call))
         return GLUE_ERROR;
     for (k = 0; k < nvr; k++)   /* all or nothing: every value is checked before one is written */
-        if (g->model->check_real(g->m, vr[k], value[k], text, sizeof text) != MODEL_OK)
-            return glue_fail(g, call, text);
+        if (g->model->check_real(g->m, vr[k], value[k]) != MODEL_OK)
+            return glue_fail(g, call, g->model->message(g->m));
     for (k = 0; k < nvr; k++)
         if (g->model->set_real(g->m, vr[k], value[k]) != MODEL_OK)
             return glue_fail(g, call, g->model->message(g->m));
@@ -374,7 +373,7 @@ static int restore_exchange(Glue *g, const GlueSaved *saved, const char *call)
         return GLUE_OK;
     }
     if (model->exchange->attach(g->m) != MODEL_OK) {
-        status = glue_fail(g, call, model->exchange->message(g->m));
+        status = glue_fail(g, call, model->message(g->m));
         model->restore(g->m, before->bytes, before->size);
         if (model->initialized(g->m))
             model->exchange->attach(g->m);

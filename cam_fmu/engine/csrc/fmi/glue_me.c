@@ -26,7 +26,7 @@ int glue_me_allowed(Glue *g, int states, int attached, const char *call)
  * Error and the error state. */
 static int model_error(Glue *g, const char *call)
 {
-    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->exchange->message(g->m));
+    glue_log(g, GLUE_ERROR, "logStatusError", "%s: %s", call, g->model->message(g->m));
     g->state = GLUE_ERROR_STATE;
     return GLUE_ERROR;
 }
@@ -80,7 +80,7 @@ int glue_set_time(Glue *g, double time, const char *call)
     if (!glue_me_allowed(g, GLUE_ME_STATES, 1, call))
         return GLUE_ERROR;
     if (g->model->exchange->set_time(g->m, time) != MODEL_OK)
-        return glue_fail(g, call, g->model->exchange->message(g->m));
+        return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
@@ -91,7 +91,7 @@ int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char 
     if (!x)
         return glue_fail(g, call, "x must not be NULL");
     if (g->model->exchange->set_states(g->m, x, nx) != MODEL_OK)
-        return glue_fail(g, call, g->model->exchange->message(g->m));
+        return glue_fail(g, call, g->model->message(g->m));
     return GLUE_OK;
 }
 
@@ -111,7 +111,7 @@ int glue_me_read(Glue *g, ModelRead which, double values[], size_t n, const char
     if (g->model->exchange->read(g->m, which, values, n) != MODEL_OK) {
         for (k = 0; values && k < n; k++)
             values[k] = 0.0;
-        return glue_fail(g, call, g->model->exchange->message(g->m));
+        return glue_fail(g, call, g->model->message(g->m));
     }
     return GLUE_OK;
 }

@@ -21,20 +21,8 @@ struct CamInstance {
     int preview_valid;                  /* preview holds the outputs of params and inputs */
     double preview[CAM_N_OUTPUTS];      /* outputs before initialisation */
     double preview_x[CAM_NX], preview_dx[CAM_NX];   /* the states and derivatives then */
-    char message[CAM_MESSAGE_LEN];
+    CamError error;                     /* the last refusal, of this layer or of Model Exchange's */
 };
-
-static int refuse(CamInstance *d, const CamError *err)
-{
-    memcpy(d->message, err->message, sizeof d->message);
-    return err->status == CAM_OK ? CAM_ERR_SIMULATION : err->status;
-}
-
-static int refuse_text(CamInstance *d, int status, const char *text)
-{
-    snprintf(d->message, sizeof d->message, "%s", text);
-    return status;
-}
 
 int cam_instance_variable(unsigned vr, CamKind *kind, const char **name)
 {
@@ -77,7 +65,8 @@ static void defaults(CamInstance *d)
     d->initialized = 0;
     d->start_time = 0.0;
     d->preview_valid = 0;
-    d->message[0] = '\0';
+    d->error.status = CAM_OK;
+    d->error.message[0] = '\0';
 }
 
 CamInstance *cam_instance_new(void)
@@ -108,7 +97,12 @@ void cam_instance_reset(CamInstance *d)
 
 const char *cam_instance_message(const CamInstance *d)
 {
-    return d->message;
+    return d->error.message;
+}
+
+CamError *cam_instance_error(CamInstance *d)
+{
+    return &d->error;
 }
 
 int cam_instance_initialized(const CamInstance *d)
@@ -162,27 +156,20 @@ static int check_real(const CamInstance *d, unsigned vr, double value, CamError 
     }
 }
 
-int cam_instance_check_real(const CamInstance *d, unsigned vr, double value, char *text, size_t text_len)
+int cam_instance_check_real(CamInstance *d, unsigned vr, double value)
 {
-    CamError err;
-    int status;
-    err.message[0] = '\0';
-    status = check_real(d, vr, value, &err);
-    if (status != CAM_OK && text_len)
-        snprintf(text, text_len, "%s", err.message);
-    return status;
+    return check_real(d, vr, value, &d->error);
 }
 
 int cam_instance_set_real(CamInstance *d, unsigned vr, double value)
 {
-    CamError err;
-    int status = check_real(d, vr, value, &err);
+    int status = check_real(d, vr, value, &d->error);
     if (status != CAM_OK)
-        return refuse(d, &err);
+        return status;
     if (vr < CAM_VR_OUTPUTS)
         d->inputs[vr] = value;
-    else if ((status = cam_params_set_real(&d->params, (int)(vr - CAM_VR_PARAMS), value, &err)) != CAM_OK)
-        return refuse(d, &err);
+    else if ((status = cam_params_set_real(&d->params, (int)(vr - CAM_VR_PARAMS), value, &d->error)) != CAM_OK)
+        return status;
     d->preview_valid = 0;
     return CAM_OK;
 }
@@ -191,17 +178,13 @@ int cam_instance_set_real(CamInstance *d, unsigned vr, double value)
 static const double *preview(CamInstance *d)
 {
     CamDrive scratch;
-    CamError err;
     if (d->preview_valid)
         return d->preview;
-    if (cam_params_check(&d->params, &err) != CAM_OK || cam_drive_init(&scratch, &d->params, &err) != CAM_OK) {
-        refuse(d, &err);
+    if (cam_params_check(&d->params, &d->error) != CAM_OK || cam_drive_init(&scratch, &d->params, &d->error) != CAM_OK)
         return NULL;
-    }
     if (cam_drive_set_inputs(&scratch, d->inputs[CAM_I_U], d->inputs[CAM_I_OMEGA_REF],
-                             d->inputs[CAM_I_OMEGA_DOT_REF], &err) != CAM_OK) {
+                             d->inputs[CAM_I_OMEGA_DOT_REF], &d->error) != CAM_OK) {
         cam_drive_free(&scratch);
-        refuse(d, &err);
         return NULL;
     }
     memcpy(d->preview, cam_drive_outputs(&scratch), sizeof d->preview);
@@ -226,11 +209,10 @@ static int state_value(CamInstance *d, unsigned vr, double *value)
     const char *name = derivative ? cam_derivative_spec(k)->name : cam_state_spec(k)->name;
     double dx[CAM_NX] = {0.0, 0.0, 0.0, 0.0, 0.0};   /* a rigid drive's shaft slots are held */
     if ((int)d->params.v[CAM_P_FORMULATION] != CAM_CHOICE_FORMULATION_CONSISTENT
-        || (int)d->params.v[CAM_P_DRIVE] != CAM_CHOICE_DRIVE_VOLTAGE) {
-        snprintf(d->message, sizeof d->message, "variable '%s' belongs to the consistent formulation under "
-                 "drive 'voltage' (the Model Exchange model); this drive has no such state: read the outputs", name);
-        return CAM_ERR_SIMULATION;
-    }
+        || (int)d->params.v[CAM_P_DRIVE] != CAM_CHOICE_DRIVE_VOLTAGE)
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "variable '%s' belongs to the consistent formulation under "
+                         "drive 'voltage' (the Model Exchange model); this drive has no such state: read the outputs",
+                         name);
     if (!d->initialized) {
         if (!cam_instance_outputs(d))
             return CAM_ERR_PARAMETER; /* the message says which parameter prevents them */
@@ -252,7 +234,7 @@ int cam_instance_get_real(CamInstance *d, unsigned vr, double *value)
     const char *name;
     *value = 0.0;
     if (!cam_instance_variable(vr, &kind, &name) || kind != CAM_KIND_REAL)
-        return refuse_text(d, CAM_ERR_SIMULATION, "no Real variable has this value reference");
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "no Real variable has this value reference");
     if (vr < CAM_VR_OUTPUTS) {
         *value = d->inputs[vr];
     } else if (vr < CAM_VR_PARAMS) {
@@ -275,39 +257,33 @@ int cam_instance_get_boolean(CamInstance *d, unsigned vr, int *value)
     *value = 0;
     if (vr < CAM_VR_PARAMS || vr >= (unsigned)(CAM_VR_PARAMS + CAM_N_PARAMS) ||
         cam_param_spec((int)(vr - CAM_VR_PARAMS))->kind != CAM_KIND_BOOLEAN)
-        return refuse_text(d, CAM_ERR_SIMULATION, "no Boolean variable has this value reference");
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "no Boolean variable has this value reference");
     *value = d->params.v[vr - CAM_VR_PARAMS] != 0.0;
     return CAM_OK;
 }
 
 static int check_parameter(CamInstance *d, unsigned vr, CamKind kind)
 {
-    char text[200];
     const CamParamSpec *s;
     if (vr < CAM_VR_PARAMS || vr >= (unsigned)(CAM_VR_PARAMS + CAM_N_PARAMS))
-        return refuse_text(d, CAM_ERR_SIMULATION, "this value reference is not a parameter");
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "this value reference is not a parameter");
     s = cam_param_spec((int)(vr - CAM_VR_PARAMS));
-    if (s->kind != kind) {
-        snprintf(text, sizeof text, "variable '%s' is a %s, not a %s", s->name, cam_kind_name(s->kind),
-                 cam_kind_name(kind));
-        return refuse_text(d, CAM_ERR_SIMULATION, text);
-    }
-    if (d->initialized) {
-        snprintf(text, sizeof text, "parameter '%s' is fixed after initialisation (fmi2Reset, then set it)",
-                 s->name);
-        return refuse_text(d, CAM_ERR_SIMULATION, text);
-    }
+    if (s->kind != kind)
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "variable '%s' is a %s, not a %s", s->name,
+                         cam_kind_name(s->kind), cam_kind_name(kind));
+    if (d->initialized)
+        return cam_error(&d->error, CAM_ERR_SIMULATION,
+                         "parameter '%s' is fixed after initialisation (fmi2Reset, then set it)", s->name);
     return CAM_OK;
 }
 
 int cam_instance_set_boolean(CamInstance *d, unsigned vr, int value)
 {
-    CamError err;
     int status = check_parameter(d, vr, CAM_KIND_BOOLEAN);
     if (status != CAM_OK)
         return status;
-    if (cam_params_set_real(&d->params, (int)(vr - CAM_VR_PARAMS), value ? 1.0 : 0.0, &err) != CAM_OK)
-        return refuse(d, &err);
+    if ((status = cam_params_set_real(&d->params, (int)(vr - CAM_VR_PARAMS), value ? 1.0 : 0.0, &d->error)) != CAM_OK)
+        return status;
     d->preview_valid = 0;
     return CAM_OK;
 }
@@ -319,7 +295,7 @@ int cam_instance_get_string(CamInstance *d, unsigned vr, const char **value)
     *value = "";
     if (vr < CAM_VR_PARAMS || vr >= (unsigned)(CAM_VR_PARAMS + CAM_N_PARAMS) ||
         cam_param_spec((int)(vr - CAM_VR_PARAMS))->kind != CAM_KIND_STRING)
-        return refuse_text(d, CAM_ERR_SIMULATION, "no String variable has this value reference");
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "no String variable has this value reference");
     s = cam_param_spec((int)(vr - CAM_VR_PARAMS));
     if (s->n_choices == 0) { /* the motion table: free text */
         *value = d->params.motion_table ? d->params.motion_table : "";
@@ -353,7 +329,6 @@ static size_t utf8_invalid_at(const unsigned char *p, size_t len)
 
 int cam_instance_set_string(CamInstance *d, unsigned vr, const char *value, size_t len)
 {
-    CamError err;
     size_t bad;
     const CamParamSpec *s;
     int status = check_parameter(d, vr, CAM_KIND_STRING);
@@ -361,24 +336,19 @@ int cam_instance_set_string(CamInstance *d, unsigned vr, const char *value, size
         return status;
     s = cam_param_spec((int)(vr - CAM_VR_PARAMS));
     bad = utf8_invalid_at((const unsigned char *)value, len);
-    if (bad < len) {
-        snprintf(d->message, sizeof d->message, "parameter '%s': the value is not valid UTF-8 (byte 0x%02x at "
-                 "offset %lu)", s->name, (unsigned)(unsigned char)value[bad], (unsigned long)bad);
-        return CAM_ERR_PARAMETER;
-    }
+    if (bad < len)
+        return cam_error(&d->error, CAM_ERR_PARAMETER, "parameter '%s': the value is not valid UTF-8 (byte 0x%02x "
+                         "at offset %lu)", s->name, (unsigned)(unsigned char)value[bad], (unsigned long)bad);
     if (s->n_choices == 0 && len > 0) { /* the motion table: refused now, not at initialisation */
         CamProfile probe;
-        memset(&probe, 0, sizeof probe);
-        char reason[CAM_MESSAGE_LEN - 40];
-        if (cam_profile_init_table(&probe, value, len, reason, sizeof reason) != 0) {
-            snprintf(d->message, sizeof d->message, "parameter 'motion_table': %s", reason);
-            cam_profile_free(&probe);
-            return CAM_ERR_PARAMETER;
-        }
+        CamError why;
+        status = cam_profile_init_table(&probe, value, len, &why);
         cam_profile_free(&probe);
+        if (status != CAM_OK)
+            return cam_error(&d->error, CAM_ERR_PARAMETER, "parameter 'motion_table': %s", why.message);
     }
-    if (cam_params_set_string(&d->params, (int)(vr - CAM_VR_PARAMS), value, len, &err) != CAM_OK)
-        return refuse(d, &err);
+    if ((status = cam_params_set_string(&d->params, (int)(vr - CAM_VR_PARAMS), value, len, &d->error)) != CAM_OK)
+        return status;
     d->preview_valid = 0;
     return CAM_OK;
 }
@@ -387,18 +357,18 @@ int cam_instance_set_string(CamInstance *d, unsigned vr, const char *value, size
 
 int cam_instance_initialize(CamInstance *d, double start_time)
 {
-    CamError err;
     int status;
     if (d->initialized)
-        return refuse_text(d, CAM_ERR_SIMULATION, "the drive is initialised already");
-    if ((status = cam_params_check(&d->params, &err)) != CAM_OK || (status = cam_drive_init(&d->drive, &d->params, &err)) != CAM_OK)
-        return refuse(d, &err);
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the drive is initialised already");
+    if ((status = cam_params_check(&d->params, &d->error)) != CAM_OK
+        || (status = cam_drive_init(&d->drive, &d->params, &d->error)) != CAM_OK)
+        return status;
     d->drive.time = start_time;
     d->drive.start_time = start_time;
     if ((status = cam_drive_set_inputs(&d->drive, d->inputs[CAM_I_U], d->inputs[CAM_I_OMEGA_REF],
-                                       d->inputs[CAM_I_OMEGA_DOT_REF], &err)) != CAM_OK) {
+                                       d->inputs[CAM_I_OMEGA_DOT_REF], &d->error)) != CAM_OK) {
         cam_drive_free(&d->drive);
-        return refuse(d, &err);
+        return status;
     }
     d->start_time = start_time;
     d->initialized = 1;
@@ -407,13 +377,10 @@ int cam_instance_initialize(CamInstance *d, double start_time)
 
 int cam_instance_step(CamInstance *d, double t, double h)
 {
-    CamError err;
     if (!d->initialized)
-        return refuse_text(d, CAM_ERR_SIMULATION, "the drive is not initialised");
-    if (cam_drive_do_step(&d->drive, t, h, d->inputs[CAM_I_U], d->inputs[CAM_I_OMEGA_REF],
-                          d->inputs[CAM_I_OMEGA_DOT_REF], &err) != CAM_OK)
-        return refuse(d, &err);
-    return CAM_OK;
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the drive is not initialised");
+    return cam_drive_do_step(&d->drive, t, h, d->inputs[CAM_I_U], d->inputs[CAM_I_OMEGA_REF],
+                             d->inputs[CAM_I_OMEGA_DOT_REF], &d->error);
 }
 
 /* ------------------------------------------------------------------ the saved state
@@ -498,110 +465,143 @@ static int same_params(const CamParams *a, const CamParams *b)
     return memcmp(a->v, b->v, sizeof a->v) == 0 && strcmp(ta, tb) == 0;
 }
 
-int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t size)
+/* The blob's header: this format, and sizes that agree with size; the flag and the table's length out. */
+static int decode_header(CamInstance *d, const unsigned char *buffer, size_t size, uint64_t *flag,
+                         uint64_t *length)
 {
-    CamParams params;
-    CamDrive fresh;
-    CamError err;
-    double state[CAM_STATE_LEN], inputs[CAM_N_INPUTS], start_time;
-    const unsigned char *p = buffer + HEADER_BYTES;
     uint64_t initialized, n;
-    size_t k;
-    int status;
-    if (size < HEADER_BYTES + 8 * FIXED_DOUBLES || get_u64(buffer) != ((uint64_t)BLOB_MAGIC | ((uint64_t)BLOB_VERSION << 32)))
-        return refuse_text(d, CAM_ERR_SIMULATION, "the state is not a saved state of this cam.fmu (format 1)");
+    if (size < HEADER_BYTES + 8 * FIXED_DOUBLES
+        || get_u64(buffer) != ((uint64_t)BLOB_MAGIC | ((uint64_t)BLOB_VERSION << 32)))
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the state is not a saved state of this cam.fmu (format 1)");
     initialized = get_u64(buffer + 8);
     n = get_u64(buffer + 16);
     if (initialized > 1 || n != size - HEADER_BYTES - 8 * FIXED_DOUBLES)
-        return refuse_text(d, CAM_ERR_SIMULATION, "the saved state is truncated or corrupt (its sizes disagree)");
-    start_time = get_double(p);
-    p += 8;
-    for (k = 0; k < CAM_N_INPUTS; k++, p += 8) {
-        inputs[k] = get_double(p);
-        if ((status = check_real(d, (unsigned)k, inputs[k], &err)) != CAM_OK)
-            return refuse(d, &err);
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state is truncated or corrupt (its sizes disagree)");
+    *flag = initialized;
+    *length = n;
+    return CAM_OK;
+}
+
+/* The start time and the inputs at p, each input checked as if a host had set it. */
+static int decode_inputs(CamInstance *d, const unsigned char *p, double *start_time, double inputs[CAM_N_INPUTS])
+{
+    size_t k;
+    int status;
+    *start_time = get_double(p);
+    for (k = 0; k < CAM_N_INPUTS; k++) {
+        inputs[k] = get_double(p + 8 * (1 + k));
+        if ((status = check_real(d, (unsigned)k, inputs[k], &d->error)) != CAM_OK)
+            return status;
     }
-    if (!isfinite(start_time))
-        return refuse_text(d, CAM_ERR_SIMULATION, "the saved state's start time is not finite");
-    /* the parameters, each checked as if a host had set it */
-    cam_params_defaults(&params);
-    for (k = 0; k < CAM_N_PARAMS; k++, p += 8) {
+    if (!isfinite(*start_time))
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's start time is not finite");
+    return CAM_OK;
+}
+
+/* The parameters at p into params (at their defaults), each checked as if a host had set it. */
+static int decode_params(CamInstance *d, const unsigned char *p, CamParams *params)
+{
+    size_t k;
+    int status;
+    for (k = 0; k < CAM_N_PARAMS; k++) {
         const CamParamSpec *s = cam_param_spec((int)k);
-        double v = get_double(p);
+        double v = get_double(p + 8 * k);
         if (s->kind == CAM_KIND_STRING) {
-            if (s->n_choices && !(v >= 0.0 && v < s->n_choices && v == floor(v))) {
-                cam_params_free(&params);
-                snprintf(d->message, sizeof d->message, "the saved state's parameter '%s' is not one of its "
-                         "choices", s->name);
-                return CAM_ERR_SIMULATION;
-            }
+            if (s->n_choices && !(v >= 0.0 && v < s->n_choices && v == floor(v)))
+                return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's parameter '%s' is not one of "
+                                 "its choices", s->name);
             if (s->n_choices)
-                params.v[k] = v;
+                params->v[k] = v;
             continue;
         }
-        if (s->kind == CAM_KIND_BOOLEAN && v != 0.0 && v != 1.0) {
-            cam_params_free(&params);
-            snprintf(d->message, sizeof d->message, "the saved state's parameter '%s' is not a boolean", s->name);
-            return CAM_ERR_SIMULATION;
-        }
-        if (cam_params_set_real(&params, (int)k, v, &err) != CAM_OK) {
-            cam_params_free(&params);
-            return refuse(d, &err);
-        }
+        if (s->kind == CAM_KIND_BOOLEAN && v != 0.0 && v != 1.0)
+            return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state's parameter '%s' is not a boolean",
+                             s->name);
+        if ((status = cam_params_set_real(params, (int)k, v, &d->error)) != CAM_OK)
+            return status;
     }
-    for (k = 0; k < CAM_STATE_LEN; k++, p += 8)
-        state[k] = get_double(p);
-    if (n) {
-        int table = -1;
-        for (k = 0; k < CAM_N_PARAMS; k++)
-            if (cam_param_spec((int)k)->kind == CAM_KIND_STRING && cam_param_spec((int)k)->n_choices == 0)
-                table = (int)k;
-        if (table < 0 || cam_params_set_string(&params, table, (const char *)p, (size_t)n, &err) != CAM_OK) {
-            cam_params_free(&params);
-            return table < 0 ? refuse_text(d, CAM_ERR_SIMULATION, "the saved state has a table and no table parameter")
-                             : refuse(d, &err);
-        }
-    }
-    if (!initialized) {
-        if (d->initialized)
-            cam_drive_free(&d->drive);
-        cam_params_free(&d->params);
-        d->params = params;
-        memcpy(d->inputs, inputs, sizeof inputs);
-        d->start_time = start_time;
-        d->initialized = 0;
-        d->preview_valid = 0;
-        return CAM_OK;
-    }
-    if (d->initialized && same_params(&d->params, &params)) {
+    return CAM_OK;
+}
+
+/* The motion table's n bytes at p into params' table parameter. */
+static int decode_table(CamInstance *d, const unsigned char *p, size_t n, CamParams *params)
+{
+    int table = -1, k;
+    for (k = 0; k < CAM_N_PARAMS; k++)
+        if (cam_param_spec(k)->kind == CAM_KIND_STRING && cam_param_spec(k)->n_choices == 0)
+            table = k;
+    if (table < 0)
+        return cam_error(&d->error, CAM_ERR_SIMULATION, "the saved state has a table and no table parameter");
+    return cam_params_set_string(params, table, (const char *)p, n, &d->error);
+}
+
+/* The drive of params (taken over: kept or freed) in the saved state: the instance's own drive when the
+ * parameters are its own, else a new one; on refusal the instance is as before. */
+static int restore_drive(CamInstance *d, CamParams *params, const double state[CAM_STATE_LEN], double start_time)
+{
+    CamDrive fresh;
+    int status;
+    if (d->initialized && same_params(&d->params, params)) {
         /* the usual case, a state of this instance: the drive's program is kept, not built again */
         CamDrive backup = d->drive;
-        cam_params_free(&params);
+        cam_params_free(params);
         d->drive.start_time = start_time;
-        if (cam_drive_set_state(&d->drive, state, &err) != CAM_OK) {
+        if ((status = cam_drive_set_state(&d->drive, state, &d->error)) != CAM_OK)
             d->drive = backup;
-            return refuse(d, &err);
-        }
+        return status;
+    }
+    if ((status = cam_params_check(params, &d->error)) != CAM_OK ||
+        (status = cam_drive_init(&fresh, params, &d->error)) != CAM_OK) {
+        cam_params_free(params);
+        return status;
+    }
+    fresh.start_time = start_time;
+    if ((status = cam_drive_set_state(&fresh, state, &d->error)) != CAM_OK) {
+        cam_drive_free(&fresh);
+        cam_params_free(params);
+        return status;
+    }
+    if (d->initialized)
+        cam_drive_free(&d->drive);
+    cam_params_free(&d->params);
+    d->params = *params;
+    d->drive = fresh;
+    return CAM_OK;
+}
+
+int cam_instance_restore(CamInstance *d, const unsigned char *buffer, size_t size)
+{
+    const unsigned char *p = buffer + HEADER_BYTES;
+    const unsigned char *p_params = p + 8 * (1 + CAM_N_INPUTS), *p_state = p_params + 8 * CAM_N_PARAMS;
+    CamParams params;
+    double state[CAM_STATE_LEN], inputs[CAM_N_INPUTS], start_time;
+    uint64_t initialized = 0, n = 0;   /* set by decode_header (initialised for the compiler) */
+    size_t k;
+    int status;
+    if ((status = decode_header(d, buffer, size, &initialized, &n)) != CAM_OK
+        || (status = decode_inputs(d, p, &start_time, inputs)) != CAM_OK)
+        return status;
+    cam_params_defaults(&params);
+    if ((status = decode_params(d, p_params, &params)) == CAM_OK && n)
+        status = decode_table(d, p_state + 8 * CAM_STATE_LEN, (size_t)n, &params);
+    if (status != CAM_OK) {
+        cam_params_free(&params);
+        return status;
+    }
+    for (k = 0; k < CAM_STATE_LEN; k++)
+        state[k] = get_double(p_state + 8 * k);
+    if (initialized) {
+        if ((status = restore_drive(d, &params, state, start_time)) != CAM_OK)
+            return status;
     } else {
-        if ((status = cam_params_check(&params, &err)) != CAM_OK ||
-            (status = cam_drive_init(&fresh, &params, &err)) != CAM_OK) {
-            cam_params_free(&params);
-            return refuse(d, &err);
-        }
-        fresh.start_time = start_time;
-        if (cam_drive_set_state(&fresh, state, &err) != CAM_OK) {
-            cam_drive_free(&fresh);
-            cam_params_free(&params);
-            return refuse(d, &err);
-        }
         if (d->initialized)
             cam_drive_free(&d->drive);
         cam_params_free(&d->params);
         d->params = params;
-        d->drive = fresh;
+        d->preview_valid = 0;
     }
     memcpy(d->inputs, inputs, sizeof inputs);
     d->start_time = start_time;
-    d->initialized = 1;
+    d->initialized = (int)initialized;
     return CAM_OK;
 }

@@ -2,9 +2,9 @@
  * that one glue serves every model the project ships (cam.fmu's drive in model_cam.c, pi_speed.fmu's
  * controller in model_pi.c, and a third block the same way). FMI-free: no FMI header, no globals.
  *
- * A model is an opaque object (void *m) made by create; every function that can refuse returns a
- * ModelStatus and leaves its message in message(m), which names the variable or setting and its allowed
- * range. A refused call changes nothing.
+ * A model is an opaque object (void *m) made by create; every function that can refuse (Model Exchange's
+ * included) returns a ModelStatus and leaves its message in message(m), which names the variable or setting
+ * and its allowed range: the one message the glue logs. A refused call changes nothing else.
  *
  * Value references run from 0 to vr_end - 1 without gaps; variable() names each one and its kind.
  * vr_cs_end (<= vr_end): the references an FMI 3.0 co-simulation FMU describes (the ones past it are
@@ -47,7 +47,6 @@ typedef struct {
     int (*completed_step)(void *m, int *enter_event);
     /* The state as bytes (state_size long) with what Model Exchange books, the live books unchanged. */
     int (*save)(void *m, unsigned char *buffer, size_t size);
-    const char *(*message)(const void *m);
 } ModelExchangeOps;
 
 typedef struct {
@@ -62,7 +61,7 @@ typedef struct {
     /* The kind and name of value reference vr; 0 if vr is no variable. */
     int (*variable)(unsigned vr, ModelKind *kind, const char **name);
     int (*get_real)(void *m, unsigned vr, double *value);
-    int (*check_real)(const void *m, unsigned vr, double value, char *err, size_t err_len);
+    int (*check_real)(void *m, unsigned vr, double value);   /* set_real's checks, nothing written */
     int (*set_real)(void *m, unsigned vr, double value);
     int (*get_boolean)(void *m, unsigned vr, int *value);
     int (*set_boolean)(void *m, unsigned vr, int value);

@@ -65,9 +65,9 @@ static int get_real(void *m, unsigned vr, double *value)
     return status_of(cam_instance_get_real(((CamFmuModel *)m)->drive, vr, value));
 }
 
-static int check_real(const void *m, unsigned vr, double value, char *err, size_t err_len)
+static int check_real(void *m, unsigned vr, double value)
 {
-    return status_of(cam_instance_check_real(((const CamFmuModel *)m)->drive, vr, value, err, err_len));
+    return status_of(cam_instance_check_real(((CamFmuModel *)m)->drive, vr, value));
 }
 
 static int set_real(void *m, unsigned vr, double value)
@@ -176,11 +176,9 @@ static int me_save(void *m, unsigned char *buffer, size_t size)
     return status_of(cam_exchange_save(&((CamFmuModel *)m)->me, buffer, size));
 }
 
-static const char *me_message(const void *m) { return cam_exchange_message(&((const CamFmuModel *)m)->me); }
-
 static const ModelExchangeOps EXCHANGE = {
     me_attach, me_attached, me_detach, me_sync, me_set_time, me_set_states, me_read, me_enter_event_mode,
-    me_event_update, me_enter_continuous, me_completed_step, me_save, me_message,
+    me_event_update, me_enter_continuous, me_completed_step, me_save,
 };
 
 static const Model CAM = {

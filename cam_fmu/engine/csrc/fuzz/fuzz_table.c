@@ -17,12 +17,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     CamProfile p;
-    char err[256];
+    CamError err;
     static const double probes[] = {0.0, 1e-9, 0.5, 1.0, 3.0, 6.283185307179586, -2.0, 1e6, -1e300};
     size_t k;
-    err[0] = '\0';
-    if (cam_profile_init_table(&p, (const char *)data, size, err, sizeof err) != 0) {
-        if (err[0] == '\0' || strlen(err) >= sizeof err) {
+    err.message[0] = '\0';
+    if (cam_profile_init_table(&p, (const char *)data, size, &err) != CAM_OK) {
+        if (err.message[0] == '\0' || err.status == CAM_OK) {
             abort();  /* every refusal says why */
         }
         cam_profile_free(&p);

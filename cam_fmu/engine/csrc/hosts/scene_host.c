@@ -2,7 +2,7 @@
  * one line per case, "name status theta omega steps" with the numbers as %a (exact bits), so that a
  * test can compare a sanitizer or valgrind build with the Python binding's results.
  *
- *     scene_host            (built by tests/test_engine_sanitizers.py against the engine library)
+ *     scene_host            (built by tests/engine/test_engine_c_host.py against the engine library)
  */
 #include <stdio.h>
 #include <string.h>

@@ -1,9 +1,8 @@
 /* The cam drive: the model of cam_model.h stepped from one communication point to the next
  * (Python: engine/simulator.py DriveSimulator).
  *
- * Three formulations (docs/model.md sections 5-8) share the model contract through
- * a table of functions each (``CamFormulation``, like the Python
- * ``physics.formulations.base.Formulation``): the consistent one is an ODE with
+ * Three formulations (docs/model.md sections 5-8; in Python physics/formulations/) share the model
+ * contract through a table of functions each (``CamFormulation``): the consistent one is an ODE with
  * events advanced by the solvers of cam_solver.h; the paper's algorithm is a
  * fixed-step discrete scheme and the speed drive imposes omega, so both provide
  * their own ``advance``. Here too: the drive's state (its formulations' states, the

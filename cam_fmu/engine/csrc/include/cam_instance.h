@@ -8,8 +8,9 @@
  * (Model Exchange's; read-only, of the consistent formulation).
  *
  * Every function that can refuse returns a CamStatus other than CAM_OK (CAM_ERR_REJECTED for a step
- * the solver cannot complete at this size: fmi2Discard) and leaves its message, which names the variable or setting and its
- * allowed range, in cam_instance_message(). A refused call changes nothing. No globals.
+ * the solver cannot complete at this size: fmi2Discard) and leaves its message, which names the variable or
+ * setting and its allowed range, in the instance's one CamError (cam_instance_error; the Model Exchange layer
+ * of exchange.h fills the same one). A refused call changes nothing but that message. No globals.
  */
 #ifndef CAM_INSTANCE_H
 #define CAM_INSTANCE_H
@@ -35,15 +36,17 @@ void cam_instance_free(CamInstance *d);
 /* Back to the state of cam_instance_new (parameters at their defaults, not initialised). */
 void cam_instance_reset(CamInstance *d);
 
-/* The message of the last refusal (empty if none); valid until the next call on d. */
+/* The last refusal (status and message; empty if none): the message valid until the next call on d. */
 const char *cam_instance_message(const CamInstance *d);
+CamError *cam_instance_error(CamInstance *d);
 
 /* Variables. Setting a parameter is allowed only before cam_instance_initialize; an input any time;
  * an output never. A value outside its range is refused with the variable's name and range.
  * Getting an output before initialisation computes it from the parameters and inputs. */
 int cam_instance_get_real(CamInstance *d, unsigned vr, double *value);
 int cam_instance_set_real(CamInstance *d, unsigned vr, double value);
-int cam_instance_check_real(const CamInstance *d, unsigned vr, double value, char *err, size_t err_len);
+/* set_real's checks without the write: CAM_OK, or the refusal in cam_instance_message. */
+int cam_instance_check_real(CamInstance *d, unsigned vr, double value);
 int cam_instance_get_boolean(CamInstance *d, unsigned vr, int *value);
 int cam_instance_set_boolean(CamInstance *d, unsigned vr, int value);
 /* Strings are copied in (len bytes, UTF-8, no NUL needed) and out (valid until the next call). */

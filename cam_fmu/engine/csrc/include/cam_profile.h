@@ -7,13 +7,15 @@
  * period 2 pi. The formulas are docs/model.md sections 1-2 and docs/cam_design.md.
  *
  * C99, libc and libm only, no globals. Every function that can refuse its input
- * returns 0 on success and otherwise writes a message naming the parameter and
- * its allowed range (or the table row) into err[0..err_len-1].
+ * returns CAM_OK (0) on success and otherwise fills err (cam_error.h) with a message
+ * naming the parameter and its allowed range (or the table row) and returns its status.
  */
 #ifndef CAM_PROFILE_H
 #define CAM_PROFILE_H
 
 #include <stddef.h>
+
+#include "cam_error.h"
 
 #define CAM_LAW_SEGMENTS 7          /* segments of one law */
 #define CAM_SEGMENT_FIELDS 7        /* end, start, F, c, kind, V0, S0 per non-empty segment */
@@ -75,7 +77,7 @@ typedef struct {
 /* The law with split points T[0..5] = T1..T6 (checked: finite, in [0, 1], ordered,
  * T3 > 0, T4 < 1); ``name`` names the parameters in messages ("rise": "rise law: ...
  * rise_T3=0.0 ..."); NULL or "" gives MotionLaw's own messages ("T3=0.0"). */
-int cam_law_init(CamLaw *law, const double T[6], const char *name, char *err, size_t err_len);
+int cam_law_init(CamLaw *law, const double T[6], const char *name, CamError *err);
 
 /* (S, V, A, J) of a dimensionless law at T into out[0..3]; dwells outside [0, 1]. */
 void cam_law_eval(const CamLaw *law, double T, double out[4]);
@@ -85,11 +87,11 @@ void cam_law_eval(const CamLaw *law, double T, double out[4]);
  * message). */
 int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double return_T[6], double lift,
                           double rise_angle, double upper_dwell, double return_angle, double lower_dwell,
-                          char *err, size_t err_len);
+                          CamError *err);
 
 /* A program from the CSV text of a motion table (see docs/cam_design.md for the format and the
  * refusals); ``text_len`` bytes, not necessarily NUL-terminated. O(text_len) time, O(rows) memory. */
-int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, char *err, size_t err_len);
+int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, CamError *err);
 
 /* sizeof(CamProfile), for bindings that mirror the structure (ctypes). */
 size_t cam_profile_sizeof(void);

@@ -21,12 +21,4 @@ void cam_repr(double x, char out[CAM_REPR_LEN]);
  * printable ASCII is written as '?'. Truncated to out_len - 1 bytes, NUL-terminated. */
 void cam_quote(const char *text, size_t len, char *out, size_t out_len);
 
-/* printf into err[0..err_len-1] (nothing when err is NULL or err_len is 0); returns 1,
- * the engine's "refused" status, so that a check reads `return cam_fail(err, n, ...)`. */
-int cam_fail(char *err, size_t err_len, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
 #endif

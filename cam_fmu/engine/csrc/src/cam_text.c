@@ -1,7 +1,6 @@
 /* Python-compatible number text and quoting for messages: see cam_text.h. */
 #include "cam_text.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -132,15 +131,4 @@ void cam_quote(const char *text, size_t len, char *out, size_t out_len)
     }
     out[pos++] = '\'';
     out[pos] = '\0';
-}
-
-int cam_fail(char *err, size_t err_len, const char *fmt, ...)
-{
-    if (err != NULL && err_len > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, err_len, fmt, ap);
-        va_end(ap);
-    }
-    return 1;
 }

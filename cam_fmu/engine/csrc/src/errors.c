@@ -1,19 +1,24 @@
-/* Errors: a status and a message (numbers and user text quoted as cam_text.h writes them, so that
- * messages read text-for-text as the Python engine's). */
+/* The engine's one error path (cam_error.h). */
 #include <stdarg.h>
 #include <stdio.h>
 
-#include "cam_model.h"
+#include "cam_error.h"
+
+int cam_verror(CamError *err, CamStatus status, const char *fmt, va_list args)
+{
+    if (err != NULL) {
+        err->status = status;
+        vsnprintf(err->message, sizeof err->message, fmt, args);
+    }
+    return (int)status;
+}
 
 int cam_error(CamError *err, CamStatus status, const char *fmt, ...)
 {
     va_list args;
-    if (err != NULL) {
-        err->status = status;
-        va_start(args, fmt);
-        vsnprintf(err->message, sizeof err->message, fmt, args);
-        va_end(args);
-    }
+    va_start(args, fmt);
+    cam_verror(err, status, fmt, args);
+    va_end(args);
     return (int)status;
 }
 

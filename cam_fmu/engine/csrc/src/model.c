@@ -277,21 +277,20 @@ static void law_T(const CamParams *p, int law_index, int first_T, double T[6])
 static int build_program(CamModel *model, CamError *err)
 {
     const CamParams *p = &model->params;
-    char why[CAM_MESSAGE_LEN];
+    CamError why;
     double rise[6], ret[6];
-    why[0] = '\0';
     if (has_text(p->motion_table)) {
-        if (cam_profile_init_table(&model->profile, p->motion_table, strlen(p->motion_table), why, sizeof why))
-            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'motion_table': %s", why);
+        if (cam_profile_init_table(&model->profile, p->motion_table, strlen(p->motion_table), &why) != CAM_OK)
+            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'motion_table': %s", why.message);
         return CAM_OK;
     }
     law_T(p, CAM_P_RISE_LAW, CAM_P_RISE_T1, rise);
     law_T(p, CAM_P_RETURN_LAW, CAM_P_RETURN_T1, ret);
     if (cam_profile_init_laws(&model->profile, rise, ret, p->v[CAM_P_LIFT], p->v[CAM_P_RISE_ANGLE],
-                              p->v[CAM_P_UPPER_DWELL], p->v[CAM_P_RETURN_ANGLE], p->v[CAM_P_LOWER_DWELL], why,
-                              sizeof why))
+                              p->v[CAM_P_UPPER_DWELL], p->v[CAM_P_RETURN_ANGLE], p->v[CAM_P_LOWER_DWELL], &why)
+        != CAM_OK)
         return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_law'/'rise_T1'..'rise_T6', "
-                        "'return_law'/'return_T1'..'return_T6': %s", why);
+                        "'return_law'/'return_T1'..'return_T6': %s", why.message);
     return CAM_OK;
 }
 

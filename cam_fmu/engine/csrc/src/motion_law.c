@@ -44,17 +44,17 @@ static void list_named(char *list, size_t len, const char *name, const double T[
     }
 }
 
-static int refuse(char *err, size_t err_len, const char *name, const char *fmt, const char *detail)
+static int refuse(CamError *err, const char *name, const char *fmt, const char *detail)
 {
     if (name != NULL && name[0] != '\0') {
         char head[64];
         snprintf(head, sizeof head, "%.20s law: ", name);
-        return cam_fail(err, err_len, "%s%s%s", head, fmt, detail);
+        return cam_error(err, CAM_ERR_PARAMETER, "%s%s%s", head, fmt, detail);
     }
-    return cam_fail(err, err_len, "%s%s", fmt, detail);
+    return cam_error(err, CAM_ERR_PARAMETER, "%s%s", fmt, detail);
 }
 
-static int validate(const double T[6], const char *name, char *err, size_t err_len)
+static int validate(const double T[6], const char *name, CamError *err)
 {
     char list[512];
     int flag[6], k, any = 0;
@@ -64,7 +64,7 @@ static int validate(const double T[6], const char *name, char *err, size_t err_l
     }
     if (any) {
         list_named(list, sizeof list, name, T, flag);
-        return refuse(err, err_len, name, "split points must be finite numbers: ", list);
+        return refuse(err, name, "split points must be finite numbers: ", list);
     }
     for (k = 0; k < 6; k++) {
         flag[k] = !(0.0 <= T[k] && T[k] <= 1.0);
@@ -72,7 +72,7 @@ static int validate(const double T[6], const char *name, char *err, size_t err_l
     }
     if (any) {
         list_named(list, sizeof list, name, T, flag);
-        return refuse(err, err_len, name, "split points must lie in [0, 1]: ", list);
+        return refuse(err, name, "split points must lie in [0, 1]: ", list);
     }
     {
         size_t pos = 0;
@@ -96,7 +96,7 @@ static int validate(const double T[6], const char *name, char *err, size_t err_l
             param_name(t2, sizeof t2, name, 2);
             param_name(t6, sizeof t6, name, 6);
             snprintf(head, sizeof head, "split points must be ordered %s <= %s <= ... <= %s: ", t1, t2, t6);
-            return refuse(err, err_len, name, head, list);
+            return refuse(err, name, head, list);
         }
     }
     if (T[2] == 0.0) {
@@ -106,7 +106,7 @@ static int validate(const double T[6], const char *name, char *err, size_t err_l
         list_named(list, sizeof list, name, T, f);
         snprintf(tail, sizeof tail, " (need %s > 0 to leave the lower dwell)", t3);
         strncat(list, tail, sizeof list - strlen(list) - 1);
-        return refuse(err, err_len, name, "no acceleration segment: ", list);
+        return refuse(err, name, "no acceleration segment: ", list);
     }
     if (T[3] == 1.0) {
         char tail[96], t4[32];
@@ -115,7 +115,7 @@ static int validate(const double T[6], const char *name, char *err, size_t err_l
         list_named(list, sizeof list, name, T, f);
         snprintf(tail, sizeof tail, " (need %s < 1 to reach the upper dwell)", t4);
         strncat(list, tail, sizeof list - strlen(list) - 1);
-        return refuse(err, err_len, name, "no deceleration segment: ", list);
+        return refuse(err, name, "no deceleration segment: ", list);
     }
     return 0;
 }
@@ -156,13 +156,13 @@ static void propagate(int side, const double L[7], const double F[7], double V0[
     *s_end = s;
 }
 
-int cam_law_init(CamLaw *law, const double T[6], const char *name, char *err, size_t err_len)
+int cam_law_init(CamLaw *law, const double T[6], const char *name, CamError *err)
 {
     double edges[8], L[7], F[7], Vp[7], Sp[7], Vm[7], Sm[7], vp, sp, vm, sm, det, Amp, Amm;
     int i;
     memset(law, 0, sizeof *law);
-    if (validate(T, name, err, err_len)) {
-        return 1;
+    if (validate(T, name, err)) {
+        return CAM_ERR_PARAMETER;
     }
     edges[0] = 0.0;
     for (i = 0; i < 6; i++) {
@@ -187,11 +187,12 @@ int cam_law_init(CamLaw *law, const double T[6], const char *name, char *err, si
         }
         snprintf(list + pos, sizeof list - pos, ")");
         if (name != NULL && name[0] != '\0') {
-            return cam_fail(err, err_len, "%.20s law: split points %.20s_T1..%.20s_T6 = %s are too close to make a "
-                            "finite curve (acceleration or deceleration phase of length ~0)", name, name, name, list);
+            return cam_error(err, CAM_ERR_PARAMETER, "%.20s law: split points %.20s_T1..%.20s_T6 = %s are too close "
+                             "to make a finite curve (acceleration or deceleration phase of length ~0)", name, name,
+                             name, list);
         }
-        return cam_fail(err, err_len, "split points %s are too close to make a finite curve "
-                        "(acceleration or deceleration phase of length ~0)", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "split points %s are too close to make a finite curve "
+                         "(acceleration or deceleration phase of length ~0)", list);
     }
     for (i = 0; i < CAM_LAW_SEGMENTS; i++) {
         double *seg;

@@ -9,11 +9,11 @@
  * of a dwell), otherwise at most 3 times the smaller chord slope. Each piece is then monotone
  * between its two lifts: no overshoot, and a run of equal lifts is exactly flat.
  */
-#include "cam_profile.h"
 #include "cam_table.h"
 #include "cam_text.h"
 
 #include <locale.h>
+#include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +21,6 @@
 
 #define TWO_PI (2.0 * 3.141592653589793)
 #define DEG (3.141592653589793 / 180.0)   /* Python's math.radians factor */
-#define MSG 600                           /* room for one message with two quoted texts */
 
 typedef struct {
     const char *s;
@@ -253,33 +252,46 @@ void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *compar
     d[0] = fmin(fmax(s, fmin(y0, y1)), fmax(y0, y1));
 }
 
-/* "motion table line L (row R): " */
-static int row_fail(char *err, size_t err_len, size_t line, size_t row, const char *what)
+/* A refusal of row `row` on line `line`: "motion table line L (row R): " and the printf-style rest. */
+static int row_fail(CamError *err, size_t line, size_t row, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static int row_fail(CamError *err, size_t line, size_t row, const char *fmt, ...)
 {
-    return cam_fail(err, err_len, "motion table line %lu (row %lu): %s", (unsigned long)line, (unsigned long)row,
-                    what);
+    va_list args;
+    int head;
+    if (err == NULL) {
+        return CAM_ERR_PARAMETER;
+    }
+    head = snprintf(err->message, sizeof err->message, "motion table line %lu (row %lu): ", (unsigned long)line,
+                    (unsigned long)row);
+    err->status = CAM_ERR_PARAMETER;
+    va_start(args, fmt);
+    vsnprintf(err->message + head, sizeof err->message - (size_t)head, fmt, args);
+    va_end(args);
+    return CAM_ERR_PARAMETER;
 }
 
 /* The number in field f (named name) or a refusal. */
-static int field_value(Span f, const char *name, size_t line, size_t row, double *value, char *err,
-                       size_t err_len)
+static int field_value(Span f, const char *name, size_t line, size_t row, double *value, CamError *err)
 {
-    char msg[MSG], q[200];
+    char q[200];
     int kind = classify(f);
     cam_quote(f.s, f.n, q, sizeof q);
     if (kind == NOT_NUMBER) {
-        snprintf(msg, sizeof msg, "the %s field is not a number: %s", name, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, "the %s field is not a number: %s", name, q);
     }
     if (f.n > CAM_TABLE_MAX_NUMBER) {
-        snprintf(msg, sizeof msg, "the %s field has more than %d characters: %s", name, CAM_TABLE_MAX_NUMBER, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, "the %s field has more than %d characters: %s", name, CAM_TABLE_MAX_NUMBER,
+                        q);
     }
     if (to_double(f, kind, value)) {
-        snprintf(msg, sizeof msg, "the %s field could not be read as a number: %s", name, q);
-        return row_fail(err, err_len, line, row, msg);
+        return row_fail(err, line, row, "the %s field could not be read as a number: %s", name, q);
     }
-    return 0;
+    return CAM_OK;
 }
 
 typedef struct {
@@ -288,187 +300,237 @@ typedef struct {
     double degrees, radians, mm;
 } RowInfo;
 
-static int parse(const char *text, size_t len, Rows *rows, char *err, size_t err_len)
-{
-    char msg[MSG], q1[200], q2[200];
-    size_t pos = 0, line = 0, row = 0;
-    int first_line = 1, closed = 0;
+/* Where the parser is: the line and row counts, and the rows later checks compare with. */
+typedef struct {
+    size_t line, row;
+    int first_line, closed;
     RowInfo first, prev, closing;
-    memset(&first, 0, sizeof first);
-    memset(&prev, 0, sizeof prev);
-    memset(&closing, 0, sizeof closing);
+} Parser;
+
+/* The line starting at *pos: its end (before '\n', '\r' or "\r\n"); *pos moves past the line break. */
+static size_t line_end(const char *text, size_t len, size_t *pos)
+{
+    size_t end = *pos;
+    while (end < len && text[end] != '\n' && text[end] != '\r') {
+        end++;
+    }
+    *pos = end;
+    if (end < len) {
+        *pos += (text[end] == '\r' && end + 1 < len && text[end + 1] == '\n') ? 2 : 1;
+    }
+    return end;
+}
+
+/* The fields of text[start..end) before a '#' comment (its end into *stop): the first two into field,
+ * how many look like numbers into *numbers; returns the number of fields. */
+static size_t line_fields(const char *text, size_t start, size_t end, Span field[2], int *numbers, size_t *stop)
+{
+    size_t k, n_fields = 0;
+    *stop = start;
+    while (*stop < end && text[*stop] != '#') {
+        (*stop)++;  /* '#' starts a comment */
+    }
+    *numbers = 0;
+    for (k = start; k < *stop;) {
+        size_t f0;
+        if (is_sep(text[k])) {
+            k++;
+            continue;
+        }
+        f0 = k;
+        while (k < *stop && !is_sep(text[k])) {
+            k++;
+        }
+        if (n_fields < 2) {
+            field[n_fields].s = text + f0;
+            field[n_fields].n = k - f0;
+        }
+        if (classify((Span){text + f0, k - f0}) != NOT_NUMBER) {
+            (*numbers)++;
+        }
+        n_fields++;
+    }
+    return n_fields;
+}
+
+/* The row on the parser's line (its text line[0..n), n_fields fields, the first two in field) read into
+ * *r: two numbers, each in its range, and no row after a closing one. */
+static int read_row(const Parser *ps, const char *line, size_t n, size_t n_fields, const Span field[2],
+                    RowInfo *r, CamError *err)
+{
+    char q[200];
+    if (ps->closed) {
+        return row_fail(err, ps->line, ps->row, "no row may follow the closing row at 360 deg (row %lu, line %lu)",
+                        (unsigned long)ps->closing.row, (unsigned long)ps->closing.line);
+    }
+    if (n_fields != 2) {
+        size_t a = 0, b = n;
+        while (a < b && is_sep(line[a])) {
+            a++;
+        }
+        while (b > a && is_sep(line[b - 1])) {
+            b--;
+        }
+        return row_fail(err, ps->line, ps->row, "expected 2 fields 'angle_deg, lift_mm', got %lu: %s",
+                        (unsigned long)n_fields, cam_text(line + a, b - a, q, sizeof q));
+    }
+    memset(r, 0, sizeof *r);
+    r->line = ps->line;
+    r->row = ps->row;
+    r->angle = field[0];
+    r->lift = field[1];
+    if (field_value(r->angle, "angle_deg", ps->line, ps->row, &r->degrees, err) ||
+        field_value(r->lift, "lift_mm", ps->line, ps->row, &r->mm, err)) {
+        return CAM_ERR_PARAMETER;
+    }
+    if (!(isfinite(r->degrees) && r->degrees >= 0.0 && r->degrees <= 360.0)) {
+        return row_fail(err, ps->line, ps->row, "angle_deg must lie in [0, 360) (or be 360 in a closing row), got %s",
+                        cam_text(r->angle.s, r->angle.n, q, sizeof q));
+    }
+    if (!(isfinite(r->mm) && r->mm >= 0.0 && r->mm <= CAM_TABLE_MAX_LIFT_MM)) {
+        return row_fail(err, ps->line, ps->row, "lift_mm must be a number in [0, 10000], got %s",
+                        cam_text(r->lift.s, r->lift.n, q, sizeof q));
+    }
+    return CAM_OK;
+}
+
+/* A row at 360 deg: it closes the period, after a first row at 0 deg and with that row's lift. */
+static int close_period(Parser *ps, const Rows *rows, const RowInfo *r, CamError *err)
+{
+    char q1[200], q2[200];
+    const RowInfo *first = &ps->first;
+    if (rows->n == 0 || first->degrees != 0.0) {
+        return row_fail(err, ps->line, ps->row, "a row at 360 deg closes the period: it must come last, "
+                        "after a first row at 0 deg");
+    }
+    if (fabs(r->mm - first->mm) > 1e-9 * fmax(1.0, fabs(first->mm))) {
+        return row_fail(err, ps->line, ps->row, "the closing row at 360 deg must repeat the lift of row %lu "
+                        "(line %lu), %s mm, got %s mm", (unsigned long)first->row, (unsigned long)first->line,
+                        cam_text(first->lift.s, first->lift.n, q1, sizeof q1),
+                        cam_text(r->lift.s, r->lift.n, q2, sizeof q2));
+    }
+    ps->closed = 1;
+    ps->closing = *r;
+    return CAM_OK;
+}
+
+/* A row inside the period: its angle above the previous one's by at least the minimum spacing, then kept. */
+static int append_row(Parser *ps, Rows *rows, RowInfo *r, CamError *err)
+{
+    char q1[200], q2[200];
+    const RowInfo *prev = &ps->prev;
+    r->radians = r->degrees * DEG;
+    if (rows->n > 0) {
+        if (r->degrees <= prev->degrees) {
+            return row_fail(err, ps->line, ps->row, "angle %s deg %s %s deg of row %lu (line %lu); angles must "
+                            "increase strictly", cam_text(r->angle.s, r->angle.n, q1, sizeof q1),
+                            r->degrees == prev->degrees ? "repeats" : "is below",
+                            cam_text(prev->angle.s, prev->angle.n, q2, sizeof q2), (unsigned long)prev->row,
+                            (unsigned long)prev->line);
+        }
+        if (r->degrees - prev->degrees < CAM_TABLE_MIN_SPACING_DEG) {
+            return row_fail(err, ps->line, ps->row, "angle %s deg is closer than 1e-06 deg to %s deg of row %lu "
+                            "(line %lu)", cam_text(r->angle.s, r->angle.n, q1, sizeof q1),
+                            cam_text(prev->angle.s, prev->angle.n, q2, sizeof q2), (unsigned long)prev->row,
+                            (unsigned long)prev->line);
+        }
+    }
+    if (rows->n >= CAM_TABLE_MAX_ROWS) {
+        return cam_error(err, CAM_ERR_PARAMETER, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
+                         (unsigned long)ps->line);
+    }
+    if (push(rows, r->radians, r->mm * 1e-3)) {
+        return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory at row %lu", (unsigned long)ps->row);
+    }
+    if (rows->n == 1) {
+        ps->first = *r;
+    }
+    ps->prev = *r;
+    return CAM_OK;
+}
+
+/* The whole table: at least two rows, and the last far enough from the first one's angle + 360 deg. */
+static int check_period(const Parser *ps, const Rows *rows, CamError *err)
+{
+    char q1[200], q2[200];
+    const RowInfo *first = &ps->first, *prev = &ps->prev;
+    if (rows->n < 2) {
+        return cam_error(err, CAM_ERR_PARAMETER, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing "
+                         "row at 360 deg not counted), got %lu", (unsigned long)rows->n);
+    }
+    if ((first->degrees + 360.0) - prev->degrees < CAM_TABLE_MIN_SPACING_DEG) {
+        return row_fail(err, prev->line, prev->row, "angle %s deg is closer than 1e-06 deg to %s deg + 360 deg of "
+                        "row %lu (line %lu), where the period starts again",
+                        cam_text(prev->angle.s, prev->angle.n, q1, sizeof q1),
+                        cam_text(first->angle.s, first->angle.n, q2, sizeof q2), (unsigned long)first->row,
+                        (unsigned long)first->line);
+    }
+    return CAM_OK;
+}
+
+/* The rows of a motion table's text (docs/cam_design.md: the format and the refusals), line by line. */
+static int parse(const char *text, size_t len, Rows *rows, CamError *err)
+{
+    Parser ps;
+    size_t pos = 0;
+    int status;
+    memset(&ps, 0, sizeof ps);
+    ps.first_line = 1;
     if (len >= 3 && (unsigned char)text[0] == 0xef && (unsigned char)text[1] == 0xbb &&
         (unsigned char)text[2] == 0xbf) {
         pos = 3;  /* a UTF-8 byte order mark, as spreadsheets write it */
     }
     while (pos < len) {
-        size_t start = pos, end = pos, stop, k, n_fields = 0;
+        size_t start = pos, end = line_end(text, len, &pos), stop, n_fields;
         Span field[2];
         RowInfo r;
-        int numbers = 0;
-        while (end < len && text[end] != '\n' && text[end] != '\r') {
-            end++;
-        }
-        pos = end;
-        if (pos < len) {
-            pos += (text[pos] == '\r' && pos + 1 < len && text[pos + 1] == '\n') ? 2 : 1;
-        }
-        line++;
-        stop = start;
-        while (stop < end && text[stop] != '#') {
-            stop++;  /* '#' starts a comment */
-        }
-        for (k = start; k < stop;) {
-            size_t f0;
-            if (is_sep(text[k])) {
-                k++;
-                continue;
-            }
-            f0 = k;
-            while (k < stop && !is_sep(text[k])) {
-                k++;
-            }
-            if (n_fields < 2) {
-                field[n_fields].s = text + f0;
-                field[n_fields].n = k - f0;
-            }
-            if (classify((Span){text + f0, k - f0}) != NOT_NUMBER) {
-                numbers++;
-            }
-            n_fields++;
-        }
+        int numbers;
+        ps.line++;
+        n_fields = line_fields(text, start, end, field, &numbers, &stop);
         if (n_fields == 0) {
             continue;  /* blank or comment */
         }
-        if (first_line) {
-            first_line = 0;
+        if (ps.first_line) {
+            ps.first_line = 0;
             if (numbers == 0) {
                 continue;  /* a header: no field is a number */
             }
         }
-        row++;
-        if (closed) {
-            snprintf(msg, sizeof msg, "no row may follow the closing row at 360 deg (row %lu, line %lu)",
-                     (unsigned long)closing.row, (unsigned long)closing.line);
-            return row_fail(err, err_len, line, row, msg);
+        ps.row++;
+        if ((status = read_row(&ps, text + start, stop - start, n_fields, field, &r, err)) != CAM_OK) {
+            return status;
         }
-        if (n_fields != 2) {
-            size_t a = start, b = stop;
-            while (a < b && is_sep(text[a])) {
-                a++;
-            }
-            while (b > a && is_sep(text[b - 1])) {
-                b--;
-            }
-            cam_quote(text + a, b - a, q1, sizeof q1);
-            snprintf(msg, sizeof msg, "expected 2 fields 'angle_deg, lift_mm', got %lu: %s", (unsigned long)n_fields,
-                     q1);
-            return row_fail(err, err_len, line, row, msg);
+        status = r.degrees == 360.0 ? close_period(&ps, rows, &r, err) : append_row(&ps, rows, &r, err);
+        if (status != CAM_OK) {
+            return status;
         }
-        memset(&r, 0, sizeof r);
-        r.line = line;
-        r.row = row;
-        r.angle = field[0];
-        r.lift = field[1];
-        if (field_value(r.angle, "angle_deg", line, row, &r.degrees, err, err_len) ||
-            field_value(r.lift, "lift_mm", line, row, &r.mm, err, err_len)) {
-            return 1;
-        }
-        if (!(isfinite(r.degrees) && r.degrees >= 0.0 && r.degrees <= 360.0)) {
-            cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
-            snprintf(msg, sizeof msg, "angle_deg must lie in [0, 360) (or be 360 in a closing row), got %s", q1);
-            return row_fail(err, err_len, line, row, msg);
-        }
-        if (!(isfinite(r.mm) && r.mm >= 0.0 && r.mm <= CAM_TABLE_MAX_LIFT_MM)) {
-            cam_quote(r.lift.s, r.lift.n, q1, sizeof q1);
-            snprintf(msg, sizeof msg, "lift_mm must be a number in [0, 10000], got %s", q1);
-            return row_fail(err, err_len, line, row, msg);
-        }
-        if (r.degrees == 360.0) {
-            if (rows->n == 0 || first.degrees != 0.0) {
-                return row_fail(err, err_len, line, row, "a row at 360 deg closes the period: it must come last, "
-                                "after a first row at 0 deg");
-            }
-            if (fabs(r.mm - first.mm) > 1e-9 * fmax(1.0, fabs(first.mm))) {
-                cam_quote(first.lift.s, first.lift.n, q1, sizeof q1);
-                cam_quote(r.lift.s, r.lift.n, q2, sizeof q2);
-                snprintf(msg, sizeof msg, "the closing row at 360 deg must repeat the lift of row %lu (line %lu), "
-                         "%s mm, got %s mm", (unsigned long)first.row, (unsigned long)first.line, q1, q2);
-                return row_fail(err, err_len, line, row, msg);
-            }
-            closed = 1;
-            closing = r;
-            continue;
-        }
-        r.radians = r.degrees * DEG;
-        if (rows->n > 0) {
-            if (r.degrees <= prev.degrees) {
-                cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
-                cam_quote(prev.angle.s, prev.angle.n, q2, sizeof q2);
-                snprintf(msg, sizeof msg, "angle %s deg %s %s deg of row %lu (line %lu); angles must increase strictly",
-                         q1, r.degrees == prev.degrees ? "repeats" : "is below", q2, (unsigned long)prev.row,
-                         (unsigned long)prev.line);
-                return row_fail(err, err_len, line, row, msg);
-            }
-            if (r.degrees - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
-                cam_quote(r.angle.s, r.angle.n, q1, sizeof q1);
-                cam_quote(prev.angle.s, prev.angle.n, q2, sizeof q2);
-                snprintf(msg, sizeof msg, "angle %s deg is closer than 1e-06 deg to %s deg of row %lu (line %lu)",
-                         q1, q2, (unsigned long)prev.row, (unsigned long)prev.line);
-                return row_fail(err, err_len, line, row, msg);
-            }
-        }
-        if (rows->n >= CAM_TABLE_MAX_ROWS) {
-            return cam_fail(err, err_len, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
-                            (unsigned long)line);
-        }
-        if (push(rows, r.radians, r.mm * 1e-3)) {
-            return cam_fail(err, err_len, "motion table: out of memory at row %lu", (unsigned long)row);
-        }
-        if (rows->n == 1) {
-            first = r;
-        }
-        prev = r;
     }
-    if (rows->n < 2) {
-        return cam_fail(err, err_len, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing row at "
-                        "360 deg not counted), got %lu", (unsigned long)rows->n);
-    }
-    if ((first.degrees + 360.0) - prev.degrees < CAM_TABLE_MIN_SPACING_DEG) {
-        cam_quote(prev.angle.s, prev.angle.n, q1, sizeof q1);
-        cam_quote(first.angle.s, first.angle.n, q2, sizeof q2);
-        snprintf(msg, sizeof msg, "motion table line %lu (row %lu): angle %s deg is closer than 1e-06 deg to %s deg "
-                 "+ 360 deg of row %lu (line %lu), where the period starts again", (unsigned long)prev.line,
-                 (unsigned long)prev.row, q1, q2, (unsigned long)first.row, (unsigned long)first.line);
-        return cam_fail(err, err_len, "%s", msg);
-    }
-    return 0;
+    return check_period(&ps, rows, err);
 }
 
-int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, char *err, size_t err_len)
+int cam_table_init(CamTable *t, const char *text, size_t text_len, CamError *err)
 {
     Rows rows;
-    CamTable *t;
     double *block;
-    size_t n, i;
-    memset(p, 0, sizeof *p);
+    size_t n;
+    int status;
+    memset(t, 0, sizeof *t);
     memset(&rows, 0, sizeof rows);
     if (text == NULL && text_len > 0) {
-        return cam_fail(err, err_len, "motion table: no text");
+        return cam_error(err, CAM_ERR_PARAMETER, "motion table: no text");
     }
-    if (parse(text, text_len, &rows, err, err_len)) {
+    if ((status = parse(text, text_len, &rows, err)) != CAM_OK) {
         free(rows.angle);
         free(rows.lift);
-        return 1;
+        return status;
     }
     n = rows.n;
     block = malloc(7 * n * sizeof *block);
     if (block == NULL) {
         free(rows.angle);
         free(rows.lift);
-        return cam_fail(err, err_len, "motion table: out of memory for %lu rows", (unsigned long)n);
+        return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory for %lu rows", (unsigned long)n);
     }
-    t = &p->table;
     t->n = n;
     t->angle = block;
     t->lift = block + n;
@@ -482,19 +544,11 @@ int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, cha
     free(rows.angle);
     free(rows.lift);
     build(t);
-    p->kind = CAM_PROGRAM_TABLE;
-    p->points = t->angle;
-    p->n_points = n;
-    p->feature_angle = t->width[0];
-    for (i = 1; i < n; i++) {
-        if (t->width[i] < p->feature_angle) {
-            p->feature_angle = t->width[i];
-        }
-    }
-    for (i = 0; i < n; i++) {
-        if (t->lift[i] > p->lift) {
-            p->lift = t->lift[i];  /* the largest lift [m], as TableProgram.lift */
-        }
-    }
-    return 0;
+    return CAM_OK;
+}
+
+void cam_table_free(CamTable *t)
+{
+    free(t->angle);  /* the table's one allocation */
+    memset(t, 0, sizeof *t);
 }

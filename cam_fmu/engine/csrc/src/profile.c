@@ -3,7 +3,8 @@
  * cam_profile_init_laws checks as kinematics/cam_program.py's CamProgram (and physics/parameters.py for
  * the sum of the angles) and computes what kinematics.cam_program.CamProgram does; cam_profile_eval is
  * CamProgram.derivatives (same operations, same order: the same doubles); breakpoints and the
- * feature angle are CamProgram.breakpoints() and CamProgram.feature_angle(). Tables: motion_table.c.
+ * feature angle are CamProgram.breakpoints() and CamProgram.feature_angle(). A table program is built here
+ * around the CamTable that motion_table.c parses, interpolates and frees (cam_table.h).
  */
 #include "cam_profile.h"
 #include "cam_table.h"
@@ -16,7 +17,7 @@
 
 #define TWO_PI (2.0 * 3.141592653589793)
 
-static int check_program(double lift, const double angle[4], char *err, size_t err_len)
+static int check_program(double lift, const double angle[4], CamError *err)
 {
     static const char *const names[4] = {"rise_angle", "upper_dwell", "return_angle", "lower_dwell"};
     char list[512], r[CAM_REPR_LEN];
@@ -25,7 +26,7 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
     int k;
     if (!(isfinite(lift) && lift > 0.0)) {
         cam_repr(lift, r);
-        return cam_fail(err, err_len, "lift must be a finite number > 0 [m], got %s", r);
+        return cam_error(err, CAM_ERR_PARAMETER, "lift must be a finite number > 0 [m], got %s", r);
     }
     list[0] = '\0';
     for (k = 0; k < 4; k++) {
@@ -35,7 +36,7 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
         }
     }
     if (pos) {
-        return cam_fail(err, err_len, "angles must be finite and >= 0 [rad]: %s", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "angles must be finite and >= 0 [rad]: %s", list);
     }
     for (k = 0; k < 4; k += 2) {
         if (angle[k] < CAM_MIN_STROKE_ANGLE) {
@@ -44,15 +45,16 @@ static int check_program(double lift, const double angle[4], char *err, size_t e
         }
     }
     if (pos) {
-        return cam_fail(err, err_len, "rise and return angles must be >= 0.000174533 rad (0.01 deg) [rad]: %s", list);
+        return cam_error(err, CAM_ERR_PARAMETER, "rise and return angles must be >= 0.000174533 rad (0.01 deg) "
+                         "[rad]: %s", list);
     }
     total = angle[0] + angle[1] + angle[2] + angle[3];
     if (fabs(total - TWO_PI) > 1e-9) {
         char two_pi[CAM_REPR_LEN];
         cam_repr(total, r);
         cam_repr(TWO_PI, two_pi);
-        return cam_fail(err, err_len, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + 'lower_dwell' "
-                        "= %s rad must equal 2 pi = %s rad (to 1e-9 rad)", r, two_pi);
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'rise_angle' + 'upper_dwell' + 'return_angle' + "
+                         "'lower_dwell' = %s rad must equal 2 pi = %s rad (to 1e-9 rad)", r, two_pi);
     }
     return 0;
 }
@@ -110,7 +112,7 @@ static double law_feature(const CamLaw *law, double beta, double best)
 
 int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double return_T[6], double lift,
                           double rise_angle, double upper_dwell, double return_angle, double lower_dwell,
-                          char *err, size_t err_len)
+                          CamError *err)
 {
     double angle[4], pts[16], beta, h;
     size_t n;
@@ -120,10 +122,10 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     angle[1] = upper_dwell;
     angle[2] = return_angle;
     angle[3] = lower_dwell;
-    if (cam_law_init(&p->rise, rise_T, "rise", err, err_len) ||
-        cam_law_init(&p->ret, return_T, "return", err, err_len) || check_program(lift, angle, err, err_len)) {
+    if (cam_law_init(&p->rise, rise_T, "rise", err) ||
+        cam_law_init(&p->ret, return_T, "return", err) || check_program(lift, angle, err)) {
         memset(p, 0, sizeof *p);
-        return 1;
+        return CAM_ERR_PARAMETER;
     }
     p->lift = lift;
     p->b1 = rise_angle;
@@ -144,12 +146,38 @@ int cam_profile_init_laws(CamProfile *p, const double rise_T[6], const double re
     p->points = malloc(n * sizeof *p->points);
     if (p->points == NULL) {
         memset(p, 0, sizeof *p);
-        return cam_fail(err, err_len, "cam program: out of memory");
+        return cam_error(err, CAM_ERR_MEMORY, "cam program: out of memory");
     }
     memcpy(p->points, pts, n * sizeof *pts);
     p->n_points = n;
     p->feature_angle = law_feature(&p->ret, return_angle, law_feature(&p->rise, rise_angle, INFINITY));
     return 0;
+}
+
+int cam_profile_init_table(CamProfile *p, const char *text, size_t text_len, CamError *err)
+{
+    const CamTable *t = &p->table;
+    size_t i;
+    int status;
+    memset(p, 0, sizeof *p);
+    if ((status = cam_table_init(&p->table, text, text_len, err)) != CAM_OK) {
+        return status;
+    }
+    p->kind = CAM_PROGRAM_TABLE;
+    p->points = t->angle;
+    p->n_points = t->n;
+    p->feature_angle = t->width[0];
+    for (i = 1; i < t->n; i++) {
+        if (t->width[i] < p->feature_angle) {
+            p->feature_angle = t->width[i];
+        }
+    }
+    for (i = 0; i < t->n; i++) {
+        if (t->lift[i] > p->lift) {
+            p->lift = t->lift[i];  /* the largest lift [m], as TableProgram.lift */
+        }
+    }
+    return CAM_OK;
 }
 
 void cam_profile_free(CamProfile *p)
@@ -158,7 +186,7 @@ void cam_profile_free(CamProfile *p)
         return;
     }
     if (p->kind == CAM_PROGRAM_TABLE) {
-        free(p->table.angle);  /* the table's one allocation; points is table.angle */
+        cam_table_free(&p->table);  /* points is the table's array of angles */
     } else {
         free(p->points);
     }
