@@ -162,10 +162,10 @@ class Design:
         """(stop - start, d) points of the unit cube (a sampled design)."""
         kind, n = self.sample  # type: ignore[misc]
         d = len(self.varies)
-        from scipy.stats import qmc
-
         if kind == "sobol":
             import warnings
+
+            from scipy.stats import qmc  # scipy.stats takes a second or two to import: only where needed
 
             engine = qmc.Sobol(d, scramble=True, seed=self.seed)
             if start:
@@ -180,6 +180,8 @@ class Design:
             return block[start - first:stop - first]
         if self._unit is None:
             if kind == "lhs":
+                from scipy.stats import qmc
+
                 self._unit = qmc.LatinHypercube(d, seed=self.seed).random(n)
             else:  # saltelli: SALib's design in the real ranges; here mapped back to the unit cube
                 import warnings

@@ -296,3 +296,23 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+def test_an_interrupted_serial_sweep_keeps_its_partial_batch_and_resumes_to_the_same_table(tmp_path):
+    """Ctrl-C in the middle of a batch of 50: the finished cases of that batch are written too; --resume runs
+    the rest of that batch and the batches after it: the table equals an uninterrupted run's."""
+    from conftest import interrupt_after_progress
+
+    args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:120", "--metric", "peak_M,rms_M", "--stop-time", "2",
+            "--serial", "--batch-size", "50", "--no-plot"]
+    _cli(*args, "--out", str(tmp_path / "whole"), cwd=tmp_path)
+    out = tmp_path / "cut"
+    status, stderr = interrupt_after_progress([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], 10,
+                                              tmp_path, _env())
+    assert status == 130, stderr[-3000:]
+    kept = int(stderr.strip().splitlines()[-1].split("interrupted: ")[1].split(" of ")[0])
+    assert 10 <= kept < 120
+    assert [r["case"] for r in _parquet_rows(out / "paper_fig6_sweep.parquet")] == list(range(1, kept + 1))
+    again = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
+    assert f"({120 - kept} to run)" in again.stderr
+    assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "whole" / "paper_fig6_sweep.csv").read_text()
