@@ -4,8 +4,9 @@
 --vary ranges, SALib.sample.sobol) like any sweep; ``indices`` then reads each metric back from the Parquet
 dataset in case order and estimates, per parameter, the first-order index S1 (the share of the metric's
 variance the parameter explains alone) and the total index ST (alone and in every interaction), each with the
-half-width of its 95 % bootstrap confidence interval (SALib.analyze.sobol). A metric with a failed case (NaN)
-gets NaN indices: the estimators need every case.
+half-width of its 95 % bootstrap confidence interval (SALib.analyze.sobol). A metric with a value that is not
+finite (a failed case: NaN; a stalled cam's energy_per_turn: inf) gets NaN indices, said on stderr: the
+estimators need every case.
 """
 from __future__ import annotations
 
@@ -28,8 +29,9 @@ def sobol_indices(problem: dict, y: np.ndarray, seed: int = 0) -> dict[str, np.n
         return {key: np.full(d, math.nan) for key in COLUMNS[2:]}
     from SALib.analyze import sobol
 
+    # the bootstrap seeded with seed + 1: SALib ignores a seed of 0 (``if seed:``) and the intervals then vary
     result = sobol.analyze(problem, np.asarray(y, dtype=float), calc_second_order=False, conf_level=0.95,
-                           print_to_console=False, seed=seed)
+                           print_to_console=False, seed=seed + 1)
     return {key: np.asarray(result[key], dtype=float) for key in COLUMNS[2:]}
 
 
@@ -46,9 +48,12 @@ def indices(plan: Any, folder: str | Path) -> list[dict[str, Any]]:
     problem = plan.design.problem()
     rows = []
     for m in metrics:
-        result = sobol_indices(problem, np.array(y[m], dtype=float), plan.design.seed)
+        values = np.array(y[m], dtype=float)
+        result = sobol_indices(problem, values, plan.design.seed)
+        bad = int(np.sum(~np.isfinite(values)))
         for j, name in enumerate(problem["names"]):
-            rows.append({"metric": m, "parameter": name, **{k: float(result[k][j]) for k in COLUMNS[2:]}})
+            rows.append({"metric": m, "parameter": name, **{k: float(result[k][j]) for k in COLUMNS[2:]},
+                         "not_finite": bad})
     return rows
 
 
@@ -86,7 +91,7 @@ def report(plan: Any, folder: str | Path, out: str | Path, plot: bool = True) ->
         print(plot_sensitivity(rows, Path(out) / f"{name}_sensitivity.png",
                                title=f"{name}: Sobol indices, {len(plan.design)} cases (Saltelli, N = "
                                      f"{plan.design.sample[1]})"))
-    bad = sorted({r["metric"] for r in rows if math.isnan(r["ST"])})
-    if bad:
-        print(f"# no indices for {', '.join(bad)}: failed cases (NaN) in the design", file=sys.stderr)
+    for metric, bad in {r["metric"]: r["not_finite"] for r in rows if r["not_finite"]}.items():
+        print(f"# no indices for {metric}: {bad} of {len(plan.design)} cases not finite (failed: NaN; "
+              "energy_per_turn = inf: the cam stalled)", file=sys.stderr)
     return rows

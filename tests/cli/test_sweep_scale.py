@@ -203,7 +203,7 @@ def test_sobol_indices_of_an_additive_function_match_the_closed_form(tmp_path):
         _write_part(folder, schema, {"case": list(range(start + 1, start + len(x) + 1)), **values,
                                      "peak_M": list(x @ a), "status": ["ok"] * len(x), "message": [""] * len(x)})
     rows = sensitivity.indices(plan, folder)
-    assert [r["parameter"] for r in rows] == ["m", "mu", "lift"]
+    assert [r["parameter"] for r in rows] == ["m", "mu", "lift"] and rows == sensitivity.indices(plan, folder)
     for r, expected in zip(rows, share):
         assert r["S1"] == pytest.approx(expected, abs=max(0.02, 2 * r["S1_conf"]))
         assert r["ST"] == pytest.approx(expected, abs=max(0.02, 2 * r["ST_conf"]))

@@ -28,8 +28,8 @@ def test_sweep_benchmark_reports_engine_serial_cluster_and_memory(tmp_path):
     assert cluster["failed"] == 0 and 0 < cluster["run_s"] <= cluster["wall_s"]
     assert cluster["cases_per_s"] == pytest.approx(60 / cluster["run_s"])
     assert cluster["ratio"] == pytest.approx(cluster["cases_per_s"] * result["engine_s"] / 2)
-    assert cluster["driver_rss_mib"]["peak"] > 0 and len(cluster["worker_rss_mib"]) >= 2
+    assert cluster["cpu_s_per_case"] > 0 and cluster["driver_rss_mib"]["peak"] > 0 and len(cluster["worker_rss_mib"]) >= 2
     lines = proc.stdout.strip().splitlines()
     assert lines[0].startswith("engine's own run of a case (fig. 6, 2 s): ") and "target <= 1.3" in lines[1]
-    assert "local cluster of 2 workers: 60 cases" in lines[2] and "target >= 0.8" in lines[2]
+    assert "local cluster of 2 workers: 60 cases" in lines[2] and "target >= 0.8" in lines[2] and "CPU a case" in lines[2]
     assert lines[3].startswith("RSS [MiB] first quarter/peak: driver ")

@@ -14,6 +14,9 @@ Measured in one process, one after another:
 - ``cluster``: the N cases on a LocalCluster of W workers (its start included in ``wall_s``, not in ``run_s``,
   the time from the first batch submitted to the last written): cases/s, cases/s per worker, ``ratio`` =
   cases/s / (W / engine_s) (target >= 0.8) and the per-case overhead W run_s / N / engine_s;
+- CPU: the driver's (with the local scheduler) and its child processes' (workers, nannies) CPU seconds a case,
+  against engine_s: on a shared machine, where the workers get less than a core each, the cost that the
+  wall clock hides;
 - memory: the driver's and each worker's RSS sampled as the batches finish (psutil), the peak of each over the
   first quarter and over the whole run (flat: the two close).
 
@@ -81,6 +84,7 @@ class _Memory:
         self.last = 0.0
         self.driver = [0.0, 0.0]
         self.workers: dict[int, list[float]] = {}
+        self.cpu: dict[int, float] = {}  # CPU seconds (user + system) of each child process at its last sample
 
     def __call__(self, done: int, total: int, failed: int = 0) -> None:
         now = time.monotonic()
@@ -93,8 +97,10 @@ class _Memory:
         for child in self.me.children(recursive=True):
             try:
                 rss = child.memory_info().rss / 2 ** 20
+                times = child.cpu_times()
             except Exception:  # noqa: BLE001 - a process gone meanwhile
                 continue
+            self.cpu[child.pid] = times.user + times.system
             peaks = self.workers.setdefault(child.pid, [0.0, 0.0])
             peaks[:] = [max(peaks[0], rss if early else 0.0), max(peaks[1], rss)]
 
@@ -115,16 +121,20 @@ def run(n: int = 100_000, workers: int = 2, serial_cases: int | None = None, out
         result["serial"] = {"cases": serial_n, "wall_s": serial.seconds, "case_s": per_case,
                             "overhead": per_case / engine_s, "batch_size": serial.batch_size}
         memory = _Memory()
+        cpu0 = memory.me.cpu_times()
         t0 = time.perf_counter()
         summary = run_sweep(_plan(n), Path(tmp) / "cluster", workers=workers, progress=memory,
                             started=lambda where, batch, todo: marks.setdefault("start", time.perf_counter()))
         end = time.perf_counter()
+        cpu1 = memory.me.cpu_times()
+        driver_cpu = cpu1.user + cpu1.system - cpu0.user - cpu0.system
         run_s = end - marks.get("start", t0)
         rate = n / run_s
         result["cluster"] = {
             "wall_s": end - t0, "run_s": run_s, "cases_per_s": rate, "cases_per_s_per_worker": rate / workers,
             "ratio": rate / (workers / engine_s), "overhead": workers * run_s / n / engine_s,
             "batch_size": summary.batch_size, "failed": summary.failed,
+            "cpu_s_per_case": (driver_cpu + sum(memory.cpu.values())) / n,
             "driver_rss_mib": {"first_quarter": memory.driver[0], "peak": memory.driver[1]},
             "worker_rss_mib": [{"first_quarter": a, "peak": b} for a, b in memory.workers.values()],
         }
@@ -145,7 +155,8 @@ def report(result: dict) -> str:
         f"local cluster of {result['workers']} workers: {result['cases']} cases in {c['wall_s']:.1f} s wall "
         f"({c['run_s']:.1f} s running, batches of {c['batch_size']}), {c['cases_per_s']:.0f} cases/s, "
         f"{c['cases_per_s_per_worker']:.0f} per worker; ratio to workers / engine time {c['ratio']:.2f} "
-        f"(target >= 0.8); per-case overhead {c['overhead']:.2f} x",
+        f"(target >= 0.8); per-case overhead {c['overhead']:.2f} x; CPU a case (driver, scheduler and workers) "
+        f"{c['cpu_s_per_case'] * 1e3:.2f} ms = {c['cpu_s_per_case'] / result['engine_s']:.2f} x the engine's run",
         f"RSS [MiB] first quarter/peak: driver {c['driver_rss_mib']['first_quarter']:.0f}/"
         f"{c['driver_rss_mib']['peak']:.0f}, workers {workers}",
     ])
