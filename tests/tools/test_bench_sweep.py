@@ -32,4 +32,5 @@ def test_sweep_benchmark_reports_engine_serial_cluster_and_memory(tmp_path):
     lines = proc.stdout.strip().splitlines()
     assert lines[0].startswith("engine's own run of a case (fig. 6, 2 s): ") and "target <= 1.3" in lines[1]
     assert "local cluster of 2 workers: 60 cases" in lines[2] and "target >= 0.8" in lines[2] and "CPU a case" in lines[2]
-    assert lines[3].startswith("RSS [MiB] first quarter/peak: driver ")
+    assert lines[3].startswith("Parquet: ") and "RSS [MiB] first quarter/peak: driver " in lines[3]
+    assert 8 < cluster["disk_bytes_per_case"] < 10_000  # at least the case number's 8 bytes

@@ -17,6 +17,7 @@ Measured in one process, one after another:
 - CPU: the driver's (with the local scheduler) and its child processes' (workers, nannies) CPU seconds a case,
   against engine_s: on a shared machine, where the workers get less than a core each, the cost that the
   wall clock hides;
+- disk: the Parquet dataset's bytes a case;
 - memory: the driver's and each worker's RSS sampled as the batches finish (psutil), the peak of each over the
   first quarter and over the whole run (flat: the two close).
 
@@ -129,12 +130,13 @@ def run(n: int = 100_000, workers: int = 2, serial_cases: int | None = None, out
         cpu1 = memory.me.cpu_times()
         driver_cpu = cpu1.user + cpu1.system - cpu0.user - cpu0.system
         run_s = end - marks.get("start", t0)
+        disk = sum(f.stat().st_size for f in (Path(tmp) / "cluster").rglob("*.parquet"))
         rate = n / run_s
         result["cluster"] = {
             "wall_s": end - t0, "run_s": run_s, "cases_per_s": rate, "cases_per_s_per_worker": rate / workers,
             "ratio": rate / (workers / engine_s), "overhead": workers * run_s / n / engine_s,
             "batch_size": summary.batch_size, "failed": summary.failed,
-            "cpu_s_per_case": (driver_cpu + sum(memory.cpu.values())) / n,
+            "cpu_s_per_case": (driver_cpu + sum(memory.cpu.values())) / n, "disk_bytes_per_case": disk / n,
             "driver_rss_mib": {"first_quarter": memory.driver[0], "peak": memory.driver[1]},
             "worker_rss_mib": [{"first_quarter": a, "peak": b} for a, b in memory.workers.values()],
         }
@@ -157,7 +159,7 @@ def report(result: dict) -> str:
         f"{c['cases_per_s_per_worker']:.0f} per worker; ratio to workers / engine time {c['ratio']:.2f} "
         f"(target >= 0.8); per-case overhead {c['overhead']:.2f} x; CPU a case (driver, scheduler and workers) "
         f"{c['cpu_s_per_case'] * 1e3:.2f} ms = {c['cpu_s_per_case'] / result['engine_s']:.2f} x the engine's run",
-        f"RSS [MiB] first quarter/peak: driver {c['driver_rss_mib']['first_quarter']:.0f}/"
+        f"Parquet: {c['disk_bytes_per_case']:.0f} bytes a case; RSS [MiB] first quarter/peak: driver {c['driver_rss_mib']['first_quarter']:.0f}/"
         f"{c['driver_rss_mib']['peak']:.0f}, workers {workers}",
     ])
 
