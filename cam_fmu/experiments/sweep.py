@@ -299,11 +299,9 @@ def plot_table(rows: Sequence[Mapping[str, Any]], varies: Sequence[Vary], metric
                 ax.legend(fontsize="x-small")
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    from ..plots import save_figure
+
+    return save_figure(plt, fig, path)
 
 
 def _short(value: Any) -> str:

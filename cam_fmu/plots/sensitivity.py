@@ -4,6 +4,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Sequence
 
+from . import save_figure
+
 
 def plot_sensitivity(rows: Sequence[dict[str, Any]], path: str | Path, title: str = "") -> Path:
     """rows: sensitivity.indices (metric, parameter, S1, S1_conf, ST, ST_conf)."""
@@ -29,8 +31,4 @@ def plot_sensitivity(rows: Sequence[dict[str, Any]], path: str | Path, title: st
     axes[0, 0].legend(fontsize="x-small")
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(plt, fig, path)

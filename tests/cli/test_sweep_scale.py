@@ -243,59 +243,33 @@ def test_progress_names_rate_and_failures_and_a_summary_line_ends_the_sweep(tmp_
     assert len(summary) == 1 and "1 failed; 3 of 3 on disk" in summary[0]
 
 
-def _start_cluster(tmp_path: Path, workers: int = 2):
-    sched_file = tmp_path / "scheduler.json"
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                               "--port", "0", "--no-dashboard", "--scheduler-file", str(sched_file)], env=_env(),
-                              cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    for _ in range(600):
-        if sched_file.is_file() and sched_file.stat().st_size:
-            break
-        time.sleep(0.1)
-    for _ in range(workers):
-        procs.append(subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", str(sched_file), "--nworkers",
-             "1", "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard"], env=_env(), cwd=tmp_path,
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-    return json.loads(sched_file.read_text())["address"], procs
-
-
 def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
     """A scheduler and 2 workers (with nannies) as processes; once 3 batches are on disk one worker process is
     killed (SIGKILL): its batch runs again elsewhere, and the table equals a serial run's."""
     from distributed import Client
+    from test_sweep import dask_processes
 
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:40", "--metric", "peak_M,final_omega", "--stop-time", "4",
             "--batch-size", "1", "--no-plot"]
     serial = _cli(*args, "--serial", "--out", str(tmp_path / "serial"), cwd=tmp_path)
     assert serial.returncode == 0
-    address, procs = _start_cluster(tmp_path)
     out = tmp_path / "dist"
     folder = out / "paper_fig6_sweep.parquet"
-    try:
-        with Client(address, timeout="60s") as client:
-            client.wait_for_workers(2, timeout=120)
-            pids = client.run(os.getpid)
-            sweep = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--scheduler", address, "--out",
-                                      str(out)], env=_env(), cwd=tmp_path, stdout=subprocess.PIPE,
-                                     stderr=subprocess.PIPE, text=True)
-            while sweep.poll() is None and len(list(folder.glob("part-*.parquet"))) < 3:
-                time.sleep(0.005)
-            os.kill(next(iter(pids.values())), signal.SIGKILL)
-            done_at_kill = len(list(folder.glob("part-*.parquet")))
-            stdout, stderr = sweep.communicate(timeout=600)
-        assert sweep.returncode == 0, stderr[-3000:]
-        assert done_at_kill < 40
-        assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "serial" / "paper_fig6_sweep.csv").read_text()
-        assert [r["case"] for r in _parquet_rows(folder)] == list(range(1, 41))
-    finally:
-        for proc in reversed(procs):
-            proc.terminate()
-        for proc in procs:
-            try:
-                proc.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                proc.kill()
+    with dask_processes(tmp_path) as address, Client(address, timeout="60s") as client:
+        pids = client.run(os.getpid)
+        assert len(pids) == 2
+        sweep = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--scheduler", address, "--out",
+                                  str(out)], env=_env(), cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                 text=True)
+        while sweep.poll() is None and len(list(folder.glob("part-*.parquet"))) < 3:
+            time.sleep(0.005)
+        os.kill(next(iter(pids.values())), signal.SIGKILL)
+        done_at_kill = len(list(folder.glob("part-*.parquet")))
+        _, stderr = sweep.communicate(timeout=600)
+    assert sweep.returncode == 0, stderr[-3000:]
+    assert done_at_kill < 40
+    assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "serial" / "paper_fig6_sweep.csv").read_text()
+    assert [r["case"] for r in _parquet_rows(folder)] == list(range(1, 41))
 
 
 def test_an_interrupted_serial_sweep_keeps_its_partial_batch_and_resumes_to_the_same_table(tmp_path):
