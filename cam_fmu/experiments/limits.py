@@ -4,7 +4,8 @@ MAX_STEPS bounds the communication steps (= output rows) of one run: `simulate` 
 output_interval), `cosim` (stop time / step size of the SSP or the options) and each sweep case. A row
 holds every output (about 20 doubles), so a run at the bound keeps about 200 MB of results.
 MAX_CASES bounds the cases of one `sweep` (the product of the --vary counts, a sample's N, a Saltelli design's
-N (d + 2)); a sweep's memory does not grow with it (experiments/sweep_run.py), its disk does (~50 bytes a case).
+N (d + 2)); a sweep's memory does not grow with it (experiments/sweep_run.py), its disk does (the Parquet
+bytes a case: `cam-fmu bench --sweep`).
 """
 from __future__ import annotations
 

@@ -11,7 +11,6 @@ values, ``status`` = "failed", ``message`` = the engine's (or FMU's) own reason 
 """
 from __future__ import annotations
 
-import contextlib
 import csv
 import math
 import os
@@ -26,24 +25,6 @@ from .sweep_cases import (Design, SweepError, Vary, cases, check_cases, check_de
                           parse_sample, parse_vary)
 
 ENGINES = ("engine", "fmu")
-
-
-@contextlib.contextmanager
-def sigint_ignored():
-    """SIGINT ignored while the block starts processes: they inherit the disposition (Python and asyncio install
-    no KeyboardInterrupt handler where SIGINT is ignored), so a Ctrl-C to the terminal's process group reaches only
-    this process, which stops the sweep; dask's worker processes print no traceback."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 # ------------------------------------------------------------------- metrics

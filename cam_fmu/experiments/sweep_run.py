@@ -16,7 +16,6 @@ worker (the last batches balance), at most MAX_BATCH cases.
 """
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import math
@@ -27,7 +26,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterator, Sequence
 
-from .sweep import Design, SweepError, header, run_batch, run_case, sigint_ignored
+from .interrupts import InterruptFlag, environment, quiet, sigint_ignored
+from .sweep import Design, SweepError, header, run_batch, run_case
 
 BATCH_SECONDS = 1.0  # s of work per batch
 MAX_BATCH = 50_000
@@ -212,33 +212,6 @@ def pilot_seconds(plan: Plan) -> float:
     return time.perf_counter() - t0
 
 
-class _InterruptFlag:
-    """SIGINT sets ``event`` instead of raising KeyboardInterrupt (in the main thread; elsewhere nothing changes);
-    ``restore`` puts the former handler back."""
-
-    def __init__(self) -> None:
-        import signal
-        import threading
-
-        self.event = threading.Event()
-        self.previous = None
-        if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, lambda signum, frame: self.event.set())
-
-    def is_set(self) -> bool:
-        return self.event.is_set()
-
-    def wait(self, seconds: float) -> None:
-        self.event.wait(seconds)
-
-    def restore(self) -> None:
-        import signal
-
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
-            self.previous = None
-
-
 def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler: str | None = None,
               serial: bool = False, resume: bool = False, overwrite: bool = False, batch_size: int | None = None,
               progress: Callable[[int, int, int], None] | None = None,
@@ -274,7 +247,7 @@ def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler
             interrupted = _distributed(plan, client, n_workers, folder, schema, todo, counts, n, progress)
     finally:
         if client is not None:
-            with sigint_ignored(), _quiet("distributed"):  # shutting down after an interrupt: no noise
+            with sigint_ignored(), quiet("distributed"):  # shutting down after an interrupt: no noise
                 client.close()
                 if cluster is not None:
                     cluster.close()
@@ -283,30 +256,38 @@ def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler
 
 
 def _serial(plan: Plan, folder: Path, schema, todo, counts: list, n: int, progress) -> bool:
+    """Batch after batch in this process; a Ctrl-C (KeyboardInterrupt) stops after writing the current batch's
+    finished cases, and one during a write waits for the write to end (a flag, not an exception)."""
     for start, stop in todo:
-        job = plan.job(start, stop)
-        names = list(job["values"])
-        columns: dict[str, list] = {"case": [], **{k: [] for k in names}, **{m: [] for m in plan.metrics},
-                                    "status": [], "message": []}
+        columns: dict[str, list] = {"case": []}
+        interrupted = False
         try:
+            job = plan.job(start, stop)
+            names = list(job["values"])
+            columns.update({k: [] for k in names}, **{m: [] for m in plan.metrics}, status=[], message=[])
             for k in range(stop - start):
                 case = {name: job["values"][name][k] for name in names}
                 row = run_case(plan.scene_ref, case, plan.metrics, plan.engine, plan.fmu, plan.stop_time)
-                columns["case"].append(start + k + 1)
                 for key in columns:
-                    if key != "case":
-                        columns[key].append(row[key])
+                    columns[key].append(start + k + 1 if key == "case" else row[key])
                 counts[1] += row["status"] == "failed"
                 counts[2] += 1
                 if progress:
                     progress(counts[0] + k + 1, n, counts[1])
         except KeyboardInterrupt:
+            interrupted = True
+            kept = min(len(values) for values in columns.values())  # a row cut short between two columns
+            for values in columns.values():
+                del values[kept:]
+        flag = InterruptFlag()
+        try:
             if columns["case"]:
                 _write_part(folder, schema, columns)
                 counts[0] += len(columns["case"])
+        finally:
+            flag.restore()
+        if interrupted or flag.is_set():
             return True
-        _write_part(folder, schema, columns)
-        counts[0] += stop - start
     return False
 
 
@@ -315,7 +296,7 @@ def _client(workers: int | None, scheduler: str | None):
 
     # The worker processes ignore a Ctrl-C to the process group (sigint_ignored) and log errors only: closing the
     # cluster after an interrupt cancels the batches they run, which each would report as a warning.
-    with sigint_ignored(), _environment(DASK_LOGGING__DISTRIBUTED="error"):
+    with sigint_ignored(), environment(DASK_LOGGING__DISTRIBUTED="error"):
         if scheduler:
             return Client(scheduler, timeout="30s"), None
         n = workers or os.cpu_count() or 1
@@ -345,7 +326,7 @@ def _distributed(plan: Plan, client, n_workers: int, folder: Path, schema, todo,
             return True
         return False
 
-    stop = _InterruptFlag()  # Ctrl-C sets a flag: a KeyboardInterrupt inside the client's calls left dask's
+    stop = InterruptFlag()  # Ctrl-C sets a flag: a KeyboardInterrupt inside the client's calls left dask's
     try:                      # event loop logging tracebacks (a cancelled sync, the workers' heartbeats)
         while in_flight < window and submit():
             pass
@@ -368,33 +349,3 @@ def _distributed(plan: Plan, client, n_workers: int, folder: Path, schema, todo,
         return True
     finally:
         stop.restore()
-
-
-@contextlib.contextmanager
-def _environment(**values: str):
-    """os.environ with ``values`` inside the block (what processes started there inherit)."""
-    saved = {name: os.environ.get(name) for name in values}
-    os.environ.update(values)
-    try:
-        yield
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
-
-
-@contextlib.contextmanager
-def _quiet(logger: str):
-    """The logger ``logger`` and its children silent below CRITICAL inside the block."""
-    import logging
-
-    log = logging.getLogger(logger)
-    level = log.level
-    log.setLevel(logging.CRITICAL)
-    try:
-        yield
-    finally:
-        log.setLevel(level)
-
