@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 CSV_MAX_CASES = 10_000  # a sweep up to this many cases also gets its CSV table and figure
@@ -112,6 +113,7 @@ def run(args) -> int:
     def started(where: str, batch: int, to_run: int) -> None:
         print(f"# {scene.name}: {n_cases} cases ({to_run} to run) on {where}, engine {engine}, batches of {batch}",
               file=sys.stderr)
+        bar.start = time.monotonic()  # the rate and the time left from here: the cluster is up
         bar(n_cases - to_run, n_cases, 0)
 
     summary = run_sweep(plan, out, args.workers, args.scheduler, args.serial, args.resume, args.overwrite,
