@@ -21,7 +21,7 @@ def test_sweep_benchmark_reports_engine_serial_cluster_and_memory(tmp_path):
     assert proc.returncode == 0, proc.stderr[-3000:]
     result = json.loads((tmp_path / "sweep_bench.json").read_text())
     assert result["cases"] == 60 and result["workers"] == 2
-    assert 0 < result["engine_s"] < result["engine_setup_s"]  # the scene's set-up costs on top of the run
+    assert 0 < result["engine_s"] < result["engine_setup_s"] and result["engine_cpu_s"] > 0  # the scene's set-up costs on top of the run
     serial, cluster = result["serial"], result["cluster"]
     assert serial["cases"] == 60 and serial["case_s"] > 0
     assert serial["overhead"] == pytest.approx(serial["case_s"] / result["engine_s"])
