@@ -28,10 +28,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder (default: out/bench)")
     p.add_argument("--fmu", type=Path, default=None,
                    help="FMU to measure (default: models/cam.fmu, rebuilt when older than its sources)")
+    p.add_argument("--sweep", type=int, nargs="?", const=100_000, default=None, metavar="N",
+                   help="instead: the sweep's benchmark, N cases of fig. 6 (default 100000) on a local cluster of "
+                        "--workers against the engine's own run (cam_fmu/tools/bench/sweep.py)")
+    p.add_argument("--workers", type=int, default=2, help="--sweep: local cluster workers (default 2)")
     return p
 
 
 def run(args) -> int:
+    if args.sweep is not None:  # its own arguments (cases, workers), not a run(ctx) of the registry
+        from ..tools.bench import sweep
+
+        return sweep.main([str(args.sweep), "--workers", str(args.workers), "--out", str(args.out)])
     from ..tools.bench import BENCHMARKS, DEFAULT, run as run_bench
 
     unknown = [name for name in args.names if name not in BENCHMARKS]

@@ -16,8 +16,10 @@ class ProgressBar:
         self.start = time.monotonic()
         self.last = 0.0
         self.open = False  # a line drawn and not yet finished with its newline
+        self.first: int | None = None  # units done at the first call
 
-    def __call__(self, done: int, total: int) -> None:
+    def __call__(self, done: int, total: int, failed: int | None = None) -> None:
+        """``failed``: failures so far (a sweep), shown with the rate [units/s] after the time left."""
         if not self.enabled:
             return
         now = time.monotonic()
@@ -27,9 +29,13 @@ class ProgressBar:
         frac = done / total if total else 1.0
         filled = int(round(self.width * frac))
         elapsed = now - self.start
-        eta = elapsed / frac - elapsed if frac > 0 else float("nan")
+        if self.first is None:  # what was done before this run (a resumed sweep): not in the rate
+            self.first = done
+        rate = (done - self.first) / elapsed if elapsed > 0 else 0.0
+        eta = (total - done) / rate if rate > 0 else (0.0 if done >= total else float("nan"))
         self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} "
-                          f"{elapsed:5.1f} s, {eta:5.1f} s left ")
+                          f"{elapsed:5.1f} s, {eta:5.1f} s left "
+                          + ("" if failed is None else f"{rate:,.0f}/s, {failed} failed "))
         self.open = done < total
         if not self.open:
             self.stream.write("\n")

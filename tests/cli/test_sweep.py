@@ -5,6 +5,7 @@ must be installed (the CI installs it): a missing dask fails these tests.
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
@@ -214,13 +215,16 @@ def test_local_cluster_equals_serial_bit_for_bit(cam_fmu_path, serial, tmp_path)
     assert _sweep(cam_fmu_path, tmp_path / "out", "--workers", "2") == serial
 
 
-def test_scheduler_and_workers_as_processes_equal_serial(cam_fmu_path, serial, tmp_path):
-    """A dask scheduler and 2 workers started as separate processes on loopback; always torn down."""
+@contextlib.contextmanager
+def dask_processes(tmp_path: Path, workers: int = 2):
+    """A dask scheduler and ``workers`` workers (one process each, with its nanny) started as separate processes
+    on loopback; yields the scheduler's address once the workers are up; always torn down."""
+    from distributed import Client
+
     sched_file = tmp_path / "scheduler.json"
-    dask = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
-    procs = [subprocess.Popen([*dask, "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                               "--scheduler-file", str(sched_file)], env=_env(), cwd=tmp_path,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                               "--port", "0", "--no-dashboard", "--scheduler-file", str(sched_file)], env=_env(),
+                              cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
     try:
         for _ in range(600):
             if sched_file.is_file() and sched_file.stat().st_size:
@@ -228,16 +232,15 @@ def test_scheduler_and_workers_as_processes_equal_serial(cam_fmu_path, serial, t
             time.sleep(0.1)
         address = json.loads(sched_file.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
-        for _ in range(2):
+        for _ in range(workers):
             procs.append(subprocess.Popen(
                 [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", str(sched_file),
                  "--nworkers", "1", "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard"],
                 env=_env(), cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
-        from distributed import Client
         with Client(address, timeout="60s") as client:
-            client.wait_for_workers(2, timeout=120)
-            assert len(client.scheduler_info()["workers"]) == 2
-        assert _sweep(cam_fmu_path, tmp_path / "out", "--scheduler", address) == serial
+            client.wait_for_workers(workers, timeout=120)
+            assert len(client.scheduler_info()["workers"]) == workers
+        yield address
     finally:
         for proc in reversed(procs):
             proc.terminate()
@@ -246,3 +249,9 @@ def test_scheduler_and_workers_as_processes_equal_serial(cam_fmu_path, serial, t
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 proc.kill()
+
+
+def test_scheduler_and_workers_as_processes_equal_serial(cam_fmu_path, serial, tmp_path):
+    """A dask scheduler and 2 workers started as separate processes on loopback; always torn down."""
+    with dask_processes(tmp_path) as address:
+        assert _sweep(cam_fmu_path, tmp_path / "out", "--scheduler", address) == serial
