@@ -116,9 +116,11 @@ def jump_speed(program, m: float, k: float, F0: float, F_gx: float = 0.0, f0: fl
         return contact_sign(0.0, s, s1, 0.0, 1.0, k, F0, F_gx, f0)
 
     weakest, theta_w = minimise_over_turn(held, program.breakpoints())
-    if weakest <= 0.0:
+    scale = abs(F0) + abs(F_gx) + f0 + k * abs(minimise_over_turn(lambda x: -program.derivatives(x)[0],
+                                                                  program.breakpoints())[0])
+    if weakest < -1e-12 * scale:  # below the rounding of F0 + k s at a stroke's end
         s, _, s2, _ = program.derivatives(theta_w)
-        return Jump(0.0, theta_w, s, s2, f"the closing force F0 + k s - F_gx (with friction) is {weakest:.6g} N <= 0 "
+        return Jump(0.0, theta_w, s, s2, f"the closing force F0 + k s - F_gx (with friction) is {weakest:.6g} N < 0 "
                                          f"at theta = {theta_w:.6g} rad: the follower is not held even at rest")
     if m == 0.0:
         return Jump(math.inf, math.nan, math.nan, math.nan, "a massless follower needs no force: it never jumps")
@@ -282,9 +284,10 @@ def impact(J_0: float, m: float, s1: float, omega: float, v: float, e: float) ->
 
 
 # ----------------------------------------------------------------------------- the follower in the speed drive
-# An impact whose rebound is slower than this [m/s] ends the bouncing: the follower stays on the flank (a plastic
-# impact). The bounces' flight times fall as e^n, so a sequence with e < 1 ends after finitely many (Zeno guard).
-ZENO_SPEED = 1e-7
+# A rebound that would rise less than this above the flank [m] ends the bouncing: the follower stays on the flank
+# (a plastic impact). The bounces' heights fall as e^2n, so a sequence with e < 1 ends after finitely many (Zeno
+# guard); 1 nm lies far above the reference's resolution of positions (atol 1e-13) and far below any clearance.
+ZENO_HEIGHT = 1e-9
 
 
 class SpeedFollower:
@@ -341,17 +344,26 @@ class SpeedFollower:
         s_cam = self.program.derivatives(theta)[0]
         return s - (s_cam - self.c), ((s_cam + self.c) - s) if self.two_sided else math.inf
 
+    def acceleration_scale(self, theta: float, omega: float, omega_dot: float) -> float:
+        """m/s2, a bound of the follower's acceleration relative to the flank near theta (flight against cam)."""
+        s, s1, s2, _ = self.flank(theta, 1.0)
+        return (abs(self.free_acceleration(s, 1.0)) + self.f0 / self.m + abs(s2) * omega * omega
+                + abs(s1 * omega_dot) + 1e-300)
+
     def land(self, theta: float, omega: float, omega_dot: float, v: float, contact: float) -> tuple[float, float, Impact]:
         """(contact after, v after [m/s], the impact) of a touch-down on the flank ``contact`` at theta.
 
-        The relative velocity w = v - s' omega becomes -e w; a rebound slower than ZENO_SPEED ends in
-        contact (plastic), where the flank holds the follower, else in flight at the flank's speed.
+        The relative velocity w = v - s' omega becomes -e w; a rebound that would rise less than ZENO_HEIGHT
+        (w^2 < 2 A ZENO_HEIGHT, A = ``acceleration_scale``) ends in contact (plastic) where the flank holds the
+        follower (a force of exactly 0 counts as held: the lift-off event, located from there, decides), else in
+        flight at the flank's speed.
         """
         s1 = self.program.derivatives(theta)[1]
         hit = impact(math.inf, self.m, s1, omega, v, self.e)
-        if abs(hit.v - s1 * omega) >= ZENO_SPEED:
+        w = hit.v - s1 * omega
+        if w * w >= 2.0 * self.acceleration_scale(theta, omega, omega_dot) * ZENO_HEIGHT:
             return 0.0, hit.v, hit
-        stay = contact if self.held(theta, omega, omega_dot, contact) > 0.0 else 0.0
+        stay = contact if self.held(theta, omega, omega_dot, contact) >= 0.0 else 0.0  # a tie: the events decide
         return stay, s1 * omega, impact(math.inf, self.m, s1, omega, v, 0.0)
 
     def outputs(self, theta: float, omega: float, omega_dot: float, s: float, v: float, contact: float) -> dict:

@@ -20,6 +20,10 @@ from ..physics.follower import SpeedFollower
 # Events at one instant in a row before the run is refused (each transition changes the mode; a cycle means
 # a model error, never a hang).
 MAX_STALL = 1000
+# m: a touch-down is located where the gap reaches -TOUCH (1 pm), and the follower is then set on the flank. Just
+# after a lift-off the gap grows as t^3 (gap, its rate and its acceleration are all 0 there), so a gap of exactly 0
+# would meet the integration's rounding (atol 1e-13 m) and land the follower again at once, without end.
+TOUCH = 1e-12
 
 
 class FollowerRun:
@@ -30,6 +34,9 @@ class FollowerRun:
         self.omega_ref = omega_ref
         self.rtol, self.atol = rtol, atol
         self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
+        # s: a time shorter than the flight the last rebound starts, or 0. A step of the integrator holding the whole
+        # bounce would see the gap <= 0 at its end and locate the touch-down at its start, where the gap is 0.
+        self.rebound = 0.0
 
     def _speed(self, t: float) -> tuple[float, float]:
         return self.omega_ref.value(t), self.omega_ref.slope(t)
@@ -38,7 +45,7 @@ class FollowerRun:
         """The mode at the start: on the +1 flank if it holds the follower, else on -1 (groove), else flying."""
         omega, omega_dot = self._speed(t)
         for contact in (1.0, -1.0) if self.body.two_sided else (1.0,):
-            if self.body.held(theta, omega, omega_dot, contact) > 0.0:
+            if self.body.held(theta, omega, omega_dot, contact) >= 0.0:
                 return contact
         return 0.0
 
@@ -63,8 +70,13 @@ class FollowerRun:
             t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
             sigma = self._direction(y)
             events = self._events(contact, sigma)
+            steps = {}
+            if self.rebound > 0.0:  # the first piece after a rebound is shorter than the bounce it starts
+                t_end = min(t_end, t + self.rebound)
+                steps = {"max_step": self.rebound / 8.0}
+                self.rebound = 0.0
             sol = solve_ivp(self._rhs(contact, sigma), (t, t_end), y, method="DOP853", rtol=self.rtol,
-                            atol=self.atol, events=events, dense_output=True)
+                            atol=self.atol, events=events, dense_output=True, **steps)
             if sol.status < 0:
                 raise RuntimeError(f"follower reference: {sol.message}")
             t_new = float(sol.t[-1])
@@ -122,9 +134,9 @@ class FollowerRun:
         if contact != 0.0:
             add("lift-off", lambda t, y: body.held(y[0], omega_ref.value(t), omega_ref.slope(t), contact))
             return events
-        add("touch-down +1", lambda t, y: body.gaps(y[0], y[1])[0])
+        add("touch-down +1", lambda t, y: body.gaps(y[0], y[1])[0] + TOUCH)
         if body.two_sided:
-            add("touch-down -1", lambda t, y: body.gaps(y[0], y[1])[1])
+            add("touch-down -1", lambda t, y: body.gaps(y[0], y[1])[1] + TOUCH)
         if body.f0 > 0.0 and sigma != 0.0:  # the friction's direction turns where v does
             add("halt", lambda t, y: sigma * y[2])
         return events
@@ -140,14 +152,18 @@ class FollowerRun:
         flank = 1.0 if kind == "touch-down +1" else -1.0
         s, s1, _, _ = body.flank(y[0], flank)
         after, v, hit = body.land(y[0], omega, omega_dot, y[2], flank)
-        self.impacts.append((t, y[2] - s1 * omega, v - s1 * omega))
+        w = v - s1 * omega
+        self.impacts.append((t, y[2] - s1 * omega, w))
+        if after == 0.0 and w != 0.0:
+            # the relative acceleration is at most A near here: the gap stays > 0 for about 2 |w| / A
+            self.rebound = abs(w) / (2.0 * body.acceleration_scale(y[0], omega, omega_dot))
         return after, [y[0], s, v]
 
     def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
-        """Apply at once a lift-off whose function is already <= 0 (s'' jumped at a breakpoint or the input did)."""
+        """Apply at once a lift-off whose function is already < 0 (s'' jumped at a breakpoint or the input did)."""
         if contact != 0.0:
             omega, omega_dot = self._speed(t)
-            if self.body.held(y[0], omega, omega_dot, contact) <= 0.0:
+            if self.body.held(y[0], omega, omega_dot, contact) < 0.0:
                 return self._transition(t, y, contact, "lift-off")
             s, s1, _, _ = self.body.flank(y[0], contact)
             return contact, [y[0], s, s1 * omega]
