@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
+from .parameters import FOLLOWER_DRIVES, RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
 
 
 def sign(x: float) -> float:
@@ -96,7 +96,7 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
     if not (p["m"] > 0.0 and p["follower_inertia"]):
         raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure {closure!r} moves the follower as a body of its "
                              "own, which needs its mass; allowed with it: m > 0 and follower_inertia true")
-    if p["drive"] != "speed":
+    if p["drive"] not in FOLLOWER_DRIVES:
         raise ParameterError(f"parameter 'closure' = {closure!r}: the follower's own motion is computed with the "
                              "speed drive only (its impacts on a voltage-driven cam are not in the reference yet); "
                              "allowed with drive 'voltage': closure 'kinematic'")

@@ -154,6 +154,7 @@ _SOLVER = (
 # How the follower is held on the cam (docs/model.md section 13). 'kinematic' is today's rule: a two-sided
 # groove whose follower rests in the clearance c until a flank takes it along (the paper's eqs. 6-8).
 CLOSURES = ("kinematic", "form", "spring")
+FOLLOWER_DRIVES = ("speed",)  # the drives whose reference computes closures 'form' and 'spring' (docs/model.md 13)
 # The follower as a body of its own: the scipy reference computes it (speed drive); the C engine does not yet,
 # so these rows are not in PARAMETERS (the engine's and the FMUs' table) and the engine refuses them by name.
 FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (

@@ -15,7 +15,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..experiments.signals import Signal
-from ..physics.follower import SpeedFollower
+from ..physics.speed_follower import SpeedFollower
 
 # Events at one instant in a row before the run is refused (each transition changes the mode; a cycle means
 # a model error, never a hang).

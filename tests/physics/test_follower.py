@@ -183,7 +183,7 @@ def test_reference_flight_is_the_closed_form_until_touch_down():
     first = flying[0] - 1  # the last row in contact; lift-off lies between it and the first flying row
     flight = Flight(model.m, model.k_spring, model.F_spring0, model.F_gx, model.mu * (abs(model.G_y) + model.N_g))
     # the lift-off instant: where the flank's force reaches 0 (root by bisection on the contact rows' physics)
-    from cam_fmu.physics.follower import SpeedFollower
+    from cam_fmu.physics.speed_follower import SpeedFollower
     body = SpeedFollower(model)
     lo, hi = result["time"][first], result["time"][first + 1]
     for _ in range(200):
