@@ -21,9 +21,10 @@ import math
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
+from ..kinematics.motion_law import golden_max
+
 # Samples per smooth piece of the program before the golden-section refinement of the jump search.
 SAMPLES = 400
-GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 def closing_force(s: float, k: float, F0: float, F_gx: float = 0.0) -> float:
@@ -65,22 +66,6 @@ def _pieces(breakpoints: Sequence[float]) -> list[tuple[float, float]]:
     return [(a, b) for a, b in zip(cuts[:-1], cuts[1:]) if b - a > 1e-12]
 
 
-def _golden_min(fn: Callable[[float], float], a: float, b: float, tol: float = 1e-13) -> float:
-    """The argument of the minimum of fn on [a, b] (a unimodal bracket) by golden section."""
-    c, d = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
-    fc, fd = fn(c), fn(d)
-    while b - a > tol * max(1.0, abs(a) + abs(b)):
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - GOLDEN * (b - a)
-            fc = fn(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + GOLDEN * (b - a)
-            fd = fn(d)
-    return 0.5 * (a + b)
-
-
 def minimise_over_turn(fn: Callable[[float], float], breakpoints: Sequence[float],
                        samples: int = SAMPLES) -> tuple[float, float]:
     """(min value, theta) of fn over one turn: each smooth piece sampled, its best bracket refined.
@@ -94,7 +79,7 @@ def minimise_over_turn(fn: Callable[[float], float], breakpoints: Sequence[float
         xs = [lo + (hi - lo) * j / samples for j in range(samples + 1)]
         ys = [fn(x) for x in xs]
         j = min(range(len(ys)), key=ys.__getitem__)
-        x = _golden_min(fn, xs[max(j - 1, 0)], xs[min(j + 1, samples)])
+        x, _ = golden_max(lambda theta: -fn(theta), xs[max(j - 1, 0)], xs[min(j + 1, samples)])
         for cand in (x, xs[j]):
             y = fn(cand)
             if y < best[0]:
