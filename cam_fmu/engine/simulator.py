@@ -23,13 +23,13 @@ __all__ = ["DriveSimulator", "run_scene"]
 N_OUTPUTS = len(OUTPUT_NAMES)
 MESSAGE_LEN = 1024
 NX, NX_RIGID = 5, 3  # cam_model.h CAM_NX, CAM_NX_RIGID: the state slots (theta, omega, i, twist, omega_m)
-# Slots of the engine's state array (cam_model.h, CAM_S_*).
+# Slots of the engine's state array (cam_drive.h, CAM_S_*).
 (S_VERSION, S_FORMULATION, S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF, S_H_NEXT, S_STEPS_TAKEN, S_X) = range(9)
 S_STUCK = S_X + 5  # CAM_NX slots
 S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE, S_FORM_U, S_HAVE_BUDGET = range(S_STUCK + 1, S_STUCK + 7)
 S_BUDGET = S_HAVE_BUDGET + 1  # work_in, work_abs, theta, i, e_mech0, e_mag0
 BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
-STATE_VERSION = 2.0  # cam_model.h CAM_STATE_VERSION
+STATE_VERSION = 2.0  # cam_drive.h CAM_STATE_VERSION
 
 
 from ..physics.formulations.consistent import EVENT_NAMES  # noqa: E402  (cam_model.h CAM_EV_*, in order)
@@ -43,7 +43,7 @@ class CamMode(ctypes.Structure):
 
 
 class CamEventRecord(ctypes.Structure):
-    """cam_model.h CamEventRecord: one transition of the consistent formulation."""
+    """cam_drive.h CamEventRecord: one transition of the consistent formulation."""
 
     _fields_ = [("code", ctypes.c_int), ("time", ctypes.c_double), ("x_before", ctypes.c_double * NX),
                 ("x_after", ctypes.c_double * NX), ("mode_before", CamMode)]
@@ -210,7 +210,7 @@ class DriveSimulator:
         self.__init__(self._params, self._start_time)
 
     def state_array(self) -> array:
-        """The engine's whole state as its flat array of doubles (cam_model.h, CAM_S_*)."""
+        """The engine's whole state as its flat array of doubles (cam_drive.h, CAM_S_*)."""
         raw = (ctypes.c_double * self._lib.cam_state_len())()
         self._lib.cam_drive_get_state(self._drive, raw)
         return array("d", raw)

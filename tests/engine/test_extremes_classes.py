@@ -264,7 +264,7 @@ def scenario_fmi(fmu):
     out["exit2_theta_kept"] = m.outputs()[1] == theta
     # 9: a state blob with omega = NaN, one cut short and one of another format are refused before anything is
     # restored. The blob (cam_fmu/engine/csrc/fmi/instance.c): a 24-byte header, the start time, the inputs,
-    # the parameters, the drive's 48-double state (cam_model.h CAM_S_*: omega is slot CAM_S_X + 1 = 9), and
+    # the parameters, the drive's 48-double state (cam_drive.h CAM_S_*: omega is slot CAM_S_X + 1 = 9), and
     # the motion table's text (none here); the serialised form adds a 16-byte header before and a CRC-32 after
     # (csrc/fmi/checksum.h), resealed here so that the entry's own check is what refuses the NaN.
     import math

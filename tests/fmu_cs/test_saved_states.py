@@ -27,7 +27,7 @@ def _reseal(blob: bytearray) -> bytes:
 
 
 def _edit_slot(blob: bytes, slot: int, value: float) -> bytes:
-    """The serialised state with the drive's state slot ``slot`` (cam_model.h CAM_S_*) set to ``value``, resealed."""
+    """The serialised state with the drive's state slot ``slot`` (cam_drive.h CAM_S_*) set to ``value``, resealed."""
     edited = bytearray(blob)
     struct.pack_into("<d", edited, len(blob) - 4 - 8 * STATE_LEN + 8 * slot, value)
     return _reseal(edited)

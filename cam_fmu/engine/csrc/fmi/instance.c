@@ -1,6 +1,6 @@
 /* One cam drive as an FMI host sees it (cam_instance.h): the parameters and inputs a host sets,
  * the drive built from them at initialisation, outputs before and after it, and the saved state
- * with the parameters in it. Holds no physics: everything is cam_model.h's CamDrive. */
+ * with the parameters in it. Holds no physics: everything is cam_drive.h's CamDrive. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>

@@ -7,7 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 static int set(CamParams *p, const char *name, double value, CamError *err)
 {

@@ -1,6 +1,6 @@
 /* One cam drive as an FMI host sees it: variables by value reference, initialisation,
  * communication steps, outputs, and the saved state (parameters included). The FMI glues
- * (csrc/fmi/) call only these functions; the drive behind them is cam_model.h's CamInstance.
+ * (csrc/fmi/) call only these functions; the drive behind them is cam_drive.h's CamDrive.
  *
  * Value references are those of the generated table (cam_params.h, generated from
  * cam_fmu/physics/parameters.py and variables.py): the inputs, then the outputs, then the
@@ -16,7 +16,7 @@
 
 #include <stddef.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 typedef struct CamInstance CamInstance;
 

@@ -21,7 +21,7 @@
 #ifndef CAM_SOLVER_H
 #define CAM_SOLVER_H
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 #define CAM_MAX_STAGES 7
 

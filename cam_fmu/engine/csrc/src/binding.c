@@ -1,5 +1,5 @@
 /* Accessors for bindings that hold the engine's structures as opaque memory (the ctypes binding). */
-#include "cam_model.h"
+#include "cam_drive.h"
 
 size_t cam_params_sizeof(void)
 {

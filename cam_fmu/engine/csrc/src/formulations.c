@@ -2,7 +2,7 @@
  * own file (consistent.c, paper.c, speed.c). */
 #include <stddef.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 const CamFormulation *cam_formulation(CamFormulationId id)
 {

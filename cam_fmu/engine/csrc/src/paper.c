@@ -11,7 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 static double sign(double x)
 {

@@ -6,7 +6,7 @@
  * not vanish with a clearance. */
 #include <math.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 #define TWO_PI (2.0 * 3.141592653589793)
 

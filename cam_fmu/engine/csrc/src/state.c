@@ -1,10 +1,10 @@
-/* The drive's state as a flat, versioned array of doubles (the CAM_S_* slots of cam_model.h), and its
+/* The drive's state as a flat, versioned array of doubles (the CAM_S_* slots of cam_drive.h), and its
  * restoration with every entry checked before use (DriveSimulator.get_state/set_state in engine/simulator.py). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "cam_model.h"
+#include "cam_drive.h"
 
 void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
 {

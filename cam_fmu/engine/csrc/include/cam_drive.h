@@ -1,0 +1,151 @@
+/* The cam drive: the model of cam_model.h stepped from one communication point to the next
+ * (Python: engine/simulator.py DriveSimulator).
+ *
+ * Three formulations (docs/model.md sections 5-8) share the model contract through
+ * a table of functions each (``CamFormulation``, like the Python
+ * ``physics.formulations.base.Formulation``): the consistent one is an ODE with
+ * events advanced by the solvers of cam_solver.h; the paper's algorithm is a
+ * fixed-step discrete scheme and the speed drive imposes omega, so both provide
+ * their own ``advance``. Here too: the drive's state (its formulations' states, the
+ * solver's carried step, the event log), its flat saved state (CAM_S_*), and the
+ * accessors for bindings that hold the structures as opaque memory (ctypes).
+ *
+ * C99, libc and libm only, no globals; errors as cam_model.h's CamError.
+ */
+#ifndef CAM_DRIVE_H
+#define CAM_DRIVE_H
+
+#include <stddef.h>
+
+#include "cam_model.h"
+
+struct CamDrive;
+
+/* One formulation: how the drive's state advances over one communication step. */
+typedef struct {
+    const char *name;
+    int energy_bounded;         /* a voltage drive: its states respect the energy bound */
+    /* set up the formulation's state from the parameters at the start inputs */
+    int (*init)(struct CamDrive *d, CamError *err);
+    /* inputs held from now on (may re-decide stick/slip) */
+    void (*set_inputs)(struct CamDrive *d, double u, double omega_ref, double omega_dot_ref);
+    /* advance by h [s] from time [s]; the steps taken into *steps; on error the state as before */
+    int (*advance)(struct CamDrive *d, double h, double time, long *steps, CamError *err);
+    /* every output at the current state */
+    void (*outputs)(struct CamDrive *d, double out[]);
+    /* the advice named in the guard messages ("reduce h_max ...") into buf */
+    void (*advice)(const struct CamDrive *d, char *buf, size_t len);
+} CamFormulation;
+
+/* The formulation of an id (formulations.c), or NULL; each is const data in its own file. */
+const CamFormulation *cam_formulation(CamFormulationId id);
+extern const CamFormulation cam_consistent;   /* consistent.c */
+extern const CamFormulation cam_paper;        /* paper.c */
+extern const CamFormulation cam_speed;        /* speed.c */
+
+/* The fixed-step paper scheme's state (paper.PaperScheme: FIELDS and M_l), in SI units. */
+typedef struct {
+    double theta, omega, i, J, M, s, v, a, alpha, voltage, M_l;
+} CamPaperState;
+
+/* The speed drive's state. */
+typedef struct {
+    double theta, s, speed;     /* rad, m, rad/s */
+} CamSpeedState;
+
+/* The solver's carried state (rk45: step size and first-same-as-last derivative). */
+typedef struct {
+    double h_next;              /* s: the next trial step of an adaptive method */
+    int k1_valid;               /* k1 holds f(x) under fsal_u and the mode */
+    double k1[CAM_NX];
+    double fsal_u;
+} CamSolverState;
+
+/* One transition of the consistent formulation, as the event log keeps it (for diagnostics and tests:
+ * the impacts' momentum, where contacts were found). Not part of the saved state. */
+typedef struct {
+    int code;                   /* CAM_EV_* */
+    double time;                /* s */
+    double x_before[CAM_NX], x_after[CAM_NX];
+    CamMode mode_before;
+} CamEventRecord;
+
+#define CAM_EVENT_LOG 256       /* the last this many transitions are kept */
+
+/* One cam drive stepped from one communication point to the next (Python: engine/simulator.py DriveSimulator). */
+typedef struct CamDrive {
+    CamModel model;
+    const CamFormulation *form;
+    double x[CAM_NX];
+    CamMode mode;
+    CamSolverState solver;
+    CamPaperState paper;
+    CamSpeedState speed;
+    double time;                /* s */
+    double start_time;          /* s: where the drive started (0; an FMU's start time); a state is never before it */
+    double u, omega_ref, omega_dot_ref;
+    double form_u;              /* the input the formulation has settled for */
+    long steps_taken;           /* internal steps, for benchmarks */
+    long last_steps;            /* of the last step */
+    int have_budget;
+    CamEnergy budget;
+    double values[CAM_N_OUTPUTS];   /* the published outputs */
+    int stale;                  /* values not yet computed for the current state */
+    long events_logged;         /* transitions since the drive was built (the log keeps the last CAM_EVENT_LOG) */
+    CamEventRecord event_log[CAM_EVENT_LOG];
+} CamDrive;
+
+/* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */
+int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err);
+/* Start the drive's clock at t0 [s] (finite, |t0| <= 1e15) instead of 0; only before its first step. */
+int cam_drive_set_start_time(CamDrive *d, double t0, CamError *err);
+void cam_drive_free(CamDrive *d);
+/* Inputs used by outputs before the first step; out of range: an error naming the input. */
+int cam_drive_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref, CamError *err);
+/* Advance from t to t + h with the inputs held (FMI co-simulation); the outputs in d->values only
+ * once every check passed; on CAM_ERR_REJECTED the state is as before the step. t must be where the drive
+ * is, to within CAM_TIME_SLACK (fmi2DoStep's rule: the rounding of a host's summed steps). */
+#define CAM_TIME_SLACK(t) (1e-9 * (fabs(t) > 1.0 ? fabs(t) : 1.0))
+int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_ref, double omega_dot_ref,
+                      CamError *err);
+/* The current outputs (computed once per state). */
+const double *cam_drive_outputs(CamDrive *d);
+
+/* The whole state as doubles (CAM_STATE_LEN of them): versioned layout, the CAM_S_* slots. */
+enum { CAM_S_VERSION = 0, CAM_S_FORMULATION, CAM_S_TIME, CAM_S_U, CAM_S_OMEGA_REF, CAM_S_OMEGA_DOT_REF,
+       CAM_S_H_NEXT, CAM_S_STEPS_TAKEN, CAM_S_X /* CAM_NX slots */, CAM_S_STUCK = CAM_S_X + CAM_NX, CAM_S_DIRECTION,
+       CAM_S_CONTACT, CAM_S_S_FREE, CAM_S_SIDE, CAM_S_FORM_U, CAM_S_HAVE_BUDGET,
+       CAM_S_WORK_IN, CAM_S_WORK_ABS, CAM_S_BUDGET_THETA, CAM_S_BUDGET_I, CAM_S_E_MECH0, CAM_S_E_MAG0,
+       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 3 slots */,
+       CAM_S_END = CAM_S_SPEED + 3 };
+#define CAM_STATE_VERSION 2.0   /* 2: the compliant shaft's two slots in x */
+#define CAM_STATE_LEN 48          /* CAM_S_END rounded up: room for slots a later version adds */
+typedef char cam_state_len_covers_the_layout[CAM_S_END <= CAM_STATE_LEN ? 1 : -1];
+/* CAM_STATE_LEN, for bindings (engine/simulator.py reads it rather than repeating the number). */
+size_t cam_state_len(void);
+void cam_drive_get_state(const CamDrive *d, double state[CAM_STATE_LEN]);
+/* Restore; every entry checked (finite, a valid mode) before use, the message naming what is wrong. */
+int cam_drive_set_state(CamDrive *d, const double state[CAM_STATE_LEN], CamError *err);
+
+/* A whole scene in one call: n_steps communication steps, step k from table[5 k .. 5 k + 4] =
+ * (t [s], h [s], u [V], omega_ref [rad/s], omega_dot_ref [rad/s2]), the outputs after step k written to
+ * out[CAM_N_OUTPUTS k ..]. Returns the status of the first failing step (*done: the steps completed). */
+int cam_drive_run(CamDrive *d, long n_steps, const double *table, double *out, long *done, CamError *err);
+
+/* For bindings that hold the structures as opaque memory (ctypes): their sizes, and the drive's fields. */
+/* The k-th transition of the log, k counted from the first ever (events_logged - CAM_EVENT_LOG <= k <
+ * events_logged), or NULL when it is no longer (or not yet) kept. */
+const CamEventRecord *cam_drive_event(const CamDrive *d, long k);
+long cam_drive_events_logged(const CamDrive *d);
+size_t cam_event_record_sizeof(void);
+
+size_t cam_params_sizeof(void);
+size_t cam_drive_sizeof(void);
+size_t cam_model_sizeof(void);
+double cam_drive_time(const CamDrive *d);
+long cam_drive_steps_taken(const CamDrive *d);
+long cam_drive_last_steps(const CamDrive *d);
+int cam_drive_nx(const CamDrive *d);
+double *cam_drive_values(CamDrive *d);   /* the published outputs (CAM_N_OUTPUTS), valid while d lives */
+
+#endif
