@@ -124,5 +124,5 @@ class SpeedFollower:
             voltage += model.L * omega * (load(theta + d)[0] - load(theta - d)[0]) / (2 * d) / model.c_m
         record = output_record(omega=omega, theta=theta, s=s, i=i, M=M, J=J, v=v, a=a, alpha=math.atan(tan_a),
                                s_cam=s_cam, voltage=voltage, theta_m=theta, omega_m=omega, M_shaft=0.0)
-        record.update(N_contact=N, contact=contact)
+        record.update(N_contact=N, contact=contact)   # variables.FOLLOWER_COLUMNS, with impacts (the reference's count)
         return record

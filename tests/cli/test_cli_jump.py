@@ -110,3 +110,9 @@ def test_the_fmu_runner_refuses_what_only_the_reference_computes():
     assert "spring_jump" not in scene_names(fmu=True) and "paper_fig6" in scene_names(fmu=True)
     with pytest.raises(EngineError, match="scipy reference only"):
         run_scene(find_scene("spring_bounce"), "fmu")
+
+
+def test_the_reference_columns_have_units():
+    from cam_fmu.experiments.columns import header
+
+    assert header("N_contact") == "N_contact [N]" and header("impacts") == "impacts [1]"
