@@ -14,7 +14,7 @@ from array import array
 from typing import Any, Mapping, Sequence
 
 from ..errors import SimulationError, StepRejected
-from ..physics.parameters import BY_NAME, FOLLOWER_PARAMETERS, ParameterError
+from ..physics.parameters import BY_NAME, ParameterError
 from ..physics.variables import INPUT_STARTS, OUTPUT_NAMES
 from .library import load
 
@@ -99,9 +99,6 @@ def engine() -> ctypes.CDLL:
     return lib
 
 
-FOLLOWER_NAMES = frozenset(p.name for p in FOLLOWER_PARAMETERS)
-
-
 def raise_for(error: CamError) -> None:
     """The exception of the engine's error status, with its message."""
     message = error.message.decode("utf-8", "replace")
@@ -115,13 +112,6 @@ def raise_for(error: CamError) -> None:
 
 
 def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any, err: CamError) -> None:
-    if name in FOLLOWER_NAMES:  # the follower's own motion: in the scipy reference only (docs/model.md 13)
-        spec = BY_NAME[name]
-        if spec.check(value) == spec.default:
-            return  # today's kinematic follower, which the engine computes
-        raise ParameterError(f"parameter {name!r} = {value!r}: the follower as a body of its own (closures 'form' "
-                             "and 'spring', docs/model.md section 13) is computed by the scipy reference only; "
-                             f"the C engine and the FMUs do not have it yet (allowed here: {spec.default!r})")
     index = lib.cam_param_index(name.encode())
     if index < 0:
         lib.cam_params_unknown(name.encode(), ctypes.byref(err))

@@ -51,11 +51,6 @@ def run_scene(scene: Scene, engine: str = "reference", fmu_path: str | Path | No
             if progress is not None:
                 progress(k, total)
         return results
-    for run in scene.runs:
-        if run.params["closure"] != "kinematic":
-            raise EngineError(f"scene {scene.name!r}, run {run.label!r}: closure {run.params['closure']!r} (the "
-                              "follower as a body of its own, docs/model.md section 13) is computed by the scipy "
-                              "reference only; cam.fmu does not have it yet (use --engine reference)")
     try:
         fmu = ensure_fmu(fmu_path)
     except FmuFileError as exc:

@@ -98,7 +98,7 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
                              "own, which needs its mass; allowed with it: m > 0 and follower_inertia true")
     if p["drive"] not in FOLLOWER_DRIVES:
         raise ParameterError(f"parameter 'closure' = {closure!r}: the follower's own motion is computed with the "
-                             "speed drive only (its impacts on a voltage-driven cam are not in the reference yet); "
+                             "speed drive only (its impacts on a voltage-driven cam are not modelled yet); "
                              "allowed with drive 'voltage': closure 'kinematic'")
 
 

@@ -155,25 +155,24 @@ _SOLVER = (
 # groove whose follower rests in the clearance c until a flank takes it along (the paper's eqs. 6-8).
 CLOSURES = ("kinematic", "form", "spring")
 FOLLOWER_DRIVES = ("speed",)  # the drives whose reference computes closures 'form' and 'spring' (docs/model.md 13)
-# The follower as a body of its own: the scipy reference computes it (speed drive); the C engine does not yet,
-# so these rows are not in PARAMETERS (the engine's and the FMUs' table) and the engine refuses them by name.
+# The follower as a body of its own (the speed drive computes closures 'form' and 'spring'; docs/model.md 13).
 FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("closure", "", "kinematic", "how the follower is held: 'kinematic' (groove; rests in the clearance c, paper "
        "eqs. 6-8), 'form' (groove; flies across the clearance c under gravity and friction), 'spring' (one flank and "
-       "a return spring k_spring, F_spring0; c = 0). 'form' and 'spring': scipy reference, speed drive only",
+       "a return spring k_spring, F_spring0; c = 0). 'form' and 'spring': speed drive only",
        kind="string", choices=CLOSURES),
     _P("k_spring", "N/m", 0.0, "rate of the return spring (closure 'spring')", low=0.0, high=1e9),
     _P("F_spring0", "N", 0.0, "preload of the return spring at s = 0 (closure 'spring')", low=0.0, high=1e6),
     _P("restitution", "1", 0.0, "coefficient of restitution of the follower's impacts on the cam (closures 'form' and "
        "'spring'; 0: plastic, 1: elastic)", low=0.0, high=1.0),
 )
-PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER
-BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS + FOLLOWER_PARAMETERS}
+PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS
+BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
 
 
 def defaults() -> dict[str, Any]:
     """All parameters at their default values."""
-    return {p.name: p.default for p in PARAMETERS + FOLLOWER_PARAMETERS}
+    return {p.name: p.default for p in PARAMETERS}
 
 
 def resolve(overrides: Mapping[str, Any] | None = None) -> dict[str, Any]:
@@ -207,7 +206,7 @@ def law_spec(values: Mapping[str, Any], stroke: str) -> str | tuple[float, ...]:
 def markdown_table() -> str:
     """The docs' parameter table (name, unit, default, allowed, meaning), generated from PARAMETERS."""
     lines = ["| name | unit | default | allowed | description |", "|---|---|---|---|---|"]
-    for p in PARAMETERS + FOLLOWER_PARAMETERS:
+    for p in PARAMETERS:
         if p.kind == "real":
             default = f"{p.default:.6g}"
         elif p.kind == "boolean":
