@@ -89,12 +89,6 @@ class Scene:
     def primary(self) -> Run:
         return self.runs[0]
 
-    @property
-    def on_fmu(self) -> bool:
-        """Does cam.fmu compute every run? Not a follower that can leave the cam (closures 'form' and 'spring',
-        docs/model.md section 13), which the scipy reference alone computes so far."""
-        return all(run.params["closure"] == "kinematic" for run in self.runs)
-
     def with_stop_time(self, stop_time: float) -> "Scene":
         """The same scene over a different duration (e.g. shortened for tests)."""
         from dataclasses import replace
@@ -270,10 +264,9 @@ def scene_files(directory: str | Path = SCENE_DIR) -> list[Path]:
     return sorted(Path(directory).glob("*.toml"))
 
 
-def scene_names(fmu: bool = False) -> list[str]:
-    """Names of the shipped scenes (``fmu``: only those cam.fmu computes, ``Scene.on_fmu``)."""
-    names = [path.stem for path in scene_files()]
-    return [name for name in names if load_scene(SCENE_DIR / f"{name}.toml").on_fmu] if fmu else names
+def scene_names() -> list[str]:
+    """Names of the shipped scenes."""
+    return [path.stem for path in scene_files()]
 
 
 def find_scene(name_or_path: str | Path) -> Scene:

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cam_fmu.experiments.runner import EngineError, run_scene
-from cam_fmu.experiments.scenes import find_scene, scene_names
+from cam_fmu.experiments.runner import run_scene
+from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.follower import jump_speed
 
@@ -63,7 +63,6 @@ def test_jump_prints_its_results(tmp_path):
     (["jump", "spring_jump", "--rpm", "-3"], "--rpm -3"),
     (["reflect", "spring_jump"], "use cam-fmu jump"),
     (["bode", "paper_fig6", "--set", "closure=spring"], "no small-signal model"),
-    (["simulate", "spring_jump", "--engine", "fmu"], "scipy reference only"),
 ])
 def test_refusals_say_why(args, message, tmp_path):
     done = cli(*args, "--out", str(tmp_path), cwd=tmp_path)
@@ -104,12 +103,6 @@ def test_bounce_and_crossover_scenes_show_their_effect():
     decelerating = (form["theta"][1:] > math.pi / 2) & (form["theta"][1:] < math.pi)
     smooth = np.max(np.abs(np.diff(kinematic["v"]))[decelerating])
     assert np.max(np.abs(np.diff(form["v"]))[decelerating]) > 0.1 > 50 * smooth > 0.0
-
-
-def test_the_fmu_runner_refuses_what_only_the_reference_computes():
-    assert "spring_jump" not in scene_names(fmu=True) and "paper_fig6" in scene_names(fmu=True)
-    with pytest.raises(EngineError, match="scipy reference only"):
-        run_scene(find_scene("spring_bounce"), "fmu")
 
 
 def test_the_reference_columns_have_units():

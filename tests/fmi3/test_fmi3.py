@@ -63,7 +63,7 @@ def test_the_fmpy_command_line_simulates_it(cam3, tmp_path):
     assert rows["time"][-1] == pytest.approx(2.0) and 13.0 < rows["theta"][-1] < 13.5  # fig. 6: 2.1 turns
 
 
-@pytest.mark.parametrize("name", scene_names(fmu=True))
+@pytest.mark.parametrize("name", scene_names())
 def test_it_agrees_with_cam_fmu_bit_for_bit_on_every_shipped_scene(cam3, engine_fmu_path, name):
     scene = find_scene(name)
     for run in scene.runs:

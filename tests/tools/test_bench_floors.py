@@ -170,7 +170,7 @@ def test_every_shipped_scene_is_in_the_full_scene_table():
     from cam_fmu.experiments.scenes import scene_names
 
     full = perstep.scene_list(quick=False)
-    assert full[0] == "paper_fig6" and sorted(full) == sorted(scene_names(fmu=True))
+    assert full[0] == "paper_fig6" and sorted(full) == sorted(scene_names())
     assert perstep.scene_list(quick=True) == ["paper_fig6"]
     speed = perstep.load_scene_case("speed_drive")
     assert speed.drive == "speed" and "solver" not in speed.start_values

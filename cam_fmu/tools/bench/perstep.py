@@ -51,7 +51,7 @@ class SceneCase:
 def scene_list(quick: bool) -> list[str]:
     if quick:
         return list(QUICK_SCENES)
-    shipped = scene_names(fmu=True)
+    shipped = scene_names()
     return [n for n in FIRST_SCENES if n in shipped] + sorted(n for n in shipped if n not in FIRST_SCENES)
 
 
