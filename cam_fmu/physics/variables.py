@@ -30,7 +30,7 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("M_shaft", "N.m", "torque of the compliant shaft on the cam, k_shaft twist + d_shaft twist rate (rigid: 0)"),
 )
 # The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
-# section 13), which only the reference computes so far: not FMU variables.
+# section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
 FOLLOWER_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("N_contact", "N", "the cam's normal force on the follower (0 while it is off the cam)"),
     ("contact", "1", "+1 on the flank pushing along the rise, -1 on a groove's other flank, 0 off the cam"),
