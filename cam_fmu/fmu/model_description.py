@@ -40,6 +40,7 @@ BASE_UNITS: Dict[str, Dict[str, int]] = {
     "N.m/rad": {"kg": 1, "m": 2, "s": -2, "rad": -1},
     "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
     "N": {"kg": 1, "m": 1, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
     "kg": {"kg": 1},
     "m": {"m": 1},
     "m/s": {"m": 1, "s": -1},
