@@ -244,7 +244,8 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
 
 
 LOG_CATEGORIES = (
-    ("logEvents", "hybrid events and mode changes of the drive (stop, break-away, contact, ...)"),
+    ("logEvents", "hybrid events and mode changes of the drive (stop, break-away, contact, a free follower's "
+                  "lift-offs and touch-downs, ...)"),
     ("logStatusWarning", "messages with status fmi2Warning"),
     ("logStatusDiscard", "messages with status fmi2Discard: a step the solver cannot complete at this size"),
     ("logStatusError", "messages with status fmi2Error: a refused value or call, naming it"),

@@ -63,7 +63,7 @@ typedef struct {
  * start, a step of h [s] (st->theta not moved), the outputs. */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot);
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
-                         CamError *err);
+                         double time, char *events, size_t events_len, CamError *err);
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[]);
 
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
@@ -84,6 +84,7 @@ typedef struct {
 } CamEventRecord;
 
 #define CAM_EVENT_LOG 256       /* the last this many transitions are kept */
+#define CAM_STEP_EVENTS 512     /* bytes of a step's line of follower events (the rest is counted, not written) */
 
 /* One cam drive stepped from one communication point to the next (Python: engine/simulator.py DriveSimulator). */
 typedef struct CamDrive {
@@ -104,6 +105,7 @@ typedef struct CamDrive {
     CamEnergy budget;
     double values[CAM_N_OUTPUTS];   /* the published outputs */
     int stale;                  /* values not yet computed for the current state */
+    char step_events[CAM_STEP_EVENTS];   /* the last step's lift-offs and touch-downs as one log line ("" none) */
     long events_logged;         /* transitions since the drive was built (the log keeps the last CAM_EVENT_LOG) */
     CamEventRecord event_log[CAM_EVENT_LOG];
 } CamDrive;

@@ -7,6 +7,9 @@
  * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The normal
  * force N_contact is the reference's column only so far (not an output of the FMUs). */
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
 
 #include "cam_drive.h"
 
@@ -170,6 +173,20 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
     return found;
 }
 
+/* Append one event to the step's log line while it has room (40 bytes kept for "and <n> more"); else count it. */
+static void note(char *events, size_t len, long *dropped, const char *format, ...)
+{
+    size_t used = strlen(events);
+    va_list args;
+    if (*dropped > 0 || used + 160 > len) {
+        *dropped += 1;
+        return;
+    }
+    va_start(args, format);
+    vsnprintf(events + used, len - used - 40, format, args);
+    va_end(args);
+}
+
 /* The contact the follower starts in at the inputs omega, omega_dot (reference/flight.py _start_contact). */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot)
 {
@@ -187,12 +204,12 @@ void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, doub
 /* The follower over a step of h [s] from st->theta at omega0 + omega_dot tau; st->theta is left unchanged
  * (the caller moves it). */
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
-                         CamError *err)
+                         double time, char *events, size_t events_len, CamError *err)
 {
     Motion mo = {m, st->theta, omega0, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double tau = 0.0, d[4];
-    long events = 0;
+    long count = 0, dropped = 0;
     Piece p = {0.0, st->s, st->v, 0.0};
     for (;;) {
         double at = h, theta, omega;
@@ -218,13 +235,18 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
             st->s = d[0];
             st->v = d[1] * omega;
         }
-        if (code == EV_NONE)
+        if (code == EV_NONE) {
+            if (dropped > 0 && events_len > strlen(events))
+                snprintf(events + strlen(events), events_len - strlen(events), "and %ld more", dropped);
             return CAM_OK;
-        if (++events > MAX_EVENTS)
+        }
+        if (++count > MAX_EVENTS)
             return cam_error(err, CAM_ERR_SIMULATION, "the follower: more than %d lift-offs and touch-downs in one "
                              "step of %g s (at theta = %g rad): refused, never a hang", MAX_EVENTS, h, theta);
         tau = at;
         if (code == EV_LIFT_OFF) {
+            note(events, events_len, &dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g rad); ",
+                 (int)st->contact, time + at, theta);
             st->contact = 0.0;
             st->rebound = 0.0;
         } else if (code == EV_HALT) {
@@ -238,7 +260,11 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
             w_after = v_after - d[1] * omega;
             st->s = d[0];
             st->impacts += 1.0;
-            if (w_after * w_after >= 2.0 * acceleration_scale(&mo, theta, omega, omega_dot) * ZENO_HEIGHT) {
+            if (w_after * w_after < 2.0 * acceleration_scale(&mo, theta, omega, omega_dot) * ZENO_HEIGHT)
+                w_after = 0.0;   /* the Zeno guard: a plastic impact */
+            note(events, events_len, &dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
+                 "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time + at, theta, w, w_after);
+            if (w_after != 0.0) {
                 st->v = v_after;
                 st->rebound = fabs(w_after) / (2.0 * acceleration_scale(&mo, theta, omega, omega_dot));
             } else {   /* the Zeno guard: a plastic impact, on the flank if it holds the follower */

@@ -110,13 +110,15 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
 {
     CamSpeedState *st = &d->speed;
     double end = st->theta + (d->omega_ref + 0.5 * d->omega_dot_ref * h) * h;
+    d->step_events[0] = '\0';
     (void)time;
     if (d->model.free_follower) {
         int status;
         if (st->fresh != 0.0)
             cam_follower_start(&d->model, st, d->omega_ref, d->omega_dot_ref);
         st->fresh = 0.0;
-        if ((status = cam_follower_advance(&d->model, st, d->omega_ref, d->omega_dot_ref, h, err)) != CAM_OK)
+        if ((status = cam_follower_advance(&d->model, st, d->omega_ref, d->omega_dot_ref, h, time, d->step_events,
+                                           sizeof d->step_events, err)) != CAM_OK)
             return status;
         st->speed = d->omega_ref + d->omega_dot_ref * h;
         st->theta = end;
