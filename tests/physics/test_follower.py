@@ -86,7 +86,7 @@ def test_preload_and_rate_for_a_target_speed(safety):
 
 def _integrated(flight: Flight, s0: float, v0: float, times: np.ndarray) -> np.ndarray:
     """scipy's DOP853 on m s'' = -(F0 + k s) + F_gx - sgn(v) f, stopped where v changes sign."""
-    out, t, y = [], 0.0, [s0, v0]
+    out, t, y = {}, 0.0, [s0, v0]
     while t < times[-1]:
         sigma = math.copysign(1.0, y[1]) if y[1] != 0.0 else math.copysign(1.0, -flight.F0 - flight.k * y[0] + flight.F_gx)
 
@@ -98,14 +98,9 @@ def _integrated(flight: Flight, s0: float, v0: float, times: np.ndarray) -> np.n
         halt.terminal, halt.direction = True, -1
         sol = solve_ivp(rhs, (t, times[-1]), y, method="DOP853", rtol=1e-12, atol=1e-14, events=halt, dense_output=True)
         inside = times[(times >= t) & (times <= sol.t[-1])]
-        out += [sol.sol(x) for x in inside if not out or x > out[-1][2]] if False else [(*sol.sol(x), x) for x in inside]
+        out.update({float(x): sol.sol(x) for x in inside if float(x) not in out})  # a halt's time: its first piece
         t, y = sol.t[-1], [sol.y[0, -1], 0.0]
-    seen, rows = set(), []
-    for s, v, x in out:
-        if x not in seen:
-            seen.add(x)
-            rows.append((s, v))
-    return np.array(rows)
+    return np.array([out[float(x)] for x in times])
 
 
 @pytest.mark.parametrize("k, F0, F_gx, f", [(2000.0, 20.0, 0.0, 0.0), (0.0, 5.0, 0.0, 0.0), (2000.0, 20.0, -3.0, 0.5),
