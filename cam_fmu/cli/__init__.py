@@ -30,6 +30,7 @@ SUBCOMMANDS: tuple[str, ...] = (
     "sweep",      # parameter sweeps of a scene on dask.distributed
     "reflect",    # the inertia and load torque the motor sees over one turn
     "bode",       # the frequency response from the motor voltage to the motor and cam speed
+    "jump",       # the speed at which a spring-closed follower leaves the cam; the spring it needs
     "cross_check",  # the FMI Cross-Check folders of the shipped FMUs, validated by fmpy
 )
 

@@ -15,7 +15,8 @@ extrema with their kind, the largest difference to the analytic response) as one
 
 Frequencies out of reach are refused before anything runs, naming the reachable range
 (experiments.frequency.OperatingPoint.reachable: the work of one run is bounded); so is a speed
-drive (drive = 'speed'), whose u plays no part.
+drive (drive = 'speed'), whose u plays no part, and a follower that can leave the cam (closures 'form'
+and 'spring'): the response holds the follower on the cam.
 """
 from __future__ import annotations
 
@@ -59,6 +60,10 @@ def run(args) -> int:
         raise ValueError(f"--amplitude {args.amplitude!r} V: allowed > 0")
     scene = apply_sets(find_scene(args.scene), args.set)
     params = scene.primary.params
+    if params["closure"] != "kinematic":
+        raise ValueError(f"scene {scene.name}: closure {params['closure']!r}: the frequency response linearises the "
+                         "drive with the follower on the cam (backlash off, the kinematic rule); a follower that can "
+                         "leave the cam has no small-signal model there (docs/model.md section 13)")
     f = np.geomspace(args.fmin, args.fmax, args.points)
     theta0 = None if args.u0 is not None else math.radians(args.theta or 0.0)
     try:

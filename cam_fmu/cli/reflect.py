@@ -8,7 +8,9 @@ header) and DIR/<scene>_reflect.png, and prints the extremes with the angles whe
 they occur; ``--json`` prints them as one JSON object instead (keys J_min, J_max
 [kg m^2], M_min, M_max [N m], f_r_min, f_r_max, f_a_min, f_a_max [Hz], each with its
 theta_<key> [rad]; the resonance keys are null when the drive-train is rigid,
-k_shaft = 0). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
+k_shaft = 0; and assumes, what the map assumes of the follower). It holds the follower on the cam at
+every angle (closure 'kinematic', a clearance ignored) and refuses closures 'form' and 'spring', whose
+follower can leave the cam (`cam-fmu jump`). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
 figure a third panel.
 """
 from __future__ import annotations
@@ -39,7 +41,10 @@ def run(args) -> int:
     from .simulate import apply_sets
 
     scene = apply_sets(find_scene(args.scene), args.set)
-    result = reflected_map(scene.primary.params, args.rpm, args.points)
+    try:
+        result = reflected_map(scene.primary.params, args.rpm, args.points)
+    except ValueError as exc:
+        raise ValueError(f"scene {scene.name}: {exc}") from None
     columns = list(result)
     extremes = summary(result, args.rpm)
     out = Path(args.out)
@@ -60,6 +65,7 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(extremes))
         return 0
+    print(f"assumes {extremes['assumes']}")
     for key in ("J", "M"):
         unit = "kg m^2" if key == "J" else "N m"
         print(f"{key}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} {unit} (min at "

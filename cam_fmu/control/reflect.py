@@ -28,6 +28,9 @@ PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
 COLUMNS = ("theta", "J", "M", *PARTS)
 FREQUENCIES = ("f_r", "f_a")  # Hz: the columns a compliant shaft adds
 UNITS = {"theta": "rad", "J": "kg.m2", "M": "N.m", **{part: "N.m" for part in PARTS}, "f_r": "Hz", "f_a": "Hz"}
+# What the map assumes of the follower (closure 'kinematic' only; the others are refused): printed and in the JSON.
+ASSUMES = ("the follower on the cam at every angle: a groove's two flanks push and pull it, a clearance c is "
+           "ignored (docs/model.md section 13)")
 RESONANCE_KEYS = ("f_r_min", "f_r_max", "f_a_min", "f_a_max")  # Hz: None with a rigid shaft
 
 
@@ -44,6 +47,10 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
     if points < 8:
         raise ValueError(f"points = {points}: at least 8 angles over a turn")
     model = DriveModel(params)
+    if model.closure != "kinematic":
+        raise ValueError(f"closure {model.closure!r}: the map holds the follower on the cam at every angle (the "
+                         "kinematic rule), while this follower can leave it (docs/model.md section 13); for where "
+                         "and at what speed it does, use cam-fmu jump")
     omega = rpm * 2.0 * math.pi / 60.0
     direction = 1.0 if omega > 0.0 else -1.0
     thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
@@ -73,7 +80,7 @@ def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
     """The extremes and where they occur [rad]: J_min, J_max [kg m^2], M_min, M_max [N m], and the
     resonance keys f_r_min .. f_a_max [Hz] (None: the drive-train is rigid)."""
     theta = result["theta"]
-    out: dict[str, Any] = {"rpm": rpm, "omega": rpm * 2.0 * math.pi / 60.0}
+    out: dict[str, Any] = {"rpm": rpm, "omega": rpm * 2.0 * math.pi / 60.0, "assumes": ASSUMES}
     names = [("J", "J"), ("M", "M")] + ([("f_r", "f_r"), ("f_a", "f_a")] if "f_r" in result else [])
     for name, key in names:
         low, high = int(np.argmin(result[name])), int(np.argmax(result[name]))

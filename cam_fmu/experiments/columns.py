@@ -15,7 +15,7 @@ def unit_of(name: str) -> str:
     """
     from ..control import pi
     from ..physics.parameters import BY_NAME
-    from ..physics.variables import UNITS
+    from ..physics.variables import FOLLOWER_UNITS, UNITS
 
     comp, _, var = name.rpartition(".")
     if var == "time":
@@ -24,7 +24,7 @@ def unit_of(name: str) -> str:
         spec = pi.BY_NAME.get(var)
         return pi.UNITS.get(var) or (spec.unit if spec else "")
     spec = BY_NAME.get(var)
-    return UNITS.get(var) or (spec.unit if spec else "")
+    return UNITS.get(var) or FOLLOWER_UNITS.get(var) or (spec.unit if spec else "")
 
 
 def header(name: str) -> str:

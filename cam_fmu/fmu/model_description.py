@@ -40,6 +40,7 @@ BASE_UNITS: Dict[str, Dict[str, int]] = {
     "N.m/rad": {"kg": 1, "m": 2, "s": -2, "rad": -1},
     "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
     "N": {"kg": 1, "m": 1, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
     "kg": {"kg": 1},
     "m": {"m": 1},
     "m/s": {"m": 1, "s": -1},
@@ -243,7 +244,8 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
 
 
 LOG_CATEGORIES = (
-    ("logEvents", "hybrid events and mode changes of the drive (stop, break-away, contact, ...)"),
+    ("logEvents", "hybrid events and mode changes of the drive (stop, break-away, contact, a free follower's "
+                  "lift-offs and touch-downs, ...)"),
     ("logStatusWarning", "messages with status fmi2Warning"),
     ("logStatusDiscard", "messages with status fmi2Discard: a step the solver cannot complete at this size"),
     ("logStatusError", "messages with status fmi2Error: a refused value or call, naming it"),

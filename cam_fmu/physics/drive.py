@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
+from .parameters import FOLLOWER_DRIVES, RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
 
 
 def sign(x: float) -> float:
@@ -77,6 +77,29 @@ def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
     for (name, choice), (reason, instead) in RIGID_ONLY.items():
         if p[name] == choice:
             raise ParameterError(f"{k}: {reason}; allowed with {name} {choice!r}: k_shaft = 0{instead}")
+
+
+def check_closure(p: Mapping[str, Any], c: float) -> None:
+    """Raise ParameterError where the closure's parameters contradict each other (docs/model.md 13)."""
+    closure = p["closure"]
+    if closure != "spring" and (p["k_spring"] != 0.0 or p["F_spring0"] != 0.0):
+        raise ParameterError(f"parameters 'k_spring' = {p['k_spring']!r} N/m, 'F_spring0' = {p['F_spring0']!r} N: "
+                             f"a return spring needs closure 'spring' (closure is {closure!r}); allowed with it: 0")
+    if closure == "kinematic":
+        if p["restitution"] != 0.0:
+            raise ParameterError(f"parameter 'restitution' = {p['restitution']!r}: closure 'kinematic' has plastic "
+                                 "impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring')")
+        return
+    if closure == "spring" and c != 0.0:
+        raise ParameterError(f"parameter 'c' = {c!r} m: closure 'spring' holds the follower on one flank, there is "
+                             "no clearance; allowed with it: c = 0")
+    if not (p["m"] > 0.0 and p["follower_inertia"]):
+        raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure {closure!r} moves the follower as a body of its "
+                             "own, which needs its mass; allowed with it: m > 0 and follower_inertia true")
+    if p["drive"] not in FOLLOWER_DRIVES:
+        raise ParameterError(f"parameter 'closure' = {closure!r}: the follower's own motion is computed with the "
+                             "speed drive only (its impacts on a voltage-driven cam are not modelled yet); "
+                             "allowed with drive 'voltage': closure 'kinematic'")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
@@ -160,6 +183,10 @@ class DriveModel:
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
         self.follower = self.m != 0.0 or self.F_gx != 0.0 or self.mu != 0.0
+        # The follower as a body of its own (docs/model.md section 13): 'kinematic' is the paper's rule.
+        self.closure = p["closure"]
+        self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
+        check_closure(p, self.c)
         if self.compliant:
             check_compliant(p, self.J_0)
         if self.mu > 0.0:

@@ -151,7 +151,22 @@ _SOLVER = (
     _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4); bounds the work of one step", low=1.0, high=1e6),
 )
 
-PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER
+# How the follower is held on the cam (docs/model.md section 13). 'kinematic' is today's rule: a two-sided
+# groove whose follower rests in the clearance c until a flank takes it along (the paper's eqs. 6-8).
+CLOSURES = ("kinematic", "form", "spring")
+FOLLOWER_DRIVES = ("speed",)  # the drives whose reference computes closures 'form' and 'spring' (docs/model.md 13)
+# The follower as a body of its own (the speed drive computes closures 'form' and 'spring'; docs/model.md 13).
+FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (
+    _P("closure", "", "kinematic", "how the follower is held: 'kinematic' (groove; rests in the clearance c, paper "
+       "eqs. 6-8), 'form' (groove; flies across the clearance c under gravity and friction), 'spring' (one flank and "
+       "a return spring k_spring, F_spring0; c = 0). 'form' and 'spring': speed drive only",
+       kind="string", choices=CLOSURES),
+    _P("k_spring", "N/m", 0.0, "rate of the return spring (closure 'spring')", low=0.0, high=1e9),
+    _P("F_spring0", "N", 0.0, "preload of the return spring at s = 0 (closure 'spring')", low=0.0, high=1e6),
+    _P("restitution", "1", 0.0, "coefficient of restitution of the follower's impacts on the cam (closures 'form' and "
+       "'spring'; 0: plastic, 1: elastic)", low=0.0, high=1.0),
+)
+PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS
 BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
 
 

@@ -29,6 +29,13 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("omega_m", "rad/s", "motor angular velocity (a rigid shaft: omega)"),
     ("M_shaft", "N.m", "torque of the compliant shaft on the cam, k_shaft twist + d_shaft twist rate (rigid: 0)"),
 )
+# The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
+# section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
+FOLLOWER_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("N_contact", "N", "the cam's normal force on the follower (0 while it is off the cam)"),
+    ("contact", "1", "+1 on the flank pushing along the rise, -1 on a groove's other flank, 0 off the cam"),
+    ("impacts", "1", "touch-downs so far"),
+)
 # Allowed range of each input [its unit]: far beyond any real drive, finite so that
 # the arithmetic stays finite (a value outside is an error naming the input and the range).
 INPUT_RANGES: dict[str, tuple[float, float]] = {
@@ -40,6 +47,7 @@ INPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in INPUTS)
 INPUT_STARTS: dict[str, float] = {row[0]: row[2] for row in INPUTS}
 OUTPUT_NAMES: tuple[str, ...] = tuple(row[0] for row in OUTPUTS)
 UNITS: dict[str, str] = {row[0]: row[1] for row in INPUTS + OUTPUTS}  # type: ignore[operator]
+FOLLOWER_UNITS: dict[str, str] = {row[0]: row[1] for row in FOLLOWER_COLUMNS}
 
 
 def output_record(**values: Any) -> dict[str, float]:

@@ -6,7 +6,9 @@ Kinds (the scene's ``plot`` key; ``PLOTS`` is their one table):
 - ``fig6``: omega [rad/s] over t [s], one curve per run (paper fig. 6);
 - ``time``: over t, one curve per run: omega, s, i, M for ``drive = "voltage"``;
   voltage [V] (the armature voltage the speed drive needs), i, omega, s, M, J for
-  ``drive = "speed"`` (``TIME_PANELS``, keyed by the scene's drive).
+  ``drive = "speed"`` (``TIME_PANELS``, keyed by the scene's drive);
+- ``follower``: over t, one curve per run: the follower's gap to the cam s - s_cam [mm], its velocity v,
+  acceleration a and the load torque M (the follower as a body of its own, docs/model.md section 13).
 
 With 2+ runs, ``fig6`` and ``time`` draw below each quantity a smaller axes
 "difference [unit]": every further run minus the primary (first) run on the
@@ -132,9 +134,18 @@ def difference(x0: np.ndarray, x: np.ndarray, y: np.ndarray, y0: np.ndarray) -> 
     return np.interp(x0, x, y, left=np.nan, right=np.nan) - y0
 
 
+FOLLOWER_PANELS = (("gap", "gap s - s_cam", "mm", 1e3), ("v", "follower v", "m/s", 1.0),
+                   ("a", "follower a", "m/s$^2$", 1.0), ("M", "load torque M", "N m", 1.0))
+
+
+def _follower(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, list]:
+    with_gap = {label: {**r, "gap": np.asarray(r["s"]) - np.asarray(r["s_cam"])} for label, r in results.items()}
+    return _panels(plt, with_gap, "time", FOLLOWER_PANELS, ncols=2, figsize=(11, 7.8))
+
+
 # kind -> draw(plt, results, drive) -> (figure, axes); 'time' picks its panels by the drive (TIME_PANELS)
 PLOTS: dict[str, Callable[[Any, Results, str], tuple[Any, list]]] = {
-    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time,
+    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time, "follower": _follower,
 }
 
 

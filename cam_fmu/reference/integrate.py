@@ -29,6 +29,7 @@ from ..physics.formulations.consistent import HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
+from .flight import follower_speed_reference
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 
@@ -263,6 +264,8 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
 def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """Imposed speed: theta = theta0 + int omega_ref dt (exact for piecewise-linear signals)."""
     p = model.params
+    if model.closure == "spring" or (model.closure == "form" and model.c > 0.0):  # the follower's own state
+        return follower_speed_reference(model, grid, omega_ref, options["rtol"], options["atol"])
     theta = p["theta0"]
     s = model.program.derivatives(theta)[0]
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import re
 from pathlib import Path
 import subprocess
 import sys
@@ -80,13 +81,13 @@ def test_it_agrees_with_cam_fmu_bit_for_bit_on_every_shipped_scene(cam3, engine_
 class Host:
     """An FMI 3.0 host call by call (fmpy's FMU3Slave), collecting the log."""
 
-    def __init__(self, unzipped, token=None):
+    def __init__(self, unzipped, token=None, logging=False):
         self.md = read_model_description(str(unzipped))
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.log = []
         self.fmu = FMU3Slave(guid=token or self.md.guid, unzipDirectory=str(unzipped),
                              modelIdentifier="cam", instanceName="cam3")
-        self.fmu.instantiate(logMessage=self._log)
+        self.fmu.instantiate(loggingOn=logging, logMessage=self._log)
 
     def _log(self, env, status, category, message):
         self.log.append((status, message.decode()))
@@ -120,6 +121,26 @@ def test_a_state_saved_restored_and_serialised_continues_to_the_bit(unzipped):
         assert host.get("theta", "omega", "s") == first
     assert host.get("time") == [pytest.approx(0.6)]
     host.fmu.freeFMUState(saved)
+    host.fmu.terminate()
+    host.fmu.freeInstance()
+
+
+def test_lift_off_and_touch_down_are_log_lines_not_a_status(unzipped):
+    """A spring-closed follower above its jump speed (docs/model.md section 13): each lift-off and touch-down is a
+    logEvents line with status OK, the touch-down's relative speeds halved by restitution 0.5."""
+    host = Host(unzipped, logging=True)
+    host.fmu.setString([host.vr["drive"], host.vr["closure"]], ["speed", "spring"])
+    host.fmu.setFloat64([host.vr[k] for k in ("k_spring", "F_spring0", "restitution", "omega_ref")],
+                        [800.0, 20.0, 0.5, 60.0])
+    host.start()
+    for k in range(1100):
+        host.fmu.doStep(k * 1e-4, 1e-4)
+    lines = [m for status, m in host.log if "follower:" in m]
+    assert all(status == 0 for status, m in host.log)  # fmi3OK: a log line, not a status change
+    assert any("lift-off from flank +1" in m for m in lines) and sum(m.count("touch-down") for m in lines) >= 10
+    first = next(m for m in lines if "touch-down" in m)
+    before, after = map(float, re.search(r"relative speed (\S+) m/s, after (\S+) m/s", first).groups())
+    assert before < 0.0 and after == pytest.approx(-0.5 * before, rel=1e-5)  # printed to 6 digits
     host.fmu.terminate()
     host.fmu.freeInstance()
 

@@ -76,6 +76,8 @@ def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, fact
         for out in ("s", "i", "M", "J"):
             assert np.all(np.isfinite(f[out])), f"{name}/{run.label}: {out} not finite"
         if run.params["drive"] == "speed" or run.params["formulation"] == "paper":
+            # the follower as a body of its own: the reference integrates its flight, the engine takes the closed form
+            free = {"s": 1e-10, "v": 1e-8, "a": 1e-7} if run.params["closure"] != "kinematic" else {}
             for out in ("s", "i", "M", "J", "v", "a", "alpha", "s_cam"):
-                assert np.allclose(f[out], r[out], rtol=1e-9, atol=1e-12), f"{name}/{run.label}: {out}"
+                assert np.allclose(f[out], r[out], rtol=1e-9, atol=free.get(out, 1e-12)), f"{name}/{run.label}: {out}"
 

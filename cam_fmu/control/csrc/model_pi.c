@@ -338,6 +338,7 @@ static const Model PI = {
     "pi_speed", 0x50495353u /* 'PISS' */, PI_VR_END, PI_VR_END,
     create, destroy, reset, message, variable, get_real, check_real, set_real, get_boolean, set_boolean,
     get_string, set_string, initialize, initialized, step, time_of, state_size, save, restore, NULL,
+    NULL,   /* no step events */
 };
 
 const Model *model_table(void) { return &PI; }

@@ -331,8 +331,12 @@ int glue_do_step(Glue *g, double t, double h, const char *call)
         return glue_fail(g, call, text);
     }
     status = glue_model_status(g, g->model->step(g->m, now, h), call);
-    if (status == GLUE_OK)
+    if (status == GLUE_OK) {
+        const char *events = g->model->step_events ? g->model->step_events(g->m) : NULL;
         g->last_successful_time = g->model->time(g->m);
+        if (events && events[0])
+            glue_log(g, GLUE_OK, "logEvents", "%s", events);
+    }
     return status;
 }
 

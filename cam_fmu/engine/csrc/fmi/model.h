@@ -78,6 +78,8 @@ typedef struct {
     int (*save)(const void *m, unsigned char *buffer, size_t size);
     int (*restore)(void *m, const unsigned char *buffer, size_t size);
     const ModelExchangeOps *exchange;   /* NULL: co-simulation only */
+    /* The events of the last step as one line ("" when none; NULL: the model has none), logged under logEvents. */
+    const char *(*step_events)(const void *m);
 } Model;
 
 /* The model this binary carries: each model file defines it (model_cam.c, model_pi.c), one per binary. */

@@ -106,6 +106,13 @@ static int step(void *m, double t, double h) { return status_of(cam_instance_ste
 
 static double time_of(const void *m) { return cam_instance_time(((const CamFmuModel *)m)->drive); }
 
+/* The last step's lift-offs and touch-downs of a free follower (follower.c), logged under logEvents. */
+static const char *step_events(const void *m)
+{
+    CamDrive *d = cam_instance_drive(((const CamFmuModel *)m)->drive);
+    return d ? d->step_events : NULL;
+}
+
 static size_t state_size(const void *m) { return cam_instance_state_size(((const CamFmuModel *)m)->drive); }
 
 static int save(const void *m, unsigned char *buffer, size_t size)
@@ -185,6 +192,7 @@ static const Model CAM = {
     "cam", 0x43414d53u /* 'CAMS' */, CAM_VR_END, CAM_VR_STATES,
     create, destroy, reset, message, variable, get_real, check_real, set_real, get_boolean, set_boolean,
     get_string, set_string, initialize, initialized, step, time_of, state_size, save, restore, &EXCHANGE,
+    step_events,
 };
 
 const Model *model_table(void) { return &CAM; }

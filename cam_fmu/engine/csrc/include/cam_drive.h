@@ -50,7 +50,20 @@ typedef struct {
 /* The speed drive's state. */
 typedef struct {
     double theta, s, speed;     /* rad, m, rad/s */
+    /* The follower as a body of its own (model.free_follower; docs/model.md section 13): */
+    double v;                   /* m/s, its velocity */
+    double contact;             /* +1 on the flank pushing along +X, -1 on a groove's other flank, 0 in flight */
+    double impacts;             /* touch-downs so far */
+    double rebound;             /* s: shorter than the flight the last rebound starts (the scan's first step), or 0 */
+    double fresh;               /* 1 until the first step: the start's contact follows the inputs set */
 } CamSpeedState;
+
+/* The follower as a body of its own in the speed drive (follower.c; docs/model.md section 13): its contact at the
+ * start, a step of h [s] (st->theta not moved), the outputs. */
+void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot);
+int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
+                         double time, char *events, size_t events_len, CamError *err);
+void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[]);
 
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
 typedef struct {
@@ -70,6 +83,7 @@ typedef struct {
 } CamEventRecord;
 
 #define CAM_EVENT_LOG 256       /* the last this many transitions are kept */
+#define CAM_STEP_EVENTS 512     /* bytes of a step's line of follower events (the rest is counted, not written) */
 
 /* One cam drive stepped from one communication point to the next (Python: engine/simulator.py DriveSimulator). */
 typedef struct CamDrive {
@@ -90,6 +104,7 @@ typedef struct CamDrive {
     CamEnergy budget;
     double values[CAM_N_OUTPUTS];   /* the published outputs */
     int stale;                  /* values not yet computed for the current state */
+    char step_events[CAM_STEP_EVENTS];   /* the last step's lift-offs and touch-downs as one log line ("" none) */
     long events_logged;         /* transitions since the drive was built (the log keeps the last CAM_EVENT_LOG) */
     CamEventRecord event_log[CAM_EVENT_LOG];
 } CamDrive;
@@ -115,8 +130,8 @@ enum { CAM_S_VERSION = 0, CAM_S_FORMULATION, CAM_S_TIME, CAM_S_U, CAM_S_OMEGA_RE
        CAM_S_H_NEXT, CAM_S_STEPS_TAKEN, CAM_S_X /* CAM_NX slots */, CAM_S_STUCK = CAM_S_X + CAM_NX, CAM_S_DIRECTION,
        CAM_S_CONTACT, CAM_S_S_FREE, CAM_S_SIDE, CAM_S_FORM_U, CAM_S_HAVE_BUDGET,
        CAM_S_WORK_IN, CAM_S_WORK_ABS, CAM_S_BUDGET_THETA, CAM_S_BUDGET_I, CAM_S_E_MECH0, CAM_S_E_MAG0,
-       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 3 slots */,
-       CAM_S_END = CAM_S_SPEED + 3 };
+       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 8 slots */,
+       CAM_S_END = CAM_S_SPEED + 8 };
 #define CAM_STATE_VERSION 2.0   /* 2: the compliant shaft's two slots in x */
 #define CAM_STATE_LEN 48          /* CAM_S_END rounded up: room for slots a later version adds */
 typedef char cam_state_len_covers_the_layout[CAM_S_END <= CAM_STATE_LEN ? 1 : -1];

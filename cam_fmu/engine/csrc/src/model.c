@@ -318,6 +318,37 @@ static int check_compliant(const CamModel *model, CamError *err)
     return CAM_OK;
 }
 
+/* physics.drive.check_closure: the closure's parameters against each other and the drive (docs/model.md 13). */
+static int check_closure(const CamModel *model, CamError *err)
+{
+    char a[40], b[40];
+    const double *v = model->params.v;
+    const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
+    if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
+                         "needs closure 'spring' (closure is '%s'); allowed with it: 0",
+                         cam_num(v[CAM_P_K_SPRING], a), cam_num(v[CAM_P_F_SPRING0], b), closure);
+    if (model->closure == CAM_CHOICE_CLOSURE_KINEMATIC) {
+        if (v[CAM_P_RESTITUTION] != 0.0)
+            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'restitution' = %s: closure 'kinematic' has plastic "
+                             "impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring')",
+                             cam_num(v[CAM_P_RESTITUTION], a));
+        return CAM_OK;
+    }
+    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && model->c != 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'c' = %s m: closure 'spring' holds the follower on one "
+                         "flank, there is no clearance; allowed with it: c = 0", cam_num(model->c, a));
+    if (!(v[CAM_P_M] > 0.0 && v[CAM_P_FOLLOWER_INERTIA] != 0.0))
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure '%s' moves the follower as a body "
+                         "of its own, which needs its mass; allowed with it: m > 0 and follower_inertia true",
+                         cam_num(v[CAM_P_M], a), closure);
+    if (model->formulation != CAM_FORM_SPEED)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s': the follower's own motion is computed "
+                         "with the speed drive only (its impacts on a voltage-driven cam are not modelled yet); "
+                         "allowed with drive 'voltage': closure 'kinematic'", closure);
+    return CAM_OK;
+}
+
 /* The sine or cosine `value` of a mounting angle [rad], exactly 0 where the angle makes it 0 to within a few of
  * its rounding units (parameters.mounting_component; docs/model.md 4.1): sin(pi) = 1.2e-16 is no force. */
 static double mounting(double value, double angle)
@@ -372,6 +403,16 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->atol = v[CAM_P_ATOL];
     model->max_steps = (long)v[CAM_P_MAX_STEPS];
     model->feature_angle = model->profile.feature_angle;
+    model->closure = (int)v[CAM_P_CLOSURE];
+    model->k_spring = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_K_SPRING] : 0.0;
+    model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
+    model->restitution = v[CAM_P_RESTITUTION];
+    model->free_follower = model->closure == CAM_CHOICE_CLOSURE_SPRING
+                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0);
+    if ((status = check_closure(model, err)) != CAM_OK) {
+        cam_model_free(model);
+        return status;
+    }
     if (model->compliant && (status = check_compliant(model, err)) != CAM_OK) {
         cam_model_free(model);
         return status;

@@ -122,8 +122,9 @@ int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, do
         total += out[k];
     if (!isfinite(total))
         return CAM_PUBLISH_NOT_FINITE;
-    if (fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) > m->c * (1.0 + 1e-9) + 1e-12)
-        return CAM_PUBLISH_CLEARANCE;
+    if (m->closure == CAM_CHOICE_CLOSURE_SPRING ? out[CAM_O_S] - out[CAM_O_S_CAM] < -2e-12   /* on or off its flank */
+        : fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) > m->c * (1.0 + 1e-9) + (m->free_follower ? 2e-12 : 1e-12))
+        return CAM_PUBLISH_CLEARANCE;   /* a free follower touches down 1e-12 m inside a flank (follower.c) */
     if (budget != NULL) {
         cam_energy_step(budget, u, h, out[CAM_O_THETA_M], out[CAM_O_I]);
         if (cam_energy_created(budget, out))

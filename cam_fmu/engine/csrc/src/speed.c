@@ -85,14 +85,22 @@ static int speed_init(CamDrive *d, CamError *err)
     d->speed.theta = d->model.params.v[CAM_P_THETA0];
     d->speed.speed = d->omega_ref;
     d->speed.s = s_at(&d->model.profile, d->speed.theta);
+    d->speed.v = d->speed.contact = d->speed.impacts = d->speed.rebound = 0.0;
+    d->speed.fresh = 1.0;
+    if (d->model.free_follower)
+        cam_follower_start(&d->model, &d->speed, d->omega_ref, d->omega_dot_ref);
     return CAM_OK;
 }
 
 static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
 {
     (void)u;
-    (void)omega_dot_ref;
     d->speed.speed = omega_ref;
+    if (d->model.free_follower) {   /* its own motion: the start's contact follows the inputs set before the first step */
+        if (d->speed.fresh != 0.0)
+            cam_follower_start(&d->model, &d->speed, omega_ref, omega_dot_ref);
+        return;
+    }
     if (omega_ref == 0.0)   /* at rest from now: the follower lies where the force along the stroke pushes it, as at
                                the end of a step that stops (the reference: at every output time with omega = 0) */
         d->speed.s = rest_position(&d->model, d->speed.theta, d->speed.s);
@@ -102,7 +110,21 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
 {
     CamSpeedState *st = &d->speed;
     double end = st->theta + (d->omega_ref + 0.5 * d->omega_dot_ref * h) * h;
+    d->step_events[0] = '\0';
     (void)time;
+    if (d->model.free_follower) {
+        int status;
+        if (st->fresh != 0.0)
+            cam_follower_start(&d->model, st, d->omega_ref, d->omega_dot_ref);
+        st->fresh = 0.0;
+        if ((status = cam_follower_advance(&d->model, st, d->omega_ref, d->omega_dot_ref, h, time, d->step_events,
+                                           sizeof d->step_events, err)) != CAM_OK)
+            return status;
+        st->speed = d->omega_ref + d->omega_dot_ref * h;
+        st->theta = end;
+        *steps = 1;
+        return CAM_OK;
+    }
     (void)err;
     st->speed = d->omega_ref + d->omega_dot_ref * h;
     st->s = follower_along(&d->model.profile, st->s, st->theta, end, d->model.c);
@@ -121,7 +143,12 @@ static void speed_outputs(CamDrive *d, double out[])
     const CamSpeedState *st = &d->speed;
     double omega = st->speed, omega_dot = d->omega_dot_ref, theta = st->theta, direction, i, voltage;
     CamLoad load, ahead, behind;
-    int on = engaged(m, theta, st->s, omega, omega_dot);
+    int on;
+    if (m->free_follower) {
+        cam_follower_outputs(m, st, omega_dot, out);
+        return;
+    }
+    on = engaged(m, theta, st->s, omega, omega_dot);
     direction = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
     cam_load(m, theta, omega, omega_dot, direction, on, &load);
     i = (m->J_0 * omega_dot + load.M) / m->c_m;

@@ -46,6 +46,11 @@ void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
     s[CAM_S_SPEED + 0] = d->speed.theta;
     s[CAM_S_SPEED + 1] = d->speed.s;
     s[CAM_S_SPEED + 2] = d->speed.speed;
+    s[CAM_S_SPEED + 3] = d->speed.v;
+    s[CAM_S_SPEED + 4] = d->speed.contact;
+    s[CAM_S_SPEED + 5] = d->speed.impacts;
+    s[CAM_S_SPEED + 6] = d->speed.rebound;
+    s[CAM_S_SPEED + 7] = d->speed.fresh;
 }
 
 static const char *const ENTRY[] = {"version", "formulation", "time", "u", "omega_ref", "omega_dot_ref", "h_next",
@@ -79,6 +84,11 @@ static void apply_state(CamDrive *d, const double s[CAM_STATE_LEN], const CamMod
     d->speed.theta = s[CAM_S_SPEED + 0];
     d->speed.s = s[CAM_S_SPEED + 1];
     d->speed.speed = s[CAM_S_SPEED + 2];
+    d->speed.v = s[CAM_S_SPEED + 3];
+    d->speed.contact = s[CAM_S_SPEED + 4];
+    d->speed.impacts = s[CAM_S_SPEED + 5];
+    d->speed.rebound = s[CAM_S_SPEED + 6];
+    d->speed.fresh = s[CAM_S_SPEED + 7];
     d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
     if (d->have_budget) {
         const double *out = cam_drive_outputs(d);
@@ -112,6 +122,13 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
     if (s[CAM_S_HAVE_BUDGET] != 0.0 && !d->form->energy_bounded)
         return cam_error(err, CAM_ERR_SIMULATION, "state has an energy account, but the %s drive keeps none",
                          d->form->name);
+    if (m->free_follower) {
+        double contact = s[CAM_S_SPEED + 4];
+        if (!(contact == 0.0 || contact == 1.0 || (contact == -1.0 && m->closure == CAM_CHOICE_CLOSURE_FORM)))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
+                             "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
+                             ? " or -1 (on the groove's other flank)" : "");
+    }
     if (m->formulation != CAM_FORM_CONSISTENT)
         return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */
     if (mode->stuck && x[CAM_OMEGA] != 0.0)

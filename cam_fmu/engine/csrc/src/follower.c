@@ -1,0 +1,326 @@
+/* The follower as a body of its own on a cam at imposed speed (docs/model.md section 13; its check is the
+ * reference's physics/speed_follower.py and reference/flight.py, which integrate the flight numerically where
+ * this file takes its closed form). Closures 'spring' (one flank, a return spring) and 'form' (a groove with
+ * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
+ * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -TOUCH, an impact with
+ * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
+ * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The normal
+ * force N_contact is the reference's column only so far (not an output of the FMUs). */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cam_drive.h"
+
+#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
+#define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
+#define SCAN_ANGLE 1e-3         /* rad: cam angle between two samples of an event function */
+#define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
+
+enum { EV_NONE = 0, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT };
+
+typedef struct {
+    const CamModel *m;
+    double theta0, omega0, omega_dot;   /* theta(tau) = theta0 + (omega0 + omega_dot tau / 2) tau */
+    double f0;                          /* N: guide friction at zero contact force */
+    double c;                           /* m: the clearance (0 for a spring) */
+    int two_sided;                      /* a groove: the -1 flank exists */
+} Motion;
+
+typedef struct {
+    double tau0, s0, v0, sigma;         /* a piece of flight from tau0, the friction's direction -sigma */
+} Piece;
+
+static double sgn(double x)
+{
+    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
+}
+
+static double theta_at(const Motion *mo, double tau)
+{
+    return mo->theta0 + (mo->omega0 + 0.5 * mo->omega_dot * tau) * tau;
+}
+
+static double closing(const CamModel *m, double s)
+{
+    return m->F_spring0 + m->k_spring * s - m->F_gx;
+}
+
+/* The follower on the flank `contact`: d = (s, s', s'', s_cam). */
+static void on_flank(const Motion *mo, double theta, double contact, double d[4])
+{
+    cam_profile_eval(&mo->m->profile, theta, d);
+    d[3] = d[0];
+    d[0] = d[3] - contact * mo->c;
+}
+
+/* > 0 while the flank `contact` holds the follower: contact (m a + F_close + sgn(v) f0). */
+static double held(const Motion *mo, double theta, double omega, double omega_dot, double contact)
+{
+    const CamModel *m = mo->m;
+    double d[4], v, friction;
+    on_flank(mo, theta, contact, d);
+    v = d[1] * omega;
+    friction = v > 0.0 ? mo->f0 : (v < 0.0 ? -mo->f0 : 0.0);
+    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + closing(m, d[0]) + friction);
+}
+
+/* m/s2 in flight with the friction's direction -sigma; sigma = 0 at a halt: 0 while static friction holds. */
+static double free_acceleration(const Motion *mo, double s, double sigma)
+{
+    double net = -closing(mo->m, s);
+    if (sigma == 0.0) {
+        if (fabs(net) <= mo->f0)
+            return 0.0;
+        sigma = net > 0.0 ? 1.0 : -1.0;
+    }
+    return (net - sigma * mo->f0) / mo->m->m;
+}
+
+/* The closed-form flight (physics.follower.Flight) tau - tau0 after the piece's start. */
+static void fly(const Motion *mo, const Piece *p, double tau, double *s, double *v)
+{
+    const CamModel *m = mo->m;
+    double t = tau - p->tau0, force;
+    if (p->sigma == 0.0) {   /* held by the guide's static friction */
+        *s = p->s0;
+        *v = 0.0;
+        return;
+    }
+    force = -m->F_spring0 + m->F_gx - p->sigma * mo->f0;
+    if (m->k_spring > 0.0) {
+        double wn = sqrt(m->k_spring / m->m), s_eq = force / m->k_spring, c = cos(wn * t), sn = sin(wn * t);
+        *s = s_eq + (p->s0 - s_eq) * c + p->v0 / wn * sn;
+        *v = -(p->s0 - s_eq) * wn * sn + p->v0 * c;
+    } else {
+        double b = force / m->m;
+        *s = p->s0 + p->v0 * t + 0.5 * b * t * t;
+        *v = p->v0 + b * t;
+    }
+}
+
+/* The event function `code` at tau (> 0: nothing happens). */
+static double event_value(const Motion *mo, const Piece *p, double contact, int code, double tau)
+{
+    double theta = theta_at(mo, tau), d[4], s, v;
+    if (code == EV_LIFT_OFF)
+        return held(mo, theta, mo->omega0 + mo->omega_dot * tau, mo->omega_dot, contact);
+    fly(mo, p, tau, &s, &v);
+    if (code == EV_HALT)
+        return p->sigma * v;
+    cam_profile_eval(&mo->m->profile, theta, d);
+    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + TOUCH : (d[0] + mo->c) - s + TOUCH;
+}
+
+/* m/s2: a bound of the follower's acceleration relative to the flank near theta (speed_follower.acceleration_scale). */
+static double acceleration_scale(const Motion *mo, double theta, double omega, double omega_dot)
+{
+    double d[4];
+    on_flank(mo, theta, 1.0, d);
+    return fabs(free_acceleration(mo, d[0], 1.0)) + mo->f0 / mo->m->m + fabs(d[2]) * omega * omega
+           + fabs(d[1] * omega_dot) + 1e-300;
+}
+
+/* The first event in (tau, end]: its code (EV_NONE: none) and *at, located by bisection between samples. */
+static int first_event(const Motion *mo, const Piece *p, double contact, double tau, double end, double rebound,
+                       double *at)
+{
+    int codes[3], n = 0, k, found = EV_NONE;
+    double spacing, a = tau, fa[3], omega_max = fabs(mo->omega0) + fabs(mo->omega_dot) * (end - tau);
+    if (contact != 0.0)
+        codes[n++] = EV_LIFT_OFF;
+    else {
+        codes[n++] = EV_TOUCH_UP;
+        if (mo->two_sided)
+            codes[n++] = EV_TOUCH_DOWN;
+        if (mo->f0 > 0.0 && p->sigma != 0.0)
+            codes[n++] = EV_HALT;
+    }
+    spacing = omega_max > 0.0 ? SCAN_ANGLE / omega_max : end - tau;
+    if (contact == 0.0 && mo->m->k_spring > 0.0)
+        spacing = fmin(spacing, 0.05 * sqrt(mo->m->m / mo->m->k_spring));   /* a twentieth of the flight's period */
+    for (k = 0; k < n; k++)
+        fa[k] = event_value(mo, p, contact, codes[k], a);
+    while (a < end && found == EV_NONE) {
+        double b = a + (rebound > 0.0 && a - tau < rebound ? fmin(spacing, rebound / 8.0) : spacing), best = end;
+        if (b > end || end - b < 1e-3 * spacing)
+            b = end;
+        for (k = 0; k < n; k++) {
+            double fb = event_value(mo, p, contact, codes[k], b);
+            if (fa[k] >= 0.0 && fb <= 0.0) {   /* a crossing downward (solve_ivp's direction -1) */
+                double lo = a, hi = b;
+                for (;;) {
+                    double mid = 0.5 * (lo + hi);
+                    if (mid <= lo || mid >= hi)
+                        break;
+                    if (event_value(mo, p, contact, codes[k], mid) > 0.0)
+                        lo = mid;
+                    else
+                        hi = mid;
+                }
+                if (hi < best || found == EV_NONE) {
+                    best = hi;
+                    found = codes[k];
+                }
+            }
+            fa[k] = fb;
+        }
+        if (found != EV_NONE)
+            *at = best;
+        a = b;
+    }
+    return found;
+}
+
+/* Append one event to the step's log line while it has room (40 bytes kept for "and <n> more"); else count it. */
+static void note(char *events, size_t len, long *dropped, const char *format, ...)
+{
+    size_t used = strlen(events);
+    va_list args;
+    if (*dropped > 0 || used + 160 > len) {
+        *dropped += 1;
+        return;
+    }
+    va_start(args, format);
+    vsnprintf(events + used, len - used - 40, format, args);
+    va_end(args);
+}
+
+/* The contact the follower starts in at the inputs omega, omega_dot (reference/flight.py _start_contact). */
+void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot)
+{
+    Motion mo = {m, st->theta, omega, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+                 m->closure == CAM_CHOICE_CLOSURE_FORM};
+    double d[4], side;
+    st->contact = held(&mo, st->theta, omega, omega_dot, 1.0) >= 0.0 ? 1.0
+                  : (mo.two_sided && held(&mo, st->theta, omega, omega_dot, -1.0) >= 0.0 ? -1.0 : 0.0);
+    side = st->contact != 0.0 ? st->contact : 1.0;
+    on_flank(&mo, st->theta, side, d);
+    st->s = d[0];
+    st->v = d[1] * omega;
+}
+
+/* The follower over a step of h [s] from st->theta at omega0 + omega_dot tau; st->theta is left unchanged
+ * (the caller moves it). */
+int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
+                         double time, char *events, size_t events_len, CamError *err)
+{
+    Motion mo = {m, st->theta, omega0, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+                 m->closure == CAM_CHOICE_CLOSURE_FORM};
+    double tau = 0.0, d[4];
+    long count = 0, dropped = 0;
+    Piece p = {0.0, st->s, st->v, 0.0};
+    for (;;) {
+        double at = h, theta, omega;
+        int code;
+        if (st->contact != 0.0 && held(&mo, theta_at(&mo, tau), omega0 + omega_dot * tau, omega_dot, st->contact) < 0.0)
+            code = EV_LIFT_OFF, at = tau;   /* already pulling (s'' jumped at a breakpoint, or the input did) */
+        else {
+            if (st->contact == 0.0) {
+                p.tau0 = tau;
+                p.s0 = st->s;
+                p.v0 = st->v;
+                p.sigma = st->v != 0.0 ? sgn(st->v) : sgn(free_acceleration(&mo, st->s, 0.0));
+            }
+            code = first_event(&mo, &p, st->contact, tau, h, st->rebound, &at);
+        }
+        theta = theta_at(&mo, at);
+        omega = omega0 + omega_dot * at;
+        if (st->contact == 0.0) {
+            fly(&mo, &p, at, &st->s, &st->v);
+            st->rebound = st->rebound > at - tau ? st->rebound - (at - tau) : 0.0;
+        } else {
+            on_flank(&mo, theta, st->contact, d);
+            st->s = d[0];
+            st->v = d[1] * omega;
+        }
+        if (code == EV_NONE) {
+            if (dropped > 0 && events_len > strlen(events))
+                snprintf(events + strlen(events), events_len - strlen(events), "and %ld more", dropped);
+            return CAM_OK;
+        }
+        if (++count > MAX_EVENTS)
+            return cam_error(err, CAM_ERR_SIMULATION, "the follower: more than %d lift-offs and touch-downs in one "
+                             "step of %g s (at theta = %g rad): refused, never a hang", MAX_EVENTS, h, theta);
+        tau = at;
+        if (code == EV_LIFT_OFF) {
+            note(events, events_len, &dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g rad); ",
+                 (int)st->contact, time + at, theta);
+            st->contact = 0.0;
+            st->rebound = 0.0;
+        } else if (code == EV_HALT) {
+            st->v = 0.0;
+        } else {
+            double flank = code == EV_TOUCH_UP ? 1.0 : -1.0, w, impulse, v_after, w_after;
+            on_flank(&mo, theta, flank, d);
+            w = st->v - d[1] * omega;
+            impulse = -(1.0 + m->restitution) * m->m * w;   /* physics.follower.impact with J_0 = inf */
+            v_after = st->v + impulse / m->m;
+            w_after = v_after - d[1] * omega;
+            st->s = d[0];
+            st->impacts += 1.0;
+            if (w_after * w_after < 2.0 * acceleration_scale(&mo, theta, omega, omega_dot) * ZENO_HEIGHT)
+                w_after = 0.0;   /* the Zeno guard: a plastic impact */
+            note(events, events_len, &dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
+                 "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time + at, theta, w, w_after);
+            if (w_after != 0.0) {
+                st->v = v_after;
+                st->rebound = fabs(w_after) / (2.0 * acceleration_scale(&mo, theta, omega, omega_dot));
+            } else {   /* the Zeno guard: a plastic impact, on the flank if it holds the follower */
+                st->contact = held(&mo, theta, omega, omega_dot, flank) >= 0.0 ? flank : 0.0;
+                st->v = d[1] * omega;
+                st->rebound = 0.0;
+            }
+        }
+    }
+}
+
+/* physics.speed_follower.SpeedFollower.outputs: the speed drive's outputs with the follower's own s, v, a. */
+void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[])
+{
+    Motion mo = {m, st->theta, st->speed, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+                 m->closure == CAM_CHOICE_CLOSURE_FORM};
+    double omega = st->speed, theta = st->theta, d[4], tan_a, shaft, i, voltage, s = st->s, v = st->v, a;
+    double M, J;
+    CamLoad load;
+    cam_profile_eval(&m->profile, theta, d);
+    tan_a = d[1] / (m->r_b + d[0]);
+    shaft = m->M_f * sgn(omega);
+    if (st->contact != 0.0) {
+        int k;
+        double Ms[3], step = 1e-6;
+        for (k = 0; k < 3; k++) {   /* at theta, theta + step and theta - step: the voltage's dM/dtheta */
+            double angle = theta + (k == 0 ? 0.0 : (k == 1 ? step : -step)), e[4], push, t_a, sigma, f;
+            on_flank(&mo, angle, st->contact, e);
+            push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + closing(m, e[0]);
+            t_a = e[1] / (m->r_b + e[3]);
+            sigma = sgn(e[1] * omega);
+            f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);
+            Ms[k] = shaft + (push + sigma * f) * e[1];
+        }
+        M = Ms[0];
+        J = m->J_0 + m->m * d[1] * d[1];
+        s = d[0] - st->contact * m->c;
+        v = d[1] * omega;
+        a = d[2] * omega * omega + d[1] * omega_dot;
+        i = (m->J_0 * omega_dot + M) / m->c_m;
+        voltage = m->R * i + m->c_e * omega;
+        if (m->L > 0.0 && omega != 0.0)
+            voltage += m->L * omega * ((Ms[1] - Ms[2]) / (2.0 * step)) / m->c_m;
+    } else {
+        M = shaft;
+        J = m->J_0;
+        a = free_acceleration(&mo, s, sgn(v));
+        i = (m->J_0 * omega_dot + M) / m->c_m;
+        voltage = m->R * i + m->c_e * omega;
+    }
+    load.M = M;
+    load.J = J;
+    load.f = 0.0;
+    load.v = v;
+    load.a = a;
+    load.alpha = atan(tan_a);
+    load.s_cam = d[0];
+    cam_record_outputs(&load, omega, theta, s, i, voltage, out);
+}

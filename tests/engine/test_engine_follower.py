@@ -1,0 +1,116 @@
+"""The C engine's follower as a body of its own (csrc/src/follower.c; docs/model.md section 13) against the scipy
+reference (physics/speed_follower.py, reference/flight.py: a numerical flight where the engine takes the closed
+form) and against closed forms; under AddressSanitizer and UBSan (tests/engine_c/follower_driver.c).
+
+Jump speed of a simple-harmonic rise of lift h over the angle b (tests/physics/test_follower.py):
+omega_jump^2 = (F0 + k h) / (m (h/2) (pi/b)^2), at the top of the stroke.
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cam_fmu.engine import codegen
+from cam_fmu.engine.build import CSRC, INCLUDE, SOURCES
+from cam_fmu.experiments.runner import _reference
+from cam_fmu.experiments.scenes import find_scene
+from cam_fmu.fmu.engine import DriveSimulator
+from native_support import require
+
+DRIVER = Path(__file__).resolve().parents[1] / "engine_c" / "follower_driver.c"
+FLAGS = ["-std=c99", "-O1", "-g", "-ffp-contract=off", "-Wall", "-Wextra", "-Werror", "-pedantic",
+         "-fsanitize=address,undefined", "-fno-sanitize-recover=all", "-fno-omit-frame-pointer"]
+H, B, MASS, K, F0 = 0.05, math.pi, 0.4, 2000.0, 20.0
+SHM = dict(drive="speed", closure="spring", k_spring=K, F_spring0=F0, mu=0.0, M_f=0.0, lift=H,
+           rise_law="simple_harmonic", return_law="simple_harmonic")
+
+
+def engine_run(params: dict, omega: float, times: np.ndarray) -> dict[str, np.ndarray]:
+    """The engine stepped over ``times`` at the constant speed omega [rad/s]: its outputs there."""
+    sim = DriveSimulator(params)
+    sim.set_inputs(u=0.0, omega_ref=omega, omega_dot_ref=0.0)
+    rows = [sim.outputs()]
+    for t0, t1 in zip(times[:-1], times[1:]):
+        sim.do_step(float(t0), float(t1 - t0), omega_ref=omega, omega_dot_ref=0.0)
+        rows.append(sim.outputs())
+    return {name: np.array([row[name] for row in rows]) for name in rows[0]}
+
+
+@pytest.mark.parametrize("name", ["spring_jump", "spring_bounce", "groove_crossover"])
+def test_the_engine_is_the_reference(name):
+    scene = find_scene(name)
+    for run in scene.runs:
+        ref = _reference(scene, run)
+        got = engine_run(dict(run.params), scene.omega_ref.value(0.0), ref["time"])
+        assert np.max(np.abs(got["theta"] - ref["theta"])) < 1e-11
+        assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10, run.label   # m (measured 2e-12)
+        assert np.max(np.abs(got["v"] - ref["v"])) < 1e-8, run.label    # m/s (measured 5e-10)
+        assert np.max(np.abs(got["a"] - ref["a"])) < 1e-7, run.label    # m/s2 (measured 4e-9)
+        for key in ("M", "i", "voltage"):
+            assert np.max(np.abs(got[key] - ref[key])) < 1e-9 * max(1.0, np.max(np.abs(ref[key]))), (run.label, key)
+
+
+@pytest.mark.parametrize("ratio, leaves", [(0.98, False), (1.02, True)])
+def test_jump_speed_in_the_speed_drive(ratio, leaves):
+    omega_jump = math.sqrt((F0 + K * H) / (MASS * H / 2 * (math.pi / B) ** 2))
+    omega = ratio * omega_jump
+    times = np.linspace(0.0, 2 * 2 * math.pi / omega, 4001)
+    got = engine_run(SHM, omega, times)
+    assert (np.max(got["s"] - got["s_cam"]) > 1e-9) == leaves
+    assert np.all(got["s"] >= got["s_cam"] - 2e-12)
+
+
+def test_restitution_one_keeps_the_flight_energy_and_less_settles():
+    """e = 1 without friction: between impacts the follower's energy m v^2/2 + F0 s + k s^2/2 is constant (only the
+    output intervals holding an impact change it); e = 0.5 ends the bouncing with the follower back on the cam."""
+    omega = 1.3 * math.sqrt((F0 + K * H) / (MASS * H / 2 * (math.pi / B) ** 2))
+    times = np.linspace(0.0, 2 * math.pi / omega, 8001)
+    elastic = engine_run(dict(SHM, restitution=1.0), omega, times)
+    flying = np.flatnonzero(elastic["s"] - elastic["s_cam"] > 1e-9)
+    energy = 0.5 * MASS * elastic["v"] ** 2 + F0 * elastic["s"] + 0.5 * K * elastic["s"] ** 2
+    pairs = flying[np.isin(flying + 1, flying)]  # two consecutive rows in flight: an impact between them or none
+    kept = np.abs(energy[pairs + 1] - energy[pairs]) <= 1e-9 * np.max(energy[flying])
+    assert len(pairs) > 1000 and np.count_nonzero(~kept) <= 0.02 * len(pairs)  # only the intervals with an impact
+    scene = find_scene("spring_bounce")   # restitution 0.5: the follower rises up to 4.9 mm, then settles
+    damped = engine_run(dict(scene.primary.params), 60.0, np.linspace(0.0, scene.stop_time, 2201))
+    assert damped["s"][-1] == damped["s_cam"][-1] and np.max(damped["s"] - damped["s_cam"]) > 4e-3
+
+
+def test_a_state_saved_in_flight_repeats_its_run():
+    scene = find_scene("spring_bounce")
+    sim = DriveSimulator(dict(scene.primary.params))
+    sim.set_inputs(u=0.0, omega_ref=60.0, omega_dot_ref=0.0)
+    k = 0
+    while sim.outputs()["s"] - sim.outputs()["s_cam"] < 1e-4:
+        sim.do_step(k * 1e-4, 1e-4, omega_ref=60.0)
+        k += 1
+    state = sim.state_array()   # the whole state, as the FMUs save it
+
+    def onwards():
+        rows = []
+        for j in range(k, k + 400):
+            sim.do_step(j * 1e-4, 1e-4, omega_ref=60.0)
+            rows.append((sim.outputs()["s"], sim.outputs()["v"]))
+        return rows
+    first = onwards()
+    sim.set_state_array(state)
+    assert onwards() == first
+
+
+def test_the_follower_is_clean_under_asan_and_ubsan(tmp_path):
+    gcc = require("gcc")
+    generated = [str(p) for p in codegen.write(tmp_path / "generated") if p.suffix == ".c"]
+    exe = tmp_path / "follower_driver"
+    cmd = [gcc, *FLAGS, f"-I{INCLUDE}", f"-I{tmp_path / 'generated'}", *sorted(str(p) for p in SOURCES.glob("*.c")),
+           *generated, str(CSRC / "fmi" / "instance.c"), str(DRIVER), "-o", str(exe), "-lm"]
+    built = subprocess.run(cmd, capture_output=True, text=True)
+    assert built.returncode == 0, built.stderr
+    proc = subprocess.run([str(exe)], capture_output=True, text=True, timeout=600,
+                          env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0", "UBSAN_OPTIONS": "print_stacktrace=1"})
+    assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr, proc.stderr[-3000:]
+    assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stderr[-3000:]
+    assert [line.split()[0] for line in proc.stdout.splitlines()[:-1]] == ["spring", "spring", "form"]

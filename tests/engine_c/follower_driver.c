@@ -1,0 +1,113 @@
+/* The follower as a body of its own (cam_fmu/engine/csrc/src/follower.c) under AddressSanitizer and UBSan:
+ * spring-closed and groove drives at imposed speed with bounces, a saved state taken in flight and restored,
+ * and the refusals of contradicting parameters.
+ *
+ *   follower_driver
+ *
+ * Prints one line per case, "<case> <impact-free checksum> <s at the end>", and "ok" at the end; a broken
+ * promise (a state in flight that does not repeat its run bit for bit, a refusal without a message) aborts.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cam_instance.h"
+
+static unsigned vr_of(const char *wanted)
+{
+    unsigned vr;
+    CamKind kind;
+    const char *name;
+    for (vr = 0; cam_instance_variable(vr, &kind, &name); vr++)
+        if (!strcmp(name, wanted))
+            return vr;
+    abort();
+}
+
+static void set_string(CamInstance *d, const char *name, const char *value)
+{
+    if (cam_instance_set_string(d, vr_of(name), value, strlen(value)) != CAM_OK) abort();
+}
+
+static void set_real(CamInstance *d, const char *name, double value)
+{
+    if (cam_instance_set_real(d, vr_of(name), value) != CAM_OK) abort();
+}
+
+static CamInstance *drive(const char *closure, double e, double omega)
+{
+    CamInstance *d = cam_instance_new();
+    if (!d) abort();
+    set_string(d, "drive", "speed");
+    set_string(d, "closure", closure);
+    set_real(d, "restitution", e);
+    if (!strcmp(closure, "spring")) {
+        set_real(d, "k_spring", 800.0);
+        set_real(d, "F_spring0", 20.0);
+    } else
+        set_real(d, "c", 5e-4);
+    set_real(d, "omega_ref", omega);
+    if (cam_instance_initialize(d, 0.0) != CAM_OK) abort();
+    return d;
+}
+
+/* Steps of 1e-4 s from step k0 to k1; the sum of s over them. */
+static double run(CamInstance *d, int k0, int k1)
+{
+    double sum = 0.0;
+    int k;
+    unsigned vr_s = vr_of("s");
+    for (k = k0; k < k1; k++) {
+        double s;
+        if (cam_instance_step(d, k * 1e-4, 1e-4) != CAM_OK) {
+            fprintf(stderr, "step refused: %s\n", cam_instance_message(d));
+            abort();
+        }
+        if (cam_instance_get_real(d, vr_s, &s) != CAM_OK) abort();
+        sum += s;
+    }
+    return sum;
+}
+
+int main(void)
+{
+    static const char *closures[] = {"spring", "spring", "form"};
+    static const double es[] = {0.5, 1.0, 0.0}, omegas[] = {60.0, 90.0, 10.0};
+    int c;
+    for (c = 0; c < 3; c++) {
+        CamInstance *d = drive(closures[c], es[c], omegas[c]);
+        unsigned vr_s = vr_of("s"), vr_s_cam = vr_of("s_cam");
+        double s, s_cam, first, again;
+        size_t size;
+        unsigned char *saved;
+        int k = 0;
+        /* to the first step in flight */
+        do {
+            run(d, k, k + 1);
+            k++;
+            if (cam_instance_get_real(d, vr_s, &s) != CAM_OK || cam_instance_get_real(d, vr_s_cam, &s_cam) != CAM_OK)
+                abort();
+        } while ((c == 2 ? fabs(fabs(s - s_cam) - 5e-4) : s - s_cam) < 1e-6 && k < 20000);   /* on a flank */
+        if (k >= 20000) abort();
+        size = cam_instance_state_size(d);
+        saved = malloc(size);
+        if (!saved || cam_instance_save(d, saved, size) != CAM_OK) abort();
+        first = run(d, k, k + 2000);
+        if (cam_instance_restore(d, saved, size) != CAM_OK) abort();
+        again = run(d, k, k + 2000);
+        if (first != again) abort();   /* a state saved in flight repeats its run bit for bit */
+        if (cam_instance_get_real(d, vr_s, &s) != CAM_OK) abort();
+        printf("%s %.17g %.17g\n", closures[c], first, s);
+        free(saved);
+        cam_instance_free(d);
+    }
+    {   /* a refusal names its reason */
+        CamInstance *d = cam_instance_new();
+        set_string(d, "closure", "spring");
+        if (cam_instance_initialize(d, 0.0) == CAM_OK || !strstr(cam_instance_message(d), "speed drive only")) abort();
+        cam_instance_free(d);
+    }
+    printf("ok\n");
+    return 0;
+}
