@@ -14,7 +14,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..experiments.signals import Signal
+from ..physics.signals import Signal
 from ..physics.speed_follower import SpeedFollower
 
 # Events at one instant in a row before the run is refused (each transition changes the mode; a cycle means
