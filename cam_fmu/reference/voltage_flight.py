@@ -1,0 +1,153 @@
+"""The reference of the spring-closed follower on a voltage-driven cam (docs/model.md section 13.6).
+
+scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = (theta, omega, i, s, v) of
+``physics.voltage_follower.VoltageFollower``, with the energy integrals E_in = int u i dt, E_copper = int R i^2 dt
+and E_shaft = int M_f |omega| dt. Terminal events stop it at each lift-off (the contact force P reaches 0),
+touch-down (the gap reaches -TOUCH, as reference/flight.py), the shaft's stop (omega = 0: refused, the
+shaft's static friction with a free follower is not modelled) and input break; the transition is applied at the
+located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (1 or 0),
+impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..physics.signals import Signal
+from ..physics.voltage_follower import VoltageFollower
+from .flight import MAX_STALL, TOUCH
+
+STATE = 5  # theta, omega, i, s, v; then the energy integrals
+
+
+class VoltageFollowerRun:
+    """One run of the voltage drive with a spring-closed follower of its own."""
+
+    def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
+        self.body = VoltageFollower(model)
+        self.u = u
+        self.rtol, self.atol, self.energy = rtol, atol, energy
+        stiff = model.L > 0.0 and model.L / model.R < 1e-3
+        self.method = method or ("Radau" if stiff else "DOP853")
+        self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
+        self.loss = 0.0  # J, the impacts' losses so far
+        self.lift_offs: list[tuple[float, float, float]] = []  # (t [s], s [m], v [m/s]) where the follower left the cam
+        self.rebound = 0.0  # s, shorter than the bounce the last rebound starts (reference/flight.py), or 0
+
+    def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
+        body, model = self.body, self.body.model
+        p = model.params
+        theta0, omega0 = p["theta0"], p["omega0"]
+        s_cam, s1, _, _ = body.program.derivatives(theta0)
+        y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0] + [0.0, 0.0, 0.0]
+        contact = 1.0
+        t, stop = float(grid[0]), float(grid[-1])
+        breaks = sorted(b for b in self.u.breaks if t < b < stop) + [stop]
+        rows, k_out, stalled, t_last = [], 0, 0, -math.inf
+        while True:
+            contact, y = self._settle(t, y, contact)
+            while k_out < len(grid) and grid[k_out] <= t + 1e-15 * max(1.0, t):
+                rows.append(self._row(float(grid[k_out]), y, contact))
+                k_out += 1
+            if t >= stop:
+                break
+            t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
+            steps = {}
+            if self.rebound > 0.0:
+                t_end = min(t_end, t + self.rebound)
+                steps = {"max_step": self.rebound / 8.0}
+                self.rebound = 0.0
+            events = self._events(contact)
+            sol = solve_ivp(self._rhs(contact), (t, t_end), y, method=self.method, rtol=self.rtol,
+                            atol=[self.atol] * STATE + [self.atol * 1e-2] * 3, events=events, dense_output=True,
+                            **steps)
+            if sol.status < 0:
+                raise RuntimeError(f"voltage follower reference: {sol.message}")
+            t_new = float(sol.t[-1])
+            while k_out < len(grid) and grid[k_out] < t_new:
+                rows.append(self._row(float(grid[k_out]), list(sol.sol(grid[k_out])), contact))
+                k_out += 1
+            y = list(sol.y[:, -1])
+            if sol.status == 1:
+                fired = next(j for j, te in enumerate(sol.t_events) if len(te))
+                stalled = stalled + 1 if t_new - t_last <= 1e-14 * max(1.0, t_new) else 0
+                if stalled > MAX_STALL:
+                    raise RuntimeError(f"voltage follower reference: {MAX_STALL} events at t = {t_new!r} s without end")
+                t_last = t_new
+                contact, y = self._transition(t_new, y, contact, events[fired].kind)
+            t = t_new
+        result = {"time": grid.copy()}
+        for name in rows[0]:
+            result[name] = np.array([row[name] for row in rows])
+        return result
+
+    def _rhs(self, contact: float):
+        body, u, energy = self.body, self.u, self.energy
+        R, M_f = body.model.R, body.M_f
+
+        def rhs(t, y):
+            u_t = u.value(t)
+            dy = body.rates(y[:STATE], u_t, contact)
+            i = body.current(y[1], y[2], u_t)
+            return dy + ([u_t * i, R * i * i, M_f * abs(y[1])] if energy else [0.0, 0.0, 0.0])
+        return rhs
+
+    def _events(self, contact: float) -> list:
+        body, u = self.body, self.u
+        events = []
+
+        def add(kind: str, fn) -> None:
+            fn.terminal, fn.direction, fn.kind = True, -1, kind
+            events.append(fn)
+
+        add("stop", lambda t, y: y[1])
+        if contact:
+            add("lift-off", lambda t, y: body.contact_force(y[:STATE], u.value(t)))
+        else:
+            add("touch-down", lambda t, y: body.gap(y) + TOUCH)
+        return events
+
+    def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
+        body, u_t = self.body, self.u.value(t)
+        if kind == "stop":
+            raise RuntimeError(f"voltage follower reference: the shaft stops at t = {t!r} s; its static friction "
+                               "with a spring-closed follower of its own is not modelled (docs/model.md 13.6)")
+        if kind == "lift-off":
+            s, s1, _, _ = body.program.derivatives(y[0])
+            self.lift_offs.append((t, s, s1 * y[1]))
+            return 0.0, y[:3] + [s, s1 * y[1]] + y[STATE:]
+        s1 = body.program.derivatives(y[0])[1]
+        w_before = y[4] - s1 * y[1]
+        after, state, hit = body.land(y[:STATE], u_t)
+        self.loss += hit.loss
+        w = state[4] - s1 * state[1]
+        self.impacts.append((t, w_before, w))
+        if after == 0.0 and w != 0.0:
+            self.rebound = abs(w) / (2.0 * body.acceleration_scale(state, u_t))
+        return after, state + y[STATE:]
+
+    def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
+        """On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s'')."""
+        if contact:
+            s, s1, _, _ = self.body.program.derivatives(y[0])
+            y = y[:3] + [s, s1 * y[1]] + y[STATE:]
+            if self.body.contact_force(y[:STATE], self.u.value(t)) < 0.0:
+                self.lift_offs.append((t, y[3], y[4]))
+                return 0.0, y
+        return contact, y
+
+    def _row(self, t: float, y, contact: float) -> dict[str, float]:
+        row = self.body.outputs([float(x) for x in y[:STATE]], self.u.value(t), contact)
+        row["impacts"] = float(len(self.impacts))
+        if self.energy:
+            row.update(E_in=float(y[5]), E_copper=float(y[6]), E_shaft=float(y[7]), E_guide=0.0, E_damp=0.0,
+                       E_impact=self.loss)
+        return row
+
+
+def follower_voltage_reference(model, grid: np.ndarray, u: Signal, options: dict) -> dict[str, np.ndarray]:
+    """The consistent voltage drive with a spring-closed follower of its own, on the output grid."""
+    run = VoltageFollowerRun(model, u, options["rtol"], options["atol"], options["energy"], options["method"])
+    return run.run(grid)
