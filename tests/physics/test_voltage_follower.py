@@ -138,8 +138,3 @@ def test_what_is_not_modelled_is_refused_with_the_reason_by_both(params, words):
         DriveSimulator(params)
     assert str(engine.value) == str(python.value)
 
-
-def test_the_engine_refuses_the_voltage_drive_with_a_spring_the_reference_computes():
-    DriveModel(SPRING)
-    with pytest.raises(ParameterError, match="the C engine, and so the FMUs, computes the follower's own motion"):
-        DriveSimulator(SPRING)

@@ -365,10 +365,7 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'omega0' = %s rad/s: the shaft's static friction with a "
                          "follower of its own is not modelled yet (the run is refused where the shaft stops); allowed "
                          "with closure 'spring' and drive 'voltage': omega0 > 0", cam_num(v[CAM_P_OMEGA0], a));
-    return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = 'spring' with drive 'voltage': the C engine, and "
-                     "so the FMUs, computes the follower's own motion with the speed drive only (the scipy reference "
-                     "computes this case, docs/model.md 13.6); allowed in the engine with drive 'voltage': closure "
-                     "'kinematic'");
+    return CAM_OK;   /* voltage_follower.c */
 }
 
 /* The sine or cosine `value` of a mounting angle [rad], exactly 0 where the angle makes it 0 to within a few of
