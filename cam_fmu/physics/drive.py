@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import FOLLOWER_DRIVES, RIGID_ONLY, ParameterError, law_spec, mounting_component, resolve
+from .parameters import FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError, law_spec, mounting_component, resolve
 
 
 def sign(x: float) -> float:
@@ -105,7 +105,7 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
         raise ParameterError(f"{voltage}: flight across a groove's clearance is computed with the speed drive only "
                              "(not modelled yet on a voltage-driven cam); allowed with drive 'voltage': closure "
                              "'kinematic' or 'spring'")
-    if p["formulation"] != "consistent":
+    if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
         raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
                              "with it: formulation 'consistent'")
     if p["k_shaft"] > 0.0:
