@@ -19,7 +19,8 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError, law_spec, mounting_component, resolve
+from .parameters import (FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError, law_spec,
+                         mounting_component, resolve)
 
 
 def sign(x: float) -> float:
