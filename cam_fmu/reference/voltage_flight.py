@@ -10,20 +10,20 @@ impacts (touch-downs so far) and, with energy, the integrals and E_impact (the i
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..physics.signals import Signal
 from ..physics.voltage_follower import VoltageFollower
-from .flight import MAX_STALL, TOUCH
+from .flight import TOUCH, PieceRun
 
 STATE = 5  # theta, omega, i, s, v; then the energy integrals
 
 
-class VoltageFollowerRun:
+class VoltageFollowerRun(PieceRun):
     """One run of the voltage drive with a spring-closed follower of its own."""
+
+    label = "voltage follower reference"
 
     def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
         self.body = VoltageFollower(model)
@@ -42,46 +42,13 @@ class VoltageFollowerRun:
         theta0, omega0 = p["theta0"], p["omega0"]
         s_cam, s1, _, _ = body.program.derivatives(theta0)
         y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0] + [0.0, 0.0, 0.0]
-        contact = 1.0
-        t, stop = float(grid[0]), float(grid[-1])
-        breaks = sorted(b for b in self.u.breaks if t < b < stop) + [stop]
-        rows, k_out, stalled, t_last = [], 0, 0, -math.inf
-        while True:
-            contact, y = self._settle(t, y, contact)
-            while k_out < len(grid) and grid[k_out] <= t + 1e-15 * max(1.0, t):
-                rows.append(self._row(float(grid[k_out]), y, contact))
-                k_out += 1
-            if t >= stop:
-                break
-            t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
-            steps = {}
-            if self.rebound > 0.0:
-                t_end = min(t_end, t + self.rebound)
-                steps = {"max_step": self.rebound / 8.0}
-                self.rebound = 0.0
-            events = self._events(contact)
-            sol = solve_ivp(self._rhs(contact), (t, t_end), y, method=self.method, rtol=self.rtol,
-                            atol=[self.atol] * STATE + [self.atol * 1e-2] * 3, events=events, dense_output=True,
-                            **steps)
-            if sol.status < 0:
-                raise RuntimeError(f"voltage follower reference: {sol.message}")
-            t_new = float(sol.t[-1])
-            while k_out < len(grid) and grid[k_out] < t_new:
-                rows.append(self._row(float(grid[k_out]), list(sol.sol(grid[k_out])), contact))
-                k_out += 1
-            y = list(sol.y[:, -1])
-            if sol.status == 1:
-                fired = next(j for j, te in enumerate(sol.t_events) if len(te))
-                stalled = stalled + 1 if t_new - t_last <= 1e-14 * max(1.0, t_new) else 0
-                if stalled > MAX_STALL:
-                    raise RuntimeError(f"voltage follower reference: {MAX_STALL} events at t = {t_new!r} s without end")
-                t_last = t_new
-                contact, y = self._transition(t_new, y, contact, events[fired].kind)
-            t = t_new
-        result = {"time": grid.copy()}
-        for name in rows[0]:
-            result[name] = np.array([row[name] for row in rows])
-        return result
+        t = float(grid[0])
+        contact, y = self._settle(t, y, 1.0)
+        return self.pieces(grid, t, y, contact, sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
+
+    def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
+        return self._events(contact), self._rhs(contact), {"method": self.method,
+                                                           "atol": [self.atol] * STATE + [self.atol * 1e-2] * 3}
 
     def _rhs(self, contact: float):
         body, u, energy = self.body, self.u, self.energy
@@ -112,7 +79,7 @@ class VoltageFollowerRun:
     def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
         body, u_t = self.body, self.u.value(t)
         if kind == "stop":
-            raise RuntimeError(f"voltage follower reference: the shaft stops at t = {t!r} s; its static friction "
+            raise RuntimeError(f"{self.label}: the shaft stops at t = {t!r} s; its static friction "
                                "with a spring-closed follower of its own is not modelled (docs/model.md 13.6)")
         if kind == "lift-off":
             s, s1, _, _ = body.program.derivatives(y[0])
