@@ -106,3 +106,20 @@ def test_the_shaft_stopping_is_refused_with_the_reason():
 def test_the_engine_refuses_what_it_does_not_compute():
     with pytest.raises(ParameterError, match="flight across a groove's clearance"):
         DriveSimulator(dict(closure="form", c=1e-3, omega0=60.0))
+
+
+@pytest.mark.parametrize("change, u", [
+    (dict(k_spring=0.0, F_spring0=30.0), 11.0),          # a preload only: parabolic flight, 0.24 m off the cam
+    (dict(F_spring0=0.0, k_spring=900.0), 11.0),         # no preload: 12 touch-downs
+    (dict(restitution=1.0, omega0=120.0, J_cam=0.2), 20.0),   # e = 1 at twice the speed: 0.54 m off the cam
+])
+def test_extremes_are_the_reference(change, u):
+    from cam_fmu.physics.signals import constant
+    from cam_fmu.reference.integrate import simulate_reference
+    params = dict(SCENE.primary.params, **change)
+    ref = simulate_reference(params, 0.12, 1e-4, u=constant(u))
+    got = engine_run(params, u, ref["time"])
+    assert np.max(ref["s"] - ref["s_cam"]) > 1e-3
+    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10            # m (measured 9e-12)
+    assert np.max(np.abs(got["omega"] - ref["omega"])) < 1e-7     # rad/s (measured 3e-9)
+    assert np.min(got["s"] - got["s_cam"]) >= -2e-12
