@@ -52,7 +52,7 @@ class PieceRun:
             events, rhs, options = self._piece(t, y, contact)
             if self.rebound > 0.0:  # the first piece after a rebound is shorter than the bounce it starts
                 t_end = min(t_end, t + self.rebound)
-                options["max_step"] = self.rebound / 8.0
+                options["max_step"] = min(options.get("max_step", math.inf), self.rebound / 8.0)
                 self.rebound = 0.0
             sol = solve_ivp(rhs, (t, t_end), y, rtol=self.rtol, events=events, dense_output=True, **options)
             if sol.status < 0:

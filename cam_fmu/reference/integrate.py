@@ -244,7 +244,7 @@ class _Consistent:
 
 def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """The consistent formulation: scipy at tight tolerances, stopping at every event and breakpoint."""
-    if model.closure == "spring":  # the follower's own state (docs/model.md 13.6)
+    if model.closure == "spring" or (model.closure == "form" and model.c > 0.0):  # its own state (model.md 13.6)
         return follower_voltage_reference(model, grid, u, options)
     return _Consistent(model, u, options["rtol"], options["atol"], options["energy"], options["method"]).run(grid)
 

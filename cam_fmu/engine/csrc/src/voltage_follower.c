@@ -22,7 +22,7 @@
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define NY 5
 
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_DOWN };
+enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN };   /* touch-down on flank +1, -1 */
 
 static double sgn(double x)
 {
@@ -41,12 +41,20 @@ static double closing(const CamModel *m, double s)
     return m->F_spring0 + m->k_spring * s - m->F_gx;
 }
 
-/* On the flank at y: d = (s, s', s'', s'''), omega_dot [rad/s2] and the contact force P [N] of the coupled equations. */
-static void on_flank(const CamModel *m, const double y[NY], double u, double d[4], double *omega_dot, double *P)
+/* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
+static double clearance(const CamModel *m)
+{
+    return m->closure == CAM_CHOICE_CLOSURE_FORM ? m->c : 0.0;
+}
+
+/* On the flank `contact` at y: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the force P [N] along X of the
+ * coupled equations. */
+static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                     double *P)
 {
     double omega = y[1], F;
     cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0]);
+    F = closing(m, d[0] - contact * clearance(m));
     *omega_dot = (torque(m, y, u) - (m->m * d[2] * omega * omega + F) * d[1]) / (m->J_0 + m->m * d[1] * d[1]);
     *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
 }
@@ -57,7 +65,7 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[2] = m->has_current ? (u - m->R * y[2] - m->c_e * y[1]) / m->L : 0.0;
     if (contact) {
         double d[4], P;
-        on_flank(m, y, u, d, &dy[1], &P);
+        on_flank(m, y, u, contact, d, &dy[1], &P);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
@@ -67,12 +75,12 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[4] = -closing(m, y[3]) / m->m;
 }
 
-/* The follower set on the flank at y's angle, moving with it. */
-static void set_on_flank(const CamModel *m, double y[NY])
+/* The follower set on the flank `contact` at y's angle, moving with it. */
+static void set_on_flank(const CamModel *m, double y[NY], int contact)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0];
+    y[3] = d[0] - contact * clearance(m);
     y[4] = d[1] * y[1];
 }
 
@@ -94,21 +102,21 @@ static void rk4(const CamModel *m, double u, int contact, const double y[NY], do
     for (j = 0; j < NY; j++)
         out[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
     if (contact)
-        set_on_flank(m, out);
+        set_on_flank(m, out, contact);
 }
 
-/* The event function `code` at y (> 0: nothing happens). */
-static double event_value(const CamModel *m, double u, int code, const double y[NY])
+/* The event function `code` at y on or off the flank `contact` (> 0: nothing happens). */
+static double event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
 {
     double d[4], omega_dot, P;
     if (code == EV_STOP)
         return y[1];
     if (code == EV_LIFT_OFF) {
-        on_flank(m, y, u, d, &omega_dot, &P);
-        return P;
+        on_flank(m, y, u, contact, d, &omega_dot, &P);
+        return contact * P;
     }
     cam_profile_eval(&m->profile, y[0], d);
-    return y[3] - d[0] + TOUCH;
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - clearance(m)) + TOUCH : (d[0] + clearance(m)) - y[3] + TOUCH;
 }
 
 static int crossed(double before, double after)
@@ -133,13 +141,14 @@ static void impact(const CamModel *m, double y[NY], double s1, double e)
     y[1] -= s1 * P / m->J_0;
 }
 
-/* A touch-down at y (voltage_follower.land): the contact after; y's follower on the flank, omega and v after. */
-static int land(const CamModel *m, double y[NY], double u, double *rebound)
+/* A touch-down on the flank `flank` at y (voltage_follower.land): the contact after; y's follower on the flank,
+ * omega and v after. */
+static int land(const CamModel *m, double y[NY], double u, int flank, double *rebound)
 {
     double d[4], before[NY], w, omega_dot, P, scale = acceleration_scale(m, y, u);
     memcpy(before, y, sizeof before);
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0];
+    y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], m->restitution);
     w = y[4] - d[1] * y[1];
     if (w * w >= 2.0 * scale * ZENO_HEIGHT) {
@@ -147,11 +156,11 @@ static int land(const CamModel *m, double y[NY], double u, double *rebound)
         return 0;
     }
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0];
+    y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], 0.0);
     y[4] = d[1] * y[1];
-    on_flank(m, y, u, d, &omega_dot, &P);
-    return P >= 0.0;
+    on_flank(m, y, u, flank, d, &omega_dot, &P);
+    return flank * P >= 0.0 ? flank : 0;
 }
 
 static void load_y(const CamDrive *d, double y[NY])
@@ -174,28 +183,36 @@ static void store_y(CamDrive *d, const double y[NY])
     d->speed.speed = y[1];
 }
 
-/* On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s''). */
+/* On the flank `contact`: the follower set on it, or lifted off at once where contact P is already < 0 (a jump of
+ * s''): the contact after. */
 static int settle(const CamModel *m, double y[NY], double u, int contact)
 {
     double d[4], omega_dot, P;
     if (!contact)
         return 0;
-    set_on_flank(m, y);
-    on_flank(m, y, u, d, &omega_dot, &P);
-    return P >= 0.0;
+    set_on_flank(m, y, contact);
+    on_flank(m, y, u, contact, d, &omega_dot, &P);
+    return contact * P >= 0.0 ? contact : 0;
 }
 
 static int vf_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
-    double y[NY];
+    double y[NY], other[NY];
+    int contact;
     (void)err;
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
     d->form_u = d->u;
     memset(&d->speed, 0, sizeof d->speed);
     d->speed.contact = 1.0;
     load_y(d, y);
-    d->speed.contact = settle(&d->model, y, d->u, 1) ? 1.0 : 0.0;
+    contact = settle(&d->model, y, d->u, 1);
+    if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
+        memcpy(other, y, sizeof other);
+        if ((contact = settle(&d->model, other, d->u, -1)) != 0)
+            memcpy(y, other, sizeof other);
+    }
+    d->speed.contact = contact;
     store_y(d, y);
     return CAM_OK;
 }
@@ -213,7 +230,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     double y[NY], next[NY], trial[NY], u = d->form_u, tau = 0.0, rebound = d->speed.rebound;
     double wn = m->k_spring > 0.0 ? sqrt(m->k_spring / m->m) : 0.0;
     double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / (m->J_0 * m->L)) : 0.0;
-    int contact = d->speed.contact != 0.0, events = 0;
+    int contact = (int)d->speed.contact, events = 0;
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
     load_y(d, y);
@@ -221,7 +238,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
-        int codes[2], n = 0, k, code = EV_NONE;
+        int codes[3], n = 0, k, code = EV_NONE;
         double dt = h - tau, at = dt;
         if (y[1] != 0.0)
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
@@ -237,18 +254,24 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              time, time + tau, dt, contact, rebound);
         rk4(m, u, contact, y, dt, next);
         codes[n++] = EV_STOP;
-        codes[n++] = contact ? EV_LIFT_OFF : EV_TOUCH_DOWN;
+        if (contact)
+            codes[n++] = EV_LIFT_OFF;
+        else {
+            codes[n++] = EV_TOUCH_UP;
+            if (m->closure == CAM_CHOICE_CLOSURE_FORM)
+                codes[n++] = EV_TOUCH_DOWN;
+        }
         at = dt;
         for (k = 0; k < n; k++) {
-            double lo = 0.0, hi = dt, before = event_value(m, u, codes[k], y);
-            if (!crossed(before, event_value(m, u, codes[k], next)))
+            double lo = 0.0, hi = dt, before = event_value(m, u, codes[k], contact, y);
+            if (!crossed(before, event_value(m, u, codes[k], contact, next)))
                 continue;
             while (hi - lo > 0.0) {
                 double mid = 0.5 * (lo + hi);
                 if (mid <= lo || mid >= hi)
                     break;
                 rk4(m, u, contact, y, mid, trial);
-                if (crossed(before, event_value(m, u, codes[k], trial)))
+                if (crossed(before, event_value(m, u, codes[k], contact, trial)))
                     hi = mid;
                 else
                     lo = mid;
@@ -278,28 +301,29 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             return cam_error(err, CAM_ERR_SIMULATION, "the shaft stops at t = %.9g s: its static friction with a "
                              "spring-closed follower of its own is not modelled (docs/model.md 13.6)", time + tau);
         if (code == EV_LIFT_OFF) {
-            set_on_flank(m, y);
+            set_on_flank(m, y, contact);
+            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d at "
+                              "t = %.9g s (theta = %.6g rad); ", contact, time + tau, y[0]);
             contact = 0;
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
-                              "(theta = %.6g rad); ", time + tau, y[0]);
         } else {
             double dd[4], w_before, w_after;
+            int flank = code == EV_TOUCH_UP ? 1 : -1;
             cam_profile_eval(&m->profile, y[0], dd);
             w_before = y[4] - dd[1] * y[1];
             rebound = 0.0;
-            contact = land(m, y, u, &rebound);
+            contact = land(m, y, u, flank, &rebound);
             w_after = y[4] - dd[1] * y[1];
             d->speed.impacts += 1.0;
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: touch-down at t = %.9g s "
-                              "(theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", time + tau, y[0],
-                              w_before, w_after);
+            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: touch-down on flank %+d at "
+                              "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank,
+                              time + tau, y[0], w_before, w_after);
         }
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more", dropped);
     store_y(d, y);
-    d->speed.contact = contact ? 1.0 : 0.0;
+    d->speed.contact = contact;
     d->speed.rebound = rebound;
     d->mode.direction = y[1] >= 0.0 ? 1.0 : -1.0;
     *steps = taken;
@@ -319,12 +343,13 @@ static void vf_outputs(CamDrive *d, double out[])
     load.s_cam = dd[0];
     load.f = 0.0;
     if (d->speed.contact != 0.0) {
-        on_flank(m, y, d->form_u, dd, &omega_dot, &P);
+        int contact = (int)d->speed.contact;
+        on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         load.M = m->M_f * sgn(y[1]) + P * dd[1];
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
-        y[3] = dd[0];
+        y[3] = dd[0] - contact * clearance(m);
     } else {
         load.M = m->M_f * sgn(y[1]);
         load.J = m->J_0;
