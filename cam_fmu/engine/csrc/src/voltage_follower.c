@@ -1,10 +1,11 @@
-/* The spring-closed follower as a body of its own on a voltage-driven cam: the consistent formulation with a rigid
- * shaft and no guide friction (docs/model.md section 13.6; its check is the reference's physics/voltage_follower.py
- * and reference/voltage_flight.py, written independently). y = (theta, omega, i, s, v): theta, omega, i in d->x,
- * the follower's s, v, contact (1 on the flank, 0 in flight), touch-downs and the rebound guard in d->speed (saved
+/* The follower as a body of its own on a voltage-driven cam, closures 'spring' and 'form' (a groove's flanks at
+ * s_cam - c, contact +1, and s_cam + c, contact -1): the consistent formulation with a rigid shaft and no guide
+ * friction (docs/model.md section 13.6; its check is the reference's physics/voltage_follower.py and
+ * reference/voltage_flight.py, written independently). y = (theta, omega, i, s, v): theta, omega, i in d->x,
+ * the follower's s, v, contact (+1, -1 on a flank, 0 in flight), touch-downs and the rebound guard in d->speed (saved
  * with the state). In contact J omega_dot = c_m i - M_f sgn(omega) - (m s'' omega^2 + F_close) s' with J = J_0 + m
- * s'^2 and the contact force P = m (s'' omega^2 + s' omega_dot) + F_close along X; lift-off where P reaches 0; in
- * flight J_0 omega_dot = c_m i - M_f sgn(omega) and m s_dd = -F_close(s); touch-down where the gap reaches -TOUCH,
+ * s'^2 and the force P = m (s'' omega^2 + s' omega_dot) + F_close along X; lift-off where contact P reaches 0; in
+ * flight J_0 omega_dot = c_m i - M_f sgn(omega) and m s_dd = -F_close(s); touch-down where a gap reaches -TOUCH,
  * an impact exchanging momentum with the shaft (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic
  * Runge-Kutta steps of at most STEP_ANGLE of cam angle and STEP_PHASE of the flight's period; an event function
  * gone from > 0 to <= 0 over a step is located by bisection on the step's length. A shaft that stops is refused. */
