@@ -203,6 +203,8 @@ static int vf_init(CamDrive *d, CamError *err)
     int contact;
     (void)err;
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
+    d->mode.contact = 1;   /* the kinematic backlash's mode is not this follower's (d->speed.contact is): held engaged */
+    d->mode.s_free = 0.0;
     d->form_u = d->u;
     memset(&d->speed, 0, sizeof d->speed);
     d->speed.contact = 1.0;
