@@ -26,7 +26,57 @@ MAX_STALL = 1000
 TOUCH = 1e-12
 
 
-class FollowerRun:
+class PieceRun:
+    """A hybrid run integrated piece by piece with solve_ivp (the follower's runs here and in voltage_flight.py).
+
+    Subclasses give ``_piece`` (events, right-hand side and solve_ivp options of the mode), ``_settle``,
+    ``_transition``, ``_row`` and set ``rtol``, ``rebound`` (s, the first piece after a rebound kept shorter than the
+    bounce, or 0) and ``label`` (the errors' prefix).
+    """
+
+    label = "follower reference"
+
+    def pieces(self, grid: np.ndarray, t: float, y: list, contact: float, breaks: list[float]) -> dict[str, np.ndarray]:
+        """Rows on ``grid`` from (t, y, contact), stopping at each event and input break [s]."""
+        stop = float(grid[-1])
+        breaks = breaks + [stop]
+        rows, k_out, stalled, t_last = [], 0, 0, -math.inf
+        while True:
+            while k_out < len(grid) and grid[k_out] <= t + 1e-15 * max(1.0, t):
+                rows.append(self._row(float(grid[k_out]), y, contact))
+                k_out += 1
+            if t >= stop:
+                break
+            contact, y = self._settle(t, y, contact)
+            t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
+            events, rhs, options = self._piece(t, y, contact)
+            if self.rebound > 0.0:  # the first piece after a rebound is shorter than the bounce it starts
+                t_end = min(t_end, t + self.rebound)
+                options["max_step"] = min(options.get("max_step", math.inf), self.rebound / 8.0)
+                self.rebound = 0.0
+            sol = solve_ivp(rhs, (t, t_end), y, rtol=self.rtol, events=events, dense_output=True, **options)
+            if sol.status < 0:
+                raise RuntimeError(f"{self.label}: {sol.message}")
+            t_new = float(sol.t[-1])
+            while k_out < len(grid) and grid[k_out] < t_new:  # outputs inside this piece, from its dense output
+                rows.append(self._row(float(grid[k_out]), list(sol.sol(grid[k_out])), contact))
+                k_out += 1
+            y = list(sol.y[:, -1])
+            if sol.status == 1:
+                fired = next(j for j, te in enumerate(sol.t_events) if len(te))
+                stalled = stalled + 1 if t_new - t_last <= 1e-14 * max(1.0, t_new) else 0
+                if stalled > MAX_STALL:
+                    raise RuntimeError(f"{self.label}: {MAX_STALL} events at t = {t_new!r} s without end")
+                t_last = t_new
+                contact, y = self._transition(t_new, y, contact, events[fired].kind)
+            t = t_new
+        result = {"time": grid.copy()}
+        for name in rows[0]:
+            result[name] = np.array([row[name] for row in rows])
+        return result
+
+
+class FollowerRun(PieceRun):
     """One run of the speed drive with the follower's own state."""
 
     def __init__(self, model, omega_ref: Signal, rtol: float, atol: float) -> None:
@@ -57,49 +107,12 @@ class FollowerRun:
         contact = self._start_contact(t, theta0, s_cam, s1 * omega)
         side = contact if contact != 0.0 else 1.0  # which flank the follower starts on (+1 if flying)
         y = [theta0, s_cam - side * body.c, s1 * omega]
-        stop = float(grid[-1])
-        breaks = sorted(b for b in self.omega_ref.breaks if t < b < stop) + [stop]
-        rows, k_out, stalled, t_last = [], 0, 0, -math.inf
-        while True:
-            while k_out < len(grid) and grid[k_out] <= t + 1e-15 * max(1.0, t):
-                rows.append(self._row(float(grid[k_out]), y, contact))
-                k_out += 1
-            if t >= stop:
-                break
-            contact, y = self._settle(t, y, contact)
-            t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
-            sigma = self._direction(y)
-            events = self._events(contact, sigma)
-            steps = {}
-            if self.rebound > 0.0:  # the first piece after a rebound is shorter than the bounce it starts
-                t_end = min(t_end, t + self.rebound)
-                steps = {"max_step": self.rebound / 8.0}
-                self.rebound = 0.0
-            sol = solve_ivp(self._rhs(contact, sigma), (t, t_end), y, method="DOP853", rtol=self.rtol,
-                            atol=self.atol, events=events, dense_output=True, **steps)
-            if sol.status < 0:
-                raise RuntimeError(f"follower reference: {sol.message}")
-            t_new = float(sol.t[-1])
-            while k_out < len(grid) and grid[k_out] < t_new:  # outputs inside this piece, from its dense output
-                rows.append(self._row(float(grid[k_out]), list(sol.sol(grid[k_out])), contact))
-                k_out += 1
-            y = list(sol.y[:, -1])
-            if sol.status == 1:
-                fired = next(j for j, te in enumerate(sol.t_events) if len(te))
-                stalled = stalled + 1 if t_new - t_last <= 1e-14 * max(1.0, t_new) else 0
-                if stalled > MAX_STALL:
-                    raise RuntimeError(f"follower reference: {MAX_STALL} events at t = {t_new!r} s without end")
-                t_last = t_new
-                contact, y = self._transition(t_new, y, contact, events[fired].kind)
-            t = t_new
-        return self._collect(rows, grid)
+        breaks = sorted(b for b in self.omega_ref.breaks if t < b < float(grid[-1]))
+        return self.pieces(grid, t, y, contact, breaks)
 
-    @staticmethod
-    def _collect(rows: list[dict], grid: np.ndarray) -> dict[str, np.ndarray]:
-        result = {"time": grid.copy()}
-        for name in rows[0]:
-            result[name] = np.array([row[name] for row in rows])
-        return result
+    def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
+        sigma = self._direction(y)
+        return self._events(contact, sigma), self._rhs(contact, sigma), {"method": "DOP853", "atol": self.atol}
 
     # ------------------------------------------------------------- the hybrid system
     def _direction(self, y: list) -> float:

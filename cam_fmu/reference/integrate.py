@@ -30,6 +30,7 @@ from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference
+from .voltage_flight import follower_voltage_reference
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 
@@ -243,6 +244,8 @@ class _Consistent:
 
 def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """The consistent formulation: scipy at tight tolerances, stopping at every event and breakpoint."""
+    if model.closure == "spring" or (model.closure == "form" and model.c > 0.0):  # its own state (model.md 13.6)
+        return follower_voltage_reference(model, grid, u, options)
     return _Consistent(model, u, options["rtol"], options["atol"], options["energy"], options["method"]).run(grid)
 
 

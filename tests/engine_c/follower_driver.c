@@ -1,6 +1,6 @@
 /* The follower as a body of its own (cam_fmu/engine/csrc/src/follower.c) under AddressSanitizer and UBSan:
- * spring-closed and groove drives at imposed speed with bounces, a saved state taken in flight and restored,
- * and the refusals of contradicting parameters.
+ * spring-closed and groove drives at imposed speed with bounces, a spring-closed and a groove cam in the voltage
+ * drive (voltage_follower.c), a saved state taken in flight and restored, and the refusals of contradicting parameters.
  *
  *   follower_driver
  *
@@ -38,9 +38,18 @@ static void set_real(CamInstance *d, const char *name, double value)
 static CamInstance *drive(const char *closure, double e, double omega)
 {
     CamInstance *d = cam_instance_new();
+    int voltage = omega < 0.0;   /* the voltage drive at u = -omega V from 60 rad/s on a flywheel */
     if (!d) abort();
-    set_string(d, "drive", "speed");
+    set_string(d, "drive", voltage ? "voltage" : "speed");
     set_string(d, "closure", closure);
+    if (voltage) {
+        set_real(d, "mu", 0.0);
+        set_real(d, "omega0", strcmp(closure, "form") ? 60.0 : 10.0);
+        set_real(d, "J_cam", 0.05);
+        set_real(d, "gamma", 3.141592653589793);
+        set_real(d, "u", -omega);
+        omega = 0.0;
+    }
     set_real(d, "restitution", e);
     if (!strcmp(closure, "spring")) {
         set_real(d, "k_spring", 800.0);
@@ -72,10 +81,10 @@ static double run(CamInstance *d, int k0, int k1)
 
 int main(void)
 {
-    static const char *closures[] = {"spring", "spring", "form"};
-    static const double es[] = {0.5, 1.0, 0.0}, omegas[] = {60.0, 90.0, 10.0};
+    static const char *closures[] = {"spring", "spring", "form", "spring", "form"};
+    static const double es[] = {0.5, 1.0, 0.0, 0.5, 0.5}, omegas[] = {60.0, 90.0, 10.0, -11.0, -1.6};
     int c;
-    for (c = 0; c < 3; c++) {
+    for (c = 0; c < 5; c++) {
         CamInstance *d = drive(closures[c], es[c], omegas[c]);
         unsigned vr_s = vr_of("s"), vr_s_cam = vr_of("s_cam");
         double s, s_cam, first, again;
@@ -88,7 +97,7 @@ int main(void)
             k++;
             if (cam_instance_get_real(d, vr_s, &s) != CAM_OK || cam_instance_get_real(d, vr_s_cam, &s_cam) != CAM_OK)
                 abort();
-        } while ((c == 2 ? fabs(fabs(s - s_cam) - 5e-4) : s - s_cam) < 1e-6 && k < 20000);   /* on a flank */
+        } while ((!strcmp(closures[c], "form") ? fabs(fabs(s - s_cam) - 5e-4) : s - s_cam) < 1e-6 && k < 20000);
         if (k >= 20000) abort();
         size = cam_instance_state_size(d);
         saved = malloc(size);
@@ -104,8 +113,8 @@ int main(void)
     }
     {   /* a refusal names its reason */
         CamInstance *d = cam_instance_new();
-        set_string(d, "closure", "spring");
-        if (cam_instance_initialize(d, 0.0) == CAM_OK || !strstr(cam_instance_message(d), "speed drive only")) abort();
+        set_string(d, "closure", "spring");   /* the voltage drive with the default guide friction */
+        if (cam_instance_initialize(d, 0.0) == CAM_OK || !strstr(cam_instance_message(d), "'mu'")) abort();
         cam_instance_free(d);
     }
     printf("ok\n");

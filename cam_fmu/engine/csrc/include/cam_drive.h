@@ -41,6 +41,7 @@ const CamFormulation *cam_formulation(CamFormulationId id);
 extern const CamFormulation cam_consistent;   /* consistent.c */
 extern const CamFormulation cam_paper;        /* paper.c */
 extern const CamFormulation cam_speed;        /* speed.c */
+extern const CamFormulation cam_voltage_follower;   /* voltage_follower.c: consistent, closure 'spring' */
 
 /* The fixed-step paper scheme's state (paper.PaperScheme: FIELDS and M_l), in SI units. */
 typedef struct {
@@ -64,6 +65,8 @@ void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, doub
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err);
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[]);
+/* Append one transition to a step's log line `events` of `len` bytes (*dropped counts what no longer fits). */
+void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...);
 
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
 typedef struct {

@@ -12,7 +12,8 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     memset(d, 0, sizeof *d);
     if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
         return status;
-    d->form = cam_formulation(d->model.formulation);
+    d->form = d->model.free_follower && d->model.formulation == CAM_FORM_CONSISTENT ? &cam_voltage_follower
+              : cam_formulation(d->model.formulation);
     if (d->form == NULL || cam_method(d->model.solver) == NULL) {   /* the generated choices and the registries */
         status = cam_error(err, CAM_ERR_PARAMETER, "formulation %d or solver %d is not in the engine",
                            (int)d->model.formulation, d->model.solver);

@@ -174,7 +174,7 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
 }
 
 /* Append one event to the step's log line while it has room (40 bytes kept for "and <n> more"); else count it. */
-static void note(char *events, size_t len, long *dropped, const char *format, ...)
+void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...)
 {
     size_t used = strlen(events);
     va_list args;
@@ -245,7 +245,7 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
                              "step of %g s (at theta = %g rad): refused, never a hang", MAX_EVENTS, h, theta);
         tau = at;
         if (code == EV_LIFT_OFF) {
-            note(events, events_len, &dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g rad); ",
+            cam_follower_note(events, events_len, &dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g rad); ",
                  (int)st->contact, time + at, theta);
             st->contact = 0.0;
             st->rebound = 0.0;
@@ -262,7 +262,7 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
             st->impacts += 1.0;
             if (w_after * w_after < 2.0 * acceleration_scale(&mo, theta, omega, omega_dot) * ZENO_HEIGHT)
                 w_after = 0.0;   /* the Zeno guard: a plastic impact */
-            note(events, events_len, &dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
+            cam_follower_note(events, events_len, &dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
                  "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time + at, theta, w, w_after);
             if (w_after != 0.0) {
                 st->v = v_after;

@@ -342,11 +342,26 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure '%s' moves the follower as a body "
                          "of its own, which needs its mass; allowed with it: m > 0 and follower_inertia true",
                          cam_num(v[CAM_P_M], a), closure);
-    if (model->formulation != CAM_FORM_SPEED)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s': the follower's own motion is computed "
-                         "with the speed drive only (its impacts on a voltage-driven cam are not modelled yet); "
-                         "allowed with drive 'voltage': closure 'kinematic'", closure);
-    return CAM_OK;
+    if (model->formulation == CAM_FORM_SPEED)
+        return CAM_OK;
+    /* The voltage drive: the reference's refusals (docs/model.md 13.6). */
+    if (model->formulation != CAM_FORM_CONSISTENT)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
+                         "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
+                         "'consistent'", closure);
+    if (v[CAM_P_K_SHAFT] > 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'k_shaft' = %s N.m/rad: a follower of its own on a "
+                         "compliant shaft is not modelled yet; allowed with drive 'voltage' and closure '%s': "
+                         "k_shaft = 0", cam_num(v[CAM_P_K_SHAFT], a), closure);
+    if (v[CAM_P_GUIDE_FRICTION] != 0.0 && v[CAM_P_MU] > 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'mu' = %s: guide friction with a follower of its own on a "
+                         "voltage-driven cam is not modelled yet; allowed with drive 'voltage' and closure '%s': "
+                         "mu = 0 (or guide_friction false)", cam_num(v[CAM_P_MU], a), closure);
+    if (!(v[CAM_P_OMEGA0] > 0.0))
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'omega0' = %s rad/s: the shaft's static friction with a "
+                         "follower of its own is not modelled yet (the run is refused where the shaft stops); allowed "
+                         "with drive 'voltage' and closure '%s': omega0 > 0", cam_num(v[CAM_P_OMEGA0], a), closure);
+    return CAM_OK;   /* voltage_follower.c */
 }
 
 /* The sine or cosine `value` of a mounting angle [rad], exactly 0 where the angle makes it 0 to within a few of

@@ -55,7 +55,10 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
  * kinetic energy and the shaft's elastic energy k (theta_m - theta)^2 / 2 (docs/model.md section 12). */
 static double mechanical(const CamEnergy *e, const double out[])
 {
-    double omega = out[CAM_O_OMEGA], twist, omega_m;
+    double omega = out[CAM_O_OMEGA], twist, omega_m, s = out[CAM_O_S], v = out[CAM_O_V];
+    if (e->own_follower)   /* the shaft's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
+        return 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s + 0.5 * e->k_spring * s * s
+               - e->F_gx * s;
     if (e->k_shaft == 0.0)
         return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S];
     twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];
@@ -76,6 +79,11 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
     e->work_abs = 0.0;
     e->k_shaft = m->compliant ? m->k_shaft : 0.0;
     e->J_m = m->J_m;
+    e->own_follower = m->free_follower && m->formulation == CAM_FORM_CONSISTENT;
+    e->J_0 = m->J_0;
+    e->m = m->m;
+    e->k_spring = m->k_spring;
+    e->F_spring0 = m->F_spring0;
     e->theta = out[CAM_O_THETA_M];
     e->i = i;
     e->e_mech0 = mechanical(e, out);

@@ -1,0 +1,159 @@
+"""The spring-closed follower on a voltage-driven cam in the scipy reference (physics/voltage_follower.py,
+reference/voltage_flight.py; docs/model.md section 13.6), against independent checks: the energy balance of
+section 9 with the spring's energy, the closed-form jump speed of a simple-harmonic rise on a heavy flywheel, the
+contact force from the numerically differentiated follower path, the closed-form flight, the restitution law.
+
+Jump speed of a simple-harmonic rise of lift h over the angle b: omega_jump^2 = (F0 + k h) / (m (h/2) (pi/b)^2).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cam_fmu.fmu.engine import DriveSimulator
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.follower import Flight
+from cam_fmu.physics.parameters import ParameterError
+from cam_fmu.physics.signals import constant
+from cam_fmu.reference.voltage_flight import VoltageFollowerRun
+from cam_fmu.reference.integrate import _grid, simulate_reference
+
+C_M = 0.015 * 9.80665
+# The paper's cam held by a return spring, horizontal, without guide friction, on a flywheel J_cam = 0.05 kg m2
+# (the spring's torque, up to 7 N m, is far beyond the motor's 0.09 N m: the flywheel carries the shaft through).
+SPRING = dict(drive="voltage", closure="spring", gamma=math.pi, F_spring0=20.0, k_spring=800.0, mu=0.0,
+              omega0=60.0, J_cam=0.05)
+U = 11.0  # V
+
+
+def run(params: dict, stop: float, interval: float, u: float = U, energy: bool = False):
+    model = DriveModel(params)
+    body = VoltageFollowerRun(model, constant(u), 1e-12, 1e-13, energy, None)
+    return model, body, body.run(_grid(stop, interval))
+
+
+def stored(model: DriveModel, r: dict) -> np.ndarray:
+    """J, the stored energy from the outputs: shaft and follower kinetic, spring F0 s + k s^2/2 (horizontal, L = 0)."""
+    return (0.5 * model.J_0 * r["omega"] ** 2 + 0.5 * model.m * r["v"] ** 2 + model.F_spring0 * r["s"]
+            + 0.5 * model.k_spring * r["s"] ** 2)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_energy_balance_holds_over_many_bounces(e):
+    """E_in - E_copper - E_shaft - E_impact = the change of the stored energy (section 9 with the spring); c_e = c_m."""
+    params = dict(SPRING, c_e=C_M, restitution=e, shaft_friction=False)
+    model, body, r = run(params, 0.3, 1e-4, energy=True)
+    assert len(body.impacts) >= 20 and len(body.lift_offs) >= 1  # e = 1: it never settles after the first
+    balance = r["E_in"] - r["E_copper"] - r["E_shaft"] - r["E_impact"] - (stored(model, r) - stored(model, r)[0])
+    scale = np.max(np.abs(r["E_in"])) + np.max(stored(model, r))
+    assert np.max(np.abs(balance)) < 1e-9 * scale, np.max(np.abs(balance))
+    if e == 1.0:
+        assert r["E_impact"][-1] == 0.0
+    else:
+        assert r["E_impact"][-1] > 1e-4
+
+
+def test_restitution_law_and_momentum_at_each_impact():
+    """Every touch-down above the Zeno guard sends the follower back at -e times its relative speed."""
+    model, body, r = run(dict(SPRING, restitution=0.5), 0.25, 1e-4)
+    bounces = [(before, after) for _, before, after in body.impacts if after != 0.0]
+    assert len(bounces) >= 10
+    for before, after in bounces:
+        assert before < 0.0 and after == pytest.approx(-0.5 * before, rel=1e-12, abs=1e-15)
+
+
+def test_less_than_elastic_settles_on_the_cam():
+    """e = 0.5: each sequence of bounces ends (Zeno guard) with the follower on the cam, finitely many impacts."""
+    model, body, r = run(dict(SPRING, restitution=0.5), 0.25, 1e-4)
+    assert r["contact"][-1] == 1.0 and r["s"][-1] == r["s_cam"][-1]
+    assert np.max(r["s"] - r["s_cam"]) > 1e-4 and 10 < len(body.impacts) < 200
+    assert np.all(r["s"] >= r["s_cam"] - 2e-12)  # never inside the cam by more than the touch-down's 1 pm
+
+
+@pytest.mark.parametrize("ratio, leaves", [(0.98, False), (1.02, True)])
+def test_jump_speed_on_a_heavy_flywheel_is_the_closed_form(ratio, leaves):
+    """J_cam = 100 kg m2 at u = c_e omega (no current): the cam turns at nearly constant speed, and the follower
+    leaves it iff omega > omega_jump of the simple-harmonic closed form."""
+    H, B, MASS, K, F0 = 0.05, math.pi, 0.4, 2000.0, 20.0
+    omega_jump = math.sqrt((F0 + K * H) / (MASS * H / 2 * (math.pi / B) ** 2))
+    omega = ratio * omega_jump
+    params = dict(SPRING, k_spring=K, F_spring0=F0, lift=H, rise_law="simple_harmonic",
+                  return_law="simple_harmonic", J_cam=100.0, omega0=omega, shaft_friction=False)
+    model, body, r = run(params, 2 * 2 * math.pi / omega, 2e-5, u=0.146 * omega)
+    assert np.max(np.abs(r["omega"] / omega - 1.0)) < 1e-4
+    assert (len(body.lift_offs) > 0) == leaves
+    assert (np.max(r["s"] - r["s_cam"]) > 1e-9) == leaves
+
+
+def test_contact_force_is_the_follower_path_differentiated():
+    """In contact N cos(alpha) = m s_dd + F0 + k s, with s_dd the numerical second difference of the output path:
+    the coupled equations' omega_dot inside N, checked without them (a light flywheel: omega swings by 8 %)."""
+    model, body, r = run(dict(SPRING, restitution=0.5), 0.1, 1e-5)
+    dt = 1e-5
+    s_dd = (r["s"][2:] - 2 * r["s"][1:-1] + r["s"][:-2]) / dt ** 2
+    inside = (r["contact"][2:] == 1) & (r["contact"][1:-1] == 1) & (r["contact"][:-2] == 1)
+    force = r["N_contact"][1:-1] * np.cos(r["alpha"][1:-1])
+    closed = model.m * s_dd + model.F_spring0 + model.k_spring * r["s"][1:-1]
+    assert np.count_nonzero(inside) > 5000 and np.ptp(r["omega"]) > 1.0
+    assert np.max(np.abs((force - closed)[inside])) < 1e-3 * np.max(np.abs(force))
+    assert np.all(r["N_contact"] >= 0.0) and np.all(r["N_contact"][r["contact"] == 0] == 0.0)
+
+
+def test_flight_is_the_closed_form_until_touch_down():
+    """From each located lift-off to the next touch-down the follower's path is Flight.state, to 1e-9 m."""
+    model, body, r = run(dict(SPRING, restitution=0.0), 0.25, 1e-5)
+    flight = Flight(model.m, model.k_spring, model.F_spring0, model.F_gx)
+    checked = 0
+    for t_lift, s0, v0 in body.lift_offs:
+        land = min((t for t, _, _ in body.impacts if t > t_lift), default=math.inf)
+        rows = np.flatnonzero((r["time"] > t_lift) & (r["time"] < land))
+        for k in rows:
+            assert r["s"][k] == pytest.approx(flight.state(r["time"][k] - t_lift, s0, v0)[0], abs=1e-9)
+        checked += len(rows)
+    assert checked > 100
+
+
+def test_the_reference_dispatches_the_voltage_follower():
+    """simulate_reference runs the spring closure in the voltage drive; the shaft's stop is refused, not stepped over."""
+    r = simulate_reference(dict(SPRING, restitution=0.5), 0.1, 1e-3, u=constant(U))
+    assert r["impacts"][-1] > 0 and "N_contact" in r
+    with pytest.raises(RuntimeError, match="shaft stops"):
+        simulate_reference(dict(SPRING, J_cam=2e-3), 0.25, 1e-3, u=constant(U))
+
+
+@pytest.mark.parametrize("params, words", [
+    (dict(SPRING, formulation="paper"), "formulation 'consistent'"),
+    (dict(SPRING, k_shaft=100.0), "'k_shaft'"),
+    (dict(SPRING, mu=0.001), "'mu'"),
+    (dict(SPRING, omega0=0.0), "'omega0'"),
+])
+def test_what_is_not_modelled_is_refused_with_the_reason_by_both(params, words):
+    """The reference and the C engine refuse the same cases with the same words."""
+    with pytest.raises(ParameterError, match=words) as python:
+        DriveModel(params)
+    with pytest.raises(ParameterError) as engine:
+        DriveSimulator(params)
+    assert str(engine.value) == str(python.value)
+
+
+
+GROOVE = dict(drive="voltage", closure="form", c=5e-4, gamma=math.pi, mu=0.0, omega0=10.0, J_cam=0.05)
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_groove_crossover_keeps_the_energy_balance_and_the_clearance(e):
+    """closure 'form' at about 10 rad/s: the follower crosses the 1 mm gap and strikes the upper flank (w > 0 towards
+    it); the balance of section 9 holds over every crossing; it never leaves the clearance by more than 1 pm."""
+    params = dict(GROOVE, restitution=e, c_e=C_M, shaft_friction=False)
+    model, body, r = run(params, 0.63, 1e-4, u=1.6, energy=True)
+    balance = r["E_in"] - r["E_copper"] - r["E_shaft"] - r["E_impact"] - (stored(model, r) - stored(model, r)[0])
+    assert np.max(np.abs(balance)) < 1e-9 * np.max(stored(model, r))
+    assert any(before > 0.0 for _, before, _ in body.impacts) and len(body.impacts) > 10
+    assert np.max(np.abs(r["s"] - r["s_cam"])) <= 5e-4 + 1e-12
+    for _, before, after in body.impacts:
+        if after != 0.0:
+            assert after == pytest.approx(-e * before, rel=1e-12, abs=1e-15)
+    if e < 1.0:
+        assert -1.0 in r["contact"] and r["E_impact"][-1] > 0.0
