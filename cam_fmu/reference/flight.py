@@ -24,6 +24,10 @@ MAX_STALL = 1000
 # after a lift-off the gap grows as t^3 (gap, its rate and its acceleration are all 0 there), so a gap of exactly 0
 # would meet the integration's rounding (atol 1e-13 m) and land the follower again at once, without end.
 TOUCH = 1e-12
+# rad: the cam's turn in one integration step at most while the follower flies. A flight without a spring is a
+# polynomial in time, which DOP853 integrates exactly in one step of any length: without a bound, one step could
+# hold a gap's crossing and its return, and the event (checked at the steps' ends) would be missed.
+FLIGHT_ANGLE = 1e-2
 
 
 class PieceRun:
@@ -112,7 +116,11 @@ class FollowerRun(PieceRun):
 
     def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
         sigma = self._direction(y)
-        return self._events(contact, sigma), self._rhs(contact, sigma), {"method": "DOP853", "atol": self.atol}
+        options = {"method": "DOP853", "atol": self.atol}
+        omega = max(abs(w) for w in self.omega_ref.values)  # rad/s: the fastest the cam turns (a bound in any piece)
+        if contact == 0.0 and omega > 0.0:
+            options["max_step"] = FLIGHT_ANGLE / omega
+        return self._events(contact, sigma), self._rhs(contact, sigma), options
 
     # ------------------------------------------------------------- the hybrid system
     def _direction(self, y: list) -> float:

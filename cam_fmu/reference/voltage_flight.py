@@ -15,10 +15,9 @@ import numpy as np
 
 from ..physics.signals import Signal
 from ..physics.voltage_follower import VoltageFollower
-from .flight import TOUCH, PieceRun
+from .flight import FLIGHT_ANGLE, TOUCH, PieceRun
 
 STATE = 5  # theta, omega, i, s, v; then the energy integrals
-FLIGHT_ANGLE = 1e-2  # rad: the cam's turn in one integration step at most while the follower flies
 
 
 class VoltageFollowerRun(PieceRun):

@@ -54,6 +54,24 @@ def test_the_engine_is_the_reference(name):
             assert np.max(np.abs(got[key] - ref[key])) < 1e-9 * max(1.0, np.max(np.abs(ref[key]))), (run.label, key)
 
 
+def test_the_engine_is_the_reference_over_many_crossings_of_a_vertical_groove():
+    """Gravity along the stroke, no spring, e = 0.9: tens of impacts on both flanks, each flight a parabola (the case
+    where the reference's steps had to be bounded, reference/flight.py FLIGHT_ANGLE). Measured: s to 2.3e-12 m."""
+    from cam_fmu.experiments.signals import constant
+    from cam_fmu.physics.drive import DriveModel
+    from cam_fmu.reference.flight import FollowerRun
+
+    params = dict(drive="speed", closure="form", c=1e-3, restitution=0.9, gamma=math.pi / 2, mu=0.0, M_f=0.0)
+    omega = 100.0
+    times = np.linspace(0.0, 2 * math.pi / omega, 2001)
+    run = FollowerRun(DriveModel(params), constant(omega), 1e-12, 1e-13)
+    ref = run.run(times, 0.0)
+    got = engine_run(params, omega, times)
+    assert len(run.impacts) >= 10 and {1.0, -1.0} <= {math.copysign(1.0, w) for _, w, _ in run.impacts}
+    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10
+    assert np.max(np.abs(got["v"] - ref["v"])) < 1e-7
+
+
 @pytest.mark.parametrize("ratio, leaves", [(0.98, False), (1.02, True)])
 def test_jump_speed_in_the_speed_drive(ratio, leaves):
     omega_jump = math.sqrt((F0 + K * H) / (MASS * H / 2 * (math.pi / B) ** 2))

@@ -230,6 +230,17 @@ def test_groove_with_clearance_crosses_the_gap():
     assert np.all(result["s"] >= result["s_cam"] - 1e-3 - 1e-12) and np.all(result["s"] <= result["s_cam"] + 1e-3 + 1e-12)
 
 
+@pytest.mark.parametrize("c, e, omega", [(1e-4, 0.9, 10.0), (1e-3, 0.9, 100.0), (1e-5, 1.0, 30.0)])
+def test_a_bouncing_follower_never_leaves_the_groove(c, e, omega):
+    """Many crossings of a vertical groove (gravity along the stroke, no spring): a flight is then a polynomial in
+    time, which the integrator would take in one long step across a flank and back, missing the touch-down; with
+    the steps bounded (flight.FLIGHT_ANGLE) every output row lies within the clearance."""
+    params = dict(drive="speed", closure="form", c=c, restitution=e, gamma=math.pi / 2, mu=0.0, M_f=0.0)
+    _, run, result = _run(params, omega, turns=2.0, points=20000)
+    assert len(run.impacts) > 30
+    assert np.max(np.abs(result["s"] - result["s_cam"])) <= c + 1e-12
+
+
 @pytest.mark.parametrize("params, words", [
     (dict(drive="speed", closure="spring", c=1e-3), "'c'"),
     (dict(drive="voltage", closure="spring"), "'mu'"),  # the voltage drive's refusals: tests/physics/test_voltage_follower.py
