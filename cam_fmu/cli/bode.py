@@ -60,7 +60,10 @@ def run(args) -> int:
         raise ValueError(f"--amplitude {args.amplitude!r} V: allowed > 0")
     scene = apply_sets(find_scene(args.scene), args.set)
     params = scene.primary.params
-    if params["closure"] != "kinematic":
+    from ..physics.drive import own_follower
+
+    if own_follower(params["closure"], params["c"] if params["backlash"] else 0.0, params["formulation"],
+                    params["drive"]):
         raise ValueError(f"scene {scene.name}: closure {params['closure']!r}: the frequency response linearises the "
                          "drive with the follower on the cam (backlash off, the kinematic rule); a follower that can "
                          "leave the cam has no small-signal model there (docs/model.md section 13)")

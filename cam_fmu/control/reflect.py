@@ -28,7 +28,8 @@ PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
 COLUMNS = ("theta", "J", "M", *PARTS)
 FREQUENCIES = ("f_r", "f_a")  # Hz: the columns a compliant shaft adds
 UNITS = {"theta": "rad", "J": "kg.m2", "M": "N.m", **{part: "N.m" for part in PARTS}, "f_r": "Hz", "f_a": "Hz"}
-# What the map assumes of the follower (closure 'kinematic' only; the others are refused): printed and in the JSON.
+# What the map assumes of the follower (refused where it is a body of its own: closure 'spring', or 'form' with a
+# clearance): printed and in the JSON.
 ASSUMES = ("the follower on the cam at every angle: a groove's two flanks push and pull it, a clearance c is "
            "ignored (docs/model.md section 13)")
 RESONANCE_KEYS = ("f_r_min", "f_r_max", "f_a_min", "f_a_max")  # Hz: None with a rigid shaft
@@ -47,7 +48,7 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
     if points < 8:
         raise ValueError(f"points = {points}: at least 8 angles over a turn")
     model = DriveModel(params)
-    if model.closure != "kinematic":
+    if model.free_follower:
         raise ValueError(f"closure {model.closure!r}: the map holds the follower on the cam at every angle (the "
                          "kinematic rule), while this follower can leave it (docs/model.md section 13); for where "
                          "and at what speed it does, use cam-fmu jump")

@@ -80,23 +80,38 @@ def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
             raise ParameterError(f"{k}: {reason}; allowed with {name} {choice!r}: k_shaft = 0{instead}")
 
 
+def own_follower(closure: str, c: float, formulation: str, drive: str) -> bool:
+    """Does the follower move as a body of its own (docs/model.md 13)? Closure 'spring' always; 'form' where the
+    groove has a clearance c > 0 [m] to fly across and the formulation has the follower's momentum (the paper's
+    voltage-drive formulation models the clearance by its eqs. 6-8, the rule of closure 'kinematic')."""
+    if closure == "spring":
+        return True
+    return closure == "form" and c > 0.0 and (drive in FOLLOWER_DRIVES or formulation in VOLTAGE_FOLLOWER_FORMULATIONS)
+
+
 def check_closure(p: Mapping[str, Any], c: float) -> None:
     """Raise ParameterError where the closure's parameters contradict each other (docs/model.md 13)."""
     closure = p["closure"]
     if closure != "spring" and (p["k_spring"] != 0.0 or p["F_spring0"] != 0.0):
         raise ParameterError(f"parameters 'k_spring' = {p['k_spring']!r} N/m, 'F_spring0' = {p['F_spring0']!r} N: "
                              f"a return spring needs closure 'spring' (closure is {closure!r}); allowed with it: 0")
-    if closure == "kinematic":
+    paper = p["drive"] not in FOLLOWER_DRIVES and p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS
+    if closure == "kinematic" or (closure == "form" and paper):
         if p["restitution"] != 0.0:
-            raise ParameterError(f"parameter 'restitution' = {p['restitution']!r}: closure 'kinematic' has plastic "
-                                 "impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring')")
+            rule = "closure 'kinematic'" if closure == "kinematic" else "the paper's formulation (its eqs. 6-8)"
+            raise ParameterError(f"parameter 'restitution' = {p['restitution']!r}: {rule} has plastic impacts only "
+                                 "(docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
+                                 "consistent formulation)")
         return
     if closure == "spring" and c != 0.0:
         raise ParameterError(f"parameter 'c' = {c!r} m: closure 'spring' holds the follower on one flank, there is "
                              "no clearance; allowed with it: c = 0")
+    if not own_follower(closure, c, p["formulation"], p["drive"]):
+        return  # a groove without clearance: held on both sides, the kinematic rule's motion exactly
+    kinematic = " (or closure 'kinematic', the paper's rule)" if closure == "form" else ""
     if not (p["m"] > 0.0 and p["follower_inertia"]):
         raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure {closure!r} moves the follower as a body of its "
-                             "own, which needs its mass; allowed with it: m > 0 and follower_inertia true")
+                             f"own, which needs its mass; allowed with it: m > 0 and follower_inertia true{kinematic}")
     if p["drive"] in FOLLOWER_DRIVES:
         return
     # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, rigid shaft, no
@@ -108,15 +123,15 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
     if p["k_shaft"] > 0.0:
         raise ParameterError(f"parameter 'k_shaft' = {p['k_shaft']!r} N.m/rad: a follower of its own on a compliant "
                              "shaft is not modelled yet; allowed with drive 'voltage' and closure "
-                             f"{closure!r}: k_shaft = 0")
+                             f"{closure!r}: k_shaft = 0{kinematic}")
     if p["guide_friction"] and p["mu"] > 0.0:
         raise ParameterError(f"parameter 'mu' = {p['mu']!r}: guide friction with a follower of its own on a "
                              "voltage-driven cam is not modelled yet; allowed with drive 'voltage' and closure "
-                             f"{closure!r}: mu = 0 (or guide_friction false)")
+                             f"{closure!r}: mu = 0 (or guide_friction false){kinematic}")
     if not p["omega0"] > 0.0:
         raise ParameterError(f"parameter 'omega0' = {p['omega0']!r} rad/s: the shaft's static friction with a "
                              "follower of its own is not modelled yet (the run is refused where the shaft stops); "
-                             f"allowed with drive 'voltage' and closure {closure!r}: omega0 > 0")
+                             f"allowed with drive 'voltage' and closure {closure!r}: omega0 > 0{kinematic}")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
@@ -204,6 +219,7 @@ class DriveModel:
         self.closure = p["closure"]
         self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
         check_closure(p, self.c)
+        self.free_follower = own_follower(self.closure, self.c, self.formulation, self.drive)
         if self.compliant:
             check_compliant(p, self.J_0)
         if self.mu > 0.0:

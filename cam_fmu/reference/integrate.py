@@ -244,7 +244,7 @@ class _Consistent:
 
 def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """The consistent formulation: scipy at tight tolerances, stopping at every event and breakpoint."""
-    if model.closure == "spring" or (model.closure == "form" and model.c > 0.0):  # its own state (model.md 13.6)
+    if model.free_follower:  # its own state (model.md 13.6)
         return follower_voltage_reference(model, grid, u, options)
     return _Consistent(model, u, options["rtol"], options["atol"], options["energy"], options["method"]).run(grid)
 
@@ -267,7 +267,7 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
 def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """Imposed speed: theta = theta0 + int omega_ref dt (exact for piecewise-linear signals)."""
     p = model.params
-    if model.closure == "spring" or (model.closure == "form" and model.c > 0.0):  # the follower's own state
+    if model.free_follower:  # the follower's own state
         return follower_speed_reference(model, grid, omega_ref, options["rtol"], options["atol"])
     theta = p["theta0"]
     s = model.program.derivatives(theta)[0]

@@ -247,6 +247,9 @@ def test_a_bouncing_follower_never_leaves_the_groove(c, e, omega):
     (dict(restitution=0.5), "plastic impacts only"),
     (dict(k_spring=100.0), "closure 'spring'"),
     (dict(drive="speed", closure="spring", m=0.0), "'m'"),
+    (dict(drive="speed", closure="form", c=1e-3, m=0.0), "or closure 'kinematic'"),
+    (dict(closure="form", c=1e-3), "or closure 'kinematic'"),  # mu > 0 in the voltage drive
+    (dict(closure="form", c=1e-3, formulation="paper", restitution=0.5), "paper's formulation"),
 ])
 def test_contradicting_closure_parameters_are_refused_with_the_reason(params, words):
     with pytest.raises(ParameterError, match=words):
@@ -258,9 +261,35 @@ def test_the_engine_refuses_what_the_model_refuses_with_the_same_words():
     from cam_fmu.fmu.engine import DriveSimulator
 
     for params in (dict(drive="speed", closure="spring", c=1e-3), dict(closure="spring"), dict(restitution=0.5),
-                   dict(k_spring=100.0), dict(drive="speed", closure="spring", m=0.0)):
+                   dict(k_spring=100.0), dict(drive="speed", closure="spring", m=0.0),
+                   dict(drive="speed", closure="form", c=1e-3, m=0.0), dict(closure="form", c=1e-3, mu=0.0),
+                   dict(closure="form", c=1e-3, formulation="paper", restitution=0.5)):
         with pytest.raises(ParameterError) as python:
             DriveModel(params)
         with pytest.raises(ParameterError) as engine:
             DriveSimulator(params)
         assert str(engine.value) == str(python.value)
+
+
+@pytest.mark.parametrize("params", [
+    dict(closure="form", m=0.0, restitution=0.5),                    # no clearance: nothing to fly across
+    dict(closure="form", c=5e-4, formulation="paper", omega0=0.0),  # the paper's formulation: its eqs. 6-8
+    dict(drive="speed", closure="form", c=0.0, m=0.0),
+])
+def test_a_groove_without_a_flight_is_the_kinematic_rule_to_the_bit(params):
+    """Closure 'form' where the follower cannot fly (c = 0, or the paper's voltage formulation, which models the
+    clearance by its eqs. 6-8) runs the kinematic rule: the same outputs, bit for bit, as closure 'kinematic'."""
+    from cam_fmu.fmu.engine import DriveSimulator
+
+    kinematic = dict(params, closure="kinematic", restitution=0.0)
+    assert not DriveModel(params).free_follower and not DriveModel(kinematic).free_follower
+    rows = []
+    for p in (params, kinematic):
+        sim = DriveSimulator(p)
+        sim.set_inputs(u=6.0, omega_ref=20.0, omega_dot_ref=0.0)
+        run = []
+        for k in range(200):
+            sim.do_step(k * 1e-3, 1e-3, u=6.0, omega_ref=20.0)
+            run.append(tuple(sim.outputs().values()))
+        rows.append(run)
+    assert rows[0] == rows[1]

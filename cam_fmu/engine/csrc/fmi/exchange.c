@@ -81,7 +81,7 @@ int cam_exchange_attach(CamExchange *e)
     if (d->model.free_follower)
         return fail(e, CAM_ERR_PARAMETER, "closure '%s' moves the follower as a body of its own: its lift-offs "
                     "and touch-downs have no event indicators in Model Exchange yet (docs/model.md 13.6), so it runs in "
-                    "co-simulation only (fmi2CoSimulation); in Model Exchange use closure 'kinematic' (the default)",
+                    "co-simulation only (fmi2CoSimulation); in Model Exchange use closure 'kinematic' (the paper's rule)",
                     cam_param_spec(CAM_P_CLOSURE)->choices[d->model.closure]);
     e->drive = d;
     d->solver.k1_valid = 0;   /* outputs compute omega_dot at the host's state, never a solver's stage */

@@ -324,24 +324,30 @@ static int check_closure(const CamModel *model, CamError *err)
     char a[40], b[40];
     const double *v = model->params.v;
     const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
+    const char *kinematic = model->closure == CAM_CHOICE_CLOSURE_FORM ? " (or closure 'kinematic', the paper's rule)" : "";
+    int paper = model->formulation == CAM_FORM_PAPER;
     if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
                          "needs closure 'spring' (closure is '%s'); allowed with it: 0",
                          cam_num(v[CAM_P_K_SPRING], a), cam_num(v[CAM_P_F_SPRING0], b), closure);
-    if (model->closure == CAM_CHOICE_CLOSURE_KINEMATIC) {
+    if (model->closure == CAM_CHOICE_CLOSURE_KINEMATIC || (model->closure == CAM_CHOICE_CLOSURE_FORM && paper)) {
         if (v[CAM_P_RESTITUTION] != 0.0)
-            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'restitution' = %s: closure 'kinematic' has plastic "
-                             "impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring')",
-                             cam_num(v[CAM_P_RESTITUTION], a));
+            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'restitution' = %s: %s has plastic impacts only "
+                             "(docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the consistent "
+                             "formulation)", cam_num(v[CAM_P_RESTITUTION], a),
+                             model->closure == CAM_CHOICE_CLOSURE_KINEMATIC ? "closure 'kinematic'"
+                             : "the paper's formulation (its eqs. 6-8)");
         return CAM_OK;
     }
     if (model->closure == CAM_CHOICE_CLOSURE_SPRING && model->c != 0.0)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'c' = %s m: closure 'spring' holds the follower on one "
                          "flank, there is no clearance; allowed with it: c = 0", cam_num(model->c, a));
+    if (!model->free_follower)
+        return CAM_OK;   /* a groove without clearance: held on both sides, the kinematic rule's motion exactly */
     if (!(v[CAM_P_M] > 0.0 && v[CAM_P_FOLLOWER_INERTIA] != 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure '%s' moves the follower as a body "
-                         "of its own, which needs its mass; allowed with it: m > 0 and follower_inertia true",
-                         cam_num(v[CAM_P_M], a), closure);
+                         "of its own, which needs its mass; allowed with it: m > 0 and follower_inertia true%s",
+                         cam_num(v[CAM_P_M], a), closure, kinematic);
     if (model->formulation == CAM_FORM_SPEED)
         return CAM_OK;
     /* The voltage drive: the reference's refusals (docs/model.md 13.6). */
@@ -352,15 +358,16 @@ static int check_closure(const CamModel *model, CamError *err)
     if (v[CAM_P_K_SHAFT] > 0.0)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'k_shaft' = %s N.m/rad: a follower of its own on a "
                          "compliant shaft is not modelled yet; allowed with drive 'voltage' and closure '%s': "
-                         "k_shaft = 0", cam_num(v[CAM_P_K_SHAFT], a), closure);
+                         "k_shaft = 0%s", cam_num(v[CAM_P_K_SHAFT], a), closure, kinematic);
     if (v[CAM_P_GUIDE_FRICTION] != 0.0 && v[CAM_P_MU] > 0.0)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'mu' = %s: guide friction with a follower of its own on a "
                          "voltage-driven cam is not modelled yet; allowed with drive 'voltage' and closure '%s': "
-                         "mu = 0 (or guide_friction false)", cam_num(v[CAM_P_MU], a), closure);
+                         "mu = 0 (or guide_friction false)%s", cam_num(v[CAM_P_MU], a), closure, kinematic);
     if (!(v[CAM_P_OMEGA0] > 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'omega0' = %s rad/s: the shaft's static friction with a "
                          "follower of its own is not modelled yet (the run is refused where the shaft stops); allowed "
-                         "with drive 'voltage' and closure '%s': omega0 > 0", cam_num(v[CAM_P_OMEGA0], a), closure);
+                         "with drive 'voltage' and closure '%s': omega0 > 0%s", cam_num(v[CAM_P_OMEGA0], a), closure,
+                         kinematic);
     return CAM_OK;   /* voltage_follower.c */
 }
 
@@ -422,8 +429,10 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->k_spring = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_K_SPRING] : 0.0;
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
     model->restitution = v[CAM_P_RESTITUTION];
+    /* physics.drive.own_follower: the paper's voltage-drive formulation models a groove's clearance by its eqs. 6-8 */
     model->free_follower = model->closure == CAM_CHOICE_CLOSURE_SPRING
-                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0);
+                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0
+                               && model->formulation != CAM_FORM_PAPER);
     if ((status = check_closure(model, err)) != CAM_OK) {
         cam_model_free(model);
         return status;
