@@ -39,11 +39,11 @@ def test_the_engine_is_the_reference(name, label):
     if run.params["closure"] == "form":   # within the groove's clearance; a spring's follower never inside the cam
         assert np.max(np.abs(got["s"] - got["s_cam"])) <= run.params["c"] + 2e-12
     assert np.min(got["s"] - got["s_cam"]) >= -run.params["c"] - 2e-12
-    assert np.max(np.abs(got["theta"] - ref["theta"])) < 1e-9        # rad (measured 1.3e-10)
-    assert np.max(np.abs(got["omega"] - ref["omega"])) < 1e-7        # rad/s (measured 5.9e-9)
-    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10               # m (measured 9.4e-12)
-    assert np.max(np.abs(got["v"] - ref["v"])) < 2e-8                # m/s (measured 2.0e-9)
-    assert np.max(np.abs(got["a"] - ref["a"])) < 2e-6                # m/s2 (measured 2.5e-7)
+    assert np.max(np.abs(got["theta"] - ref["theta"])) < 1e-9        # rad (measured 2.8e-12)
+    assert np.max(np.abs(got["omega"] - ref["omega"])) < 1e-7        # rad/s (measured 1.5e-10)
+    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10               # m (measured 3.7e-13)
+    assert np.max(np.abs(got["v"] - ref["v"])) < 2e-8                # m/s (measured 3.4e-10)
+    assert np.max(np.abs(got["a"] - ref["a"])) < 2e-6                # m/s2 (measured 9.6e-9)
     for key in ("M", "i", "J"):
         assert np.max(np.abs(got[key] - ref[key])) < 1e-8 * np.max(np.abs(ref[key])), key
 
