@@ -134,6 +134,13 @@ class VoltageFollower:
             return self.on_flank(y[0], y[1], self.torque(y, u), contact)[2] * abs(s1 * y[1])
         return self.f0 * abs(y[4]) if sigma else 0.0
 
+    def side_force(self, y, u: float, contact: float) -> float:
+        """N, the guide's side force N_r = P tan(alpha) + G_y on the flank ``contact`` (its sign is the friction's
+        branch; |N_r| has a kink where it changes)."""
+        s_cam, s1, _, _ = self.program.derivatives(y[0])
+        P = self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
+        return P * s1 / (self.model.r_b + s_cam) + self.G_y
+
     def contact_force(self, y, u: float, contact: float = 1.0) -> float:
         """N, contact P: the force the flank ``contact`` must give, along its normal (lift-off: contact while >= 0)."""
         return contact * self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]

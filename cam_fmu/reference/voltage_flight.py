@@ -15,8 +15,9 @@ import math
 
 import numpy as np
 
+from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.signals import Signal
-from ..physics.voltage_follower import VoltageFollower
+from ..physics.voltage_follower import VoltageFollower, sgn
 from .flight import TOUCH, PieceRun, next_breakpoint
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
@@ -64,7 +65,7 @@ class VoltageFollowerRun(PieceRun):
         if contact == 0.0 and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
             options["max_step"] = FLIGHT_ANGLE / abs(y[1])  # could hold a gap's crossing and its return
         sigma = self.body.direction(y) if contact == 0.0 else 0.0  # the flight's friction direction, held
-        events = self._events(contact, sigma)
+        events = self._events(contact, sigma, t, y)
         # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md 6.3): DOP853
         # stepping over one with guide friction was 2.5e-7 rad/s off.
         target = self.target = next_breakpoint(self.breakpoints, y[0], 1.0)
@@ -90,7 +91,7 @@ class VoltageFollowerRun(PieceRun):
                          d_shaft * slip * slip if body.compliant else 0.0]
         return rhs
 
-    def _events(self, contact: float, sigma: float = 0.0) -> list:
+    def _events(self, contact: float, sigma: float, t0: float, y0: list) -> list:
         body, u = self.body, self.u
         events = []
 
@@ -101,6 +102,9 @@ class VoltageFollowerRun(PieceRun):
         add("stop", lambda t, y: y[1])
         if contact:
             add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
+            side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
+            if side != 0.0:  # the piece ends just past the kink of |N_r| (by 1e-9 N, docs/model.md 10), no transition
+                add("side", lambda t, y: side * body.side_force(y[:body.size], u.value(t), contact) + SIDE_HYSTERESIS)
             return events
         add("touch-down +1", lambda t, y: body.gap(y, 1.0) + TOUCH)
         if body.two_sided:
@@ -120,6 +124,8 @@ class VoltageFollowerRun(PieceRun):
             return 0.0, y[:3] + [s, s1 * y[1]] + y[5:]
         if kind == "halt":
             return 0.0, y[:4] + [0.0] + y[5:]
+        if kind == "side":
+            return contact, y
         if kind == "breakpoint":  # on from just past it: a root a rounding short of it lies on the piece before
             return contact, [max(y[0], self.target + 1e-15 * max(1.0, abs(self.target)))] + y[1:]
         s1 = body.program.derivatives(y[0])[1]

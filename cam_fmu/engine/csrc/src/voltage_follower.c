@@ -5,7 +5,8 @@
  * omega, i and a compliant shaft's twist phi and rotor speed omega_m in d->x, the follower's s, v, contact (+1, -1 on
  * a flank, 0 in flight), touch-downs and the rebound guard in d->speed (saved with the state); sigma is the flying
  * follower's direction, held over a step (rate 0). The cam side is driven by T = c_m i (rigid) or the shaft's
- * k phi + d (omega_m - omega), less M_f sgn(omega). In contact J omega_dot = T - (m s'' omega^2 + F_close + sgn(v) f) s'
+ * k phi + d (omega_m - omega), less M_f sgn(omega). In contact
+ * J omega_dot = T - (m s'' omega^2 + F_close + sgn(v) f) s'
  * with J = J_0 + m s'^2, the guide friction f solved with omega_dot as model.c's load_terms does (section 4.4 with
  * F_close in gravity's place), and the force P = m (s'' omega^2 + s' omega_dot) + F_close + sgn(v) f along X;
  * lift-off where contact P reaches 0; in flight J_0 omega_dot = T and m s_dd = -F_close(s) - sigma f0 (f0 the
@@ -30,7 +31,8 @@
 #define Y_ROTOR 6
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
 
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK };   /* touch-down on +1, -1 */
+/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
+enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK, EV_SIDE };
 
 static double sgn(double x)
 {
@@ -77,15 +79,16 @@ static double clearance(const CamModel *m)
 /* On the flank `contact` at y: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the force P [N] along X of the
  * coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot (model.c load_terms with
  * F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
-static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
-                     double *P)
+static void flank_terms(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                        double *P, double *n_r)
 {
-    double omega = y[1], F, J, inertial, x0, sigma, tan_a, f;
+    double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
     F = closing(m, d[0] - contact * clearance(m));
     if (m->mu == 0.0) {
         *omega_dot = (torque(m, y, u) - (m->m * d[2] * omega * omega + F) * d[1]) / (m->J_0 + m->m * d[1] * d[1]);
         *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
+        *n_r = 0.0;
         return;
     }
     J = m->J_0 + m->m * d[1] * d[1];
@@ -93,10 +96,27 @@ static void on_flank(const CamModel *m, const double y[NY], double u, int contac
     x0 = (torque(m, y, u) - inertial * d[1]) / J;
     sigma = sgn(d[1] * omega);
     tan_a = d[1] / (m->r_b + d[0]);
-    f = cam_guide_friction((inertial + m->m * d[1] * x0) * tan_a + m->G_y, m->J_0 / J * tan_a, sigma, m->mu, m->N_g,
-                           0.0);
+    n0 = (inertial + m->m * d[1] * x0) * tan_a + m->G_y;
+    kappa = m->J_0 / J * tan_a;
+    f = cam_guide_friction(n0, kappa, sigma, m->mu, m->N_g, 0.0);
     *omega_dot = x0 - sigma * f * d[1] / J;
     *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
+    *n_r = n0 + sigma * kappa * f;
+}
+
+static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                     double *P)
+{
+    double n_r;
+    flank_terms(m, y, u, contact, d, omega_dot, P, &n_r);
+}
+
+/* N: the guide's side force N_r on the flank `contact` at y (0 without guide friction). */
+static double side_force(const CamModel *m, const double y[NY], double u, int contact)
+{
+    double d[4], omega_dot, P, n_r;
+    flank_terms(m, y, u, contact, d, &omega_dot, &P, &n_r);
+    return n_r;
 }
 
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
@@ -182,10 +202,15 @@ static double event_value(const CamModel *m, double u, int code, int contact, co
     return code == EV_TOUCH_UP ? y[3] - (d[0] - clearance(m)) + TOUCH : (d[0] + clearance(m)) - y[3] + TOUCH;
 }
 
-/* event_value, and for EV_BREAK the cam's angle short of the profile's breakpoint `target` [rad]. */
-static double event_at(const CamModel *m, double u, int code, int contact, double target, const double y[NY])
+/* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
+ * EV_SIDE the side force N_r times its sign at[1] at the step's start, past 0 by CAM_SIDE_HYSTERESIS (|N_r|'s kink). */
+static double event_at(const CamModel *m, double u, int code, int contact, const double at[2], const double y[NY])
 {
-    return code == EV_BREAK ? target - y[0] : event_value(m, u, code, contact, y);
+    if (code == EV_BREAK)
+        return at[0] - y[0];
+    if (code == EV_SIDE)
+        return at[1] * side_force(m, y, u, contact) + CAM_SIDE_HYSTERESIS;
+    return event_value(m, u, code, contact, y);
 }
 
 static int crossed(double before, double after)
@@ -321,8 +346,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
-        int codes[5], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt, target;
+        int codes[6], n = 0, k, code = EV_NONE;
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0};
         if (y[1] != 0.0)
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
         if (!contact && wn > 0.0)
@@ -350,20 +375,22 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             if (y[Y_SIGMA] != 0.0 && friction0(m) > 0.0)
                 codes[n++] = EV_HALT;
         }
-        target = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
-        if (target == target)   /* the step ends just past the profile's breakpoint (s'' or the third derivative jump there) */
+        ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
+        if (ends[0] == ends[0])   /* the step ends just past the profile's breakpoint (s'' or s''' jumps there) */
             codes[n++] = EV_BREAK;
+        if (contact && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
+            codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
         for (k = 0; k < n; k++) {
-            double lo = 0.0, hi = dt, before = event_at(m, u, codes[k], contact, target, y);
-            if (!crossed(before, event_at(m, u, codes[k], contact, target, next)))
+            double lo = 0.0, hi = dt, before = event_at(m, u, codes[k], contact, ends, y);
+            if (!crossed(before, event_at(m, u, codes[k], contact, ends, next)))
                 continue;
             while (hi - lo > 0.0) {
                 double mid = 0.5 * (lo + hi);
                 if (mid <= lo || mid >= hi)
                     break;
                 rk4(m, u, contact, y, mid, trial);
-                if (crossed(before, event_at(m, u, codes[k], contact, target, trial)))
+                if (crossed(before, event_at(m, u, codes[k], contact, ends, trial)))
                     hi = mid;
                 else
                     lo = mid;
@@ -385,6 +412,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (rebound > 0.0)
             rebound = fmax(rebound - (code == EV_NONE ? dt : at), 0.0);
         if (code == EV_NONE)
+            continue;
+        if (code == EV_SIDE)
             continue;
         if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
             if (contact && !(contact = settle(m, y, u, contact)))
