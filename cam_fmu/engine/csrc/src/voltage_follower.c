@@ -218,6 +218,22 @@ static int crossed(double before, double after)
     return (before > 0.0 && after <= 0.0) || (before == 0.0 && after < 0.0);
 }
 
+typedef struct {                /* a Runge-Kutta step from y and its event functions (trial_event) */
+    const CamModel *m;
+    double u;
+    int contact;
+    const double *ends, *y;
+} Trial;
+
+/* The event function `code` at the end of a Runge-Kutta step of h [s] from the trial's y. */
+static double trial_event(void *ctx, int code, double h)
+{
+    const Trial *t = ctx;
+    double out[NY];
+    rk4(t->m, t->u, t->contact, t->y, h, out);
+    return event_at(t->m, t->u, code, t->contact, t->ends, out);
+}
+
 /* m/s2: a bound of the follower's acceleration relative to the flank near y (voltage_follower.acceleration_scale). */
 static double acceleration_scale(const CamModel *m, const double y[NY], double u)
 {
@@ -347,7 +363,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0};
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
         if (y[1] != 0.0)
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
         if (!contact && wn > 0.0)
@@ -382,23 +398,12 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
         for (k = 0; k < n; k++) {
-            double lo = 0.0, hi = dt, before = event_at(m, u, codes[k], contact, ends, y);
-            if (!crossed(before, event_at(m, u, codes[k], contact, ends, next)))
-                continue;
-            while (hi - lo > 0.0) {
-                double mid = 0.5 * (lo + hi);
-                if (mid <= lo || mid >= hi)
-                    break;
-                rk4(m, u, contact, y, mid, trial);
-                if (crossed(before, event_at(m, u, codes[k], contact, ends, trial)))
-                    hi = mid;
-                else
-                    lo = mid;
-            }
-            if (hi < at || code == EV_NONE) {
-                at = hi;
-                code = codes[k];
-            }
+            before[k] = event_at(m, u, codes[k], contact, ends, y);
+            after[k] = event_at(m, u, codes[k], contact, ends, next);
+        }
+        {
+            Trial tr = {m, u, contact, ends, y};
+            code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
         }
         if (code == EV_NONE) {
             memcpy(y, next, sizeof y);
