@@ -114,20 +114,12 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
                              f"own, which needs its mass; allowed with it: m > 0 and follower_inertia true{kinematic}")
     if p["drive"] in FOLLOWER_DRIVES:
         return
-    # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, rigid shaft, no
-    # guide friction, a turning shaft at the start; each other case refused with its reason.
+    # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, with guide
+    # friction and a rigid or compliant shaft, a turning shaft at the start; each other case refused with its reason.
     voltage = f"parameter 'closure' = {closure!r} with drive 'voltage'"
     if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
         raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
                              "with it: formulation 'consistent'")
-    if p["k_shaft"] > 0.0:
-        raise ParameterError(f"parameter 'k_shaft' = {p['k_shaft']!r} N.m/rad: a follower of its own on a compliant "
-                             "shaft is not modelled yet; allowed with drive 'voltage' and closure "
-                             f"{closure!r}: k_shaft = 0{kinematic}")
-    if p["guide_friction"] and p["mu"] > 0.0:
-        raise ParameterError(f"parameter 'mu' = {p['mu']!r}: guide friction with a follower of its own on a "
-                             "voltage-driven cam is not modelled yet; allowed with drive 'voltage' and closure "
-                             f"{closure!r}: mu = 0 (or guide_friction false){kinematic}")
     if not p["omega0"] > 0.0:
         raise ParameterError(f"parameter 'omega0' = {p['omega0']!r} rad/s: the shaft's static friction with a "
                              "follower of its own is not modelled yet (the run is refused where the shaft stops); "

@@ -1,22 +1,31 @@
 """The follower as a body of its own on a voltage-driven cam (docs/model.md 13.6).
 
-The consistent formulation (docs/model.md 5.1) with a rigid shaft and no guide friction, the follower held on
-the cam's flank by a return spring (closure 'spring'), or in a groove with the clearance c (closure 'form': the
-flanks at s_cam - c, pushing along +X, contact +1, and s_cam + c, contact -1). ``math`` only, written
+The consistent formulation (docs/model.md 5.1) with the follower held on the cam's flank by a return spring
+(closure 'spring'), or in a groove with the clearance c (closure 'form': the flanks at s_cam - c, pushing along +X,
+contact +1, and s_cam + c, contact -1), with guide friction and a rigid or compliant shaft. ``math`` only, written
 independently of the C engine.
 
-On a flank (s = s_cam - contact c, v = s' omega) the spring's force joins gravity's in the follower's load:
+The cam side is driven by the torque T: the motor's c_m i on a rigid shaft, the shaft's k phi + d (omega_m - omega)
+on a compliant one (docs/model.md 12.1), less the shaft's friction M_f sgn(omega). On a flank (s = s_cam - contact c,
+v = s' omega) the contact's force along X, P = N_n cos(alpha) (N_n the normal force, signed as the flank pushes),
+and the cam's acceleration solve two linear equations (the cam side's torque balance and the follower's force
+balance along X), the guide's friction f = mu (|P tan(alpha) + G_y| + |N_g|) opposing v:
 
-    J omega_dot = c_m i - M_f sgn(omega) - (m s'' omega^2 + F_close(s)) s',   J = J_0 + m s'^2
-    P = m (s'' omega^2 + s' omega_dot) + F_close(s)        (the contact force along X, >= 0)
+    J_0 omega_dot + s' P = T
+    m (s'' omega^2 + s' omega_dot) = P - F_close(s) - sgn(v) f
 
-with F_close = F0 + k s - F_gx (follower.closing_force). Lift-off where contact P reaches 0. In flight the shaft
-turns alone, J_0 omega_dot = c_m i - M_f sgn(omega), and m s_dd = -F_close(s). Touch-down where a gap closes: ``follower.impact`` with the shaft's inertia J_0 (momentum J_0 omega + m s' v kept, w+ = -e w-).
+with F_close = F0 + k s - F_gx (follower.closing_force); one branch per sign of the side force P tan(alpha) + G_y.
+Lift-off where contact P reaches 0. In flight the cam side turns alone, J_0 omega_dot = T, and the follower obeys
+m s_dd = -F_close(s) - sgn(v) f0 with the friction at no contact force f0 = mu (|G_y| + |N_g|); where v reaches 0
+the friction turns, or holds the follower while |F_close| <= f0. Touch-down where a gap closes: ``follower.impact``
+with the cam side's inertia J_0 (momentum J_0 omega + m s' v kept, w+ = -e w-; the guide's friction gives no
+impulse).
 """
 from __future__ import annotations
 
 import math
 
+from .drive import solve_guide_friction
 from .follower import Impact, closing_force, impact
 from .speed_follower import ZENO_HEIGHT
 from .variables import output_record
@@ -28,7 +37,10 @@ def sgn(x: float) -> float:
 
 
 class VoltageFollower:
-    """The hybrid system of a follower of its own on a voltage-driven cam (``contact`` +1, -1 on a flank, 0 off)."""
+    """The hybrid system of a follower of its own on a voltage-driven cam (``contact`` +1, -1 on a flank, 0 off).
+
+    The state y is (theta, omega, i, s, v), with (phi, omega_m) after it on a compliant shaft (``size`` 7).
+    """
 
     def __init__(self, model) -> None:
         self.model = model
@@ -39,42 +51,99 @@ class VoltageFollower:
         self.has_current = model.L > 0.0
         self.two_sided = model.closure == "form"
         self.c = model.c if self.two_sided else 0.0
+        self.mu, self.G_y, self.N_g = model.mu, model.G_y, model.N_g
+        self.f0 = self.mu * (abs(self.G_y) + self.N_g)  # N, the guide's friction at no contact force
+        self.compliant = model.compliant
+        self.size = 7 if self.compliant else 5
 
-    def torque(self, omega: float, i: float, u: float) -> float:
-        """N m, the motor's c_m i (the state's i with L > 0, else quasi-static) less the shaft's friction."""
-        drive = self.model.c_m * i if self.has_current else self.motor.quasi_static_torque(u, omega)
-        return drive - self.M_f * sgn(omega)
+    def motor_speed(self, y) -> float:
+        """rad/s, the rotor's speed: omega_m on a compliant shaft, else the cam's."""
+        return y[6] if self.compliant else y[1]
 
-    def current(self, omega: float, i: float, u: float) -> float:
-        """A, the armature current: the state with L > 0, else quasi-static."""
-        return i if self.has_current else self.motor.quasi_static_current(u, omega)
+    def current(self, y, u: float) -> float:
+        """A, the armature current: the state with L > 0, else quasi-static at the rotor's speed."""
+        return y[2] if self.has_current else self.motor.quasi_static_current(u, self.motor_speed(y))
 
-    def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0) -> tuple[float, float]:
-        """(omega_dot [rad/s2], P [N]) with the follower on the flank ``contact``: the module's coupled equations."""
-        s, s1, s2, _ = self.program.derivatives(theta)
-        s -= contact * self.c
-        F = closing_force(s, self.k, self.F0, self.F_gx)
-        omega_dot = (drive - (self.m * s2 * omega * omega + F) * s1) / (self.J_0 + self.m * s1 * s1)
-        return omega_dot, self.m * (s2 * omega * omega + s1 * omega_dot) + F
+    def shaft_torque(self, y) -> float:
+        """N m, a compliant shaft's torque on the cam, k phi + d (omega_m - omega) (0 when rigid)."""
+        if not self.compliant:
+            return 0.0
+        return self.model.k_shaft * y[5] + self.model.d_shaft * (y[6] - y[1])
 
-    def free_acceleration(self, s: float) -> float:
-        """m/s2, the flying follower's acceleration: -F_close(s) / m."""
-        return -closing_force(s, self.k, self.F0, self.F_gx) / self.m
+    def torque(self, y, u: float) -> float:
+        """N m, what drives the cam side: the motor's c_m i (rigid) or the shaft's torque, less M_f sgn(omega)."""
+        drive = self.shaft_torque(y) if self.compliant else self.model.c_m * self.current(y, u)
+        return drive - self.M_f * sgn(y[1])
 
-    def rates(self, y, u: float, contact: float) -> list[float]:
-        """dy/dt of y = (theta, omega, i, s, v); on the flank s and v follow the cam (their rates are the cam's)."""
-        theta, omega, i, s, v = y
-        drive = self.torque(omega, i, u)
-        di = self.motor.current_rate(u, i, omega) if self.has_current else 0.0
+    def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0) -> tuple[float, float, float]:
+        """(omega_dot [rad/s2], P [N], f [N]) with the follower on the flank ``contact``: the module's equations."""
+        s_cam, s1, s2, _ = self.program.derivatives(theta)
+        F = closing_force(s_cam - contact * self.c, self.k, self.F0, self.F_gx)
+        m, J_0 = self.m, self.J_0
+        if self.mu == 0.0:
+            omega_dot = (drive - (m * s2 * omega * omega + F) * s1) / (J_0 + m * s1 * s1)
+            return omega_dot, m * (s2 * omega * omega + s1 * omega_dot) + F, 0.0
+        sigma, tan_a = sgn(s1 * omega), s1 / (self.model.r_b + s_cam)
+        for side in (1.0, -1.0):  # the branch where the side force P tan(alpha) + G_y has the sign `side`
+            slope = 1.0 - sigma * self.mu * side * tan_a  # dP/dP of P - sgn(v) f on this branch
+            rest = m * s2 * omega * omega + F + sigma * self.mu * (side * self.G_y + self.N_g)
+            # J_0 omega_dot + s' P = drive;  m s' omega_dot - slope P = -rest
+            det = -J_0 * slope - m * s1 * s1
+            omega_dot = (-drive * slope + s1 * rest) / det
+            P = (-J_0 * rest - m * s1 * drive) / det
+            if side * (P * tan_a + self.G_y) >= 0.0:
+                break
+        f = self.mu * (abs(P * tan_a + self.G_y) + self.N_g)
+        return omega_dot, P, f
+
+    def direction(self, y) -> float:
+        """The sign of the flying follower's velocity over the next piece: sgn(v), or at a halt the way the net force
+        pushes it beyond the guide's static friction (0: held)."""
+        if y[4] != 0.0:
+            return sgn(y[4])
+        net = -closing_force(y[3], self.k, self.F0, self.F_gx)
+        return sgn(net) if abs(net) > self.f0 else 0.0
+
+    def free_acceleration(self, s: float, sigma: float) -> float:
+        """m/s2, the flying follower's acceleration, (-F_close(s) - sigma f0) / m (sigma = 0: held, 0)."""
+        if sigma == 0.0:
+            return 0.0
+        return (-closing_force(s, self.k, self.F0, self.F_gx) - sigma * self.f0) / self.m
+
+    def rates(self, y, u: float, contact: float, sigma: float = 0.0) -> list[float]:
+        """dy/dt; on the flank s and v follow the cam (their rates are the cam's); in flight the friction's
+        direction is -sigma (``direction``, held over a piece)."""
+        theta, omega, i, s, v = y[:5]
+        drive = self.torque(y, u)
+        omega_m = self.motor_speed(y)
+        di = self.motor.current_rate(u, i, omega_m) if self.has_current else 0.0
         if contact:
-            omega_dot, _ = self.on_flank(theta, omega, drive, contact)
+            omega_dot, _, _ = self.on_flank(theta, omega, drive, contact)
             _, s1, s2, _ = self.program.derivatives(theta)
-            return [omega, omega_dot, di, s1 * omega, s2 * omega * omega + s1 * omega_dot]
-        return [omega, drive / self.J_0, di, v, self.free_acceleration(s)]
+            dy = [omega, omega_dot, di, s1 * omega, s2 * omega * omega + s1 * omega_dot]
+        else:
+            dy = [omega, drive / self.J_0, di, v, self.free_acceleration(s, sigma)]
+        if self.compliant:  # the twist and the rotor: J_m omega_m_dot = c_m i - M_shaft
+            dy += [omega_m - omega, (self.model.c_m * self.current(y, u) - self.shaft_torque(y)) / self.model.J_m]
+        return dy
+
+    def friction_power(self, y, u: float, contact: float, sigma: float) -> float:
+        """W, the guide friction's dissipation f |v| (in flight f0 |v|)."""
+        if contact:
+            _, s1, _, _ = self.program.derivatives(y[0])
+            return self.on_flank(y[0], y[1], self.torque(y, u), contact)[2] * abs(s1 * y[1])
+        return self.f0 * abs(y[4]) if sigma else 0.0
+
+    def side_force(self, y, u: float, contact: float) -> float:
+        """N, the guide's side force N_r = P tan(alpha) + G_y on the flank ``contact`` (its sign is the friction's
+        branch; |N_r| has a kink where it changes)."""
+        s_cam, s1, _, _ = self.program.derivatives(y[0])
+        P = self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
+        return P * s1 / (self.model.r_b + s_cam) + self.G_y
 
     def contact_force(self, y, u: float, contact: float = 1.0) -> float:
         """N, contact P: the force the flank ``contact`` must give, along its normal (lift-off: contact while >= 0)."""
-        return contact * self.on_flank(y[0], y[1], self.torque(y[1], y[2], u), contact)[1]
+        return contact * self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
 
     def flank(self, theta: float, contact: float) -> tuple[float, float]:
         """(s [m], s' [m/rad]) of the follower on the flank ``contact`` at theta [rad]."""
@@ -89,46 +158,51 @@ class VoltageFollower:
         """m/s2, a bound of the follower's acceleration relative to the flank near y."""
         theta, omega = y[0], y[1]
         s, s1, s2, _ = self.program.derivatives(theta)
-        return (abs(self.free_acceleration(s)) + abs(s2) * omega * omega
-                + abs(s1 * self.torque(omega, y[2], u) / self.J_0) + 1e-300)
+        return (abs(closing_force(s, self.k, self.F0, self.F_gx)) / self.m + self.f0 / self.m
+                + abs(s2) * omega * omega + abs(s1 * self.torque(y, u) / self.J_0) + 1e-300)
 
     def land(self, y, u: float, contact: float = 1.0) -> tuple[float, list[float], Impact]:
-        """(contact after, state after, the impact) at a touch-down: w = v - s' omega becomes -e w with the shaft's
+        """(contact after, state after, the impact) at a touch-down: w = v - s' omega becomes -e w with the cam side's
         inertia J_0 taking -s' P; a rebound rising less than ZENO_HEIGHT (w^2 < 2 A ZENO_HEIGHT) is plastic, and the
-        follower stays on the flank where it holds it (P >= 0)."""
-        theta, omega, i, _, v = y
+        follower stays on the flank where it holds it (P >= 0). A compliant shaft's rotor is not in the impact."""
+        theta, omega, i, _, v = y[:5]
         s, s1 = self.flank(theta, contact)
         hit = impact(self.J_0, self.m, s1, omega, v, self.e)
         w = hit.v - s1 * hit.omega
         if w * w >= 2.0 * self.acceleration_scale(y, u) * ZENO_HEIGHT:
-            return 0.0, [theta, hit.omega, i, s, hit.v], hit
+            return 0.0, [theta, hit.omega, i, s, hit.v, *y[5:]], hit
         hit = impact(self.J_0, self.m, s1, omega, v, 0.0)
-        after = [theta, hit.omega, i, s, s1 * hit.omega]
+        after = [theta, hit.omega, i, s, s1 * hit.omega, *y[5:]]
         return (contact if self.contact_force(after, u, contact) >= 0.0 else 0.0), after, hit
 
     def stored_energy(self, y) -> float:
-        """J, the shaft's and follower's kinetic energy, the spring's F0 s + k s^2/2, gravity's -F_gx s, L i^2/2."""
-        _, omega, i, s, v = y
-        return (0.5 * self.J_0 * omega * omega + 0.5 * self.m * v * v + self.F0 * s + 0.5 * self.k * s * s
-                - self.F_gx * s + 0.5 * self.model.L * i * i)
+        """J, the cam side's and follower's kinetic energy, the spring's F0 s + k s^2/2, gravity's -F_gx s, L i^2/2;
+        on a compliant shaft the rotor's J_m omega_m^2/2 and the shaft's k phi^2/2 too."""
+        _, omega, i, s, v = y[:5]
+        energy = (0.5 * self.J_0 * omega * omega + 0.5 * self.m * v * v + self.F0 * s + 0.5 * self.k * s * s
+                  - self.F_gx * s + 0.5 * self.model.L * i * i)
+        if self.compliant:
+            energy += 0.5 * self.model.J_m * y[6] ** 2 + 0.5 * self.model.k_shaft * y[5] ** 2
+        return energy
 
     def outputs(self, y, u: float, contact: float) -> dict[str, float]:
         """Every output of the drive, with the follower's own s, v, a and N_contact [N] (0 in flight)."""
         model = self.model
-        theta, omega, i_state, s, v = y
+        theta, omega, _, s, v = y[:5]
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
-        drive = self.torque(omega, i_state, u)
+        drive = self.torque(y, u)
         shaft = self.M_f * sgn(omega)
         if contact:
-            omega_dot, P = self.on_flank(theta, omega, drive, contact)
+            omega_dot, P, _ = self.on_flank(theta, omega, drive, contact)
             a, M, J = s2 * omega * omega + s1 * omega_dot, shaft + P * s1, self.J_0 + self.m * s1 * s1
             N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: |P| / cos(alpha)
             s, v = s_cam - contact * self.c, s1 * omega
         else:
-            a, M, J, N = self.free_acceleration(s), shaft, self.J_0, 0.0
-        record = output_record(omega=omega, theta=theta, s=s, i=self.current(omega, i_state, u), M=M, J=J, v=v,
-                               a=a, alpha=math.atan(tan_a), s_cam=s_cam, voltage=u, theta_m=theta, omega_m=omega,
-                               M_shaft=0.0)
+            a, M, J, N = self.free_acceleration(s, self.direction(y)), shaft, self.J_0, 0.0
+        theta_m, omega_m = (theta + y[5], y[6]) if self.compliant else (theta, omega)
+        record = output_record(omega=omega, theta=theta, s=s, i=self.current(y, u), M=M,
+                               J=J + (model.J_m if self.compliant else 0.0), v=v, a=a, alpha=math.atan(tan_a),
+                               s_cam=s_cam, voltage=u, theta_m=theta_m, omega_m=omega_m, M_shaft=self.shaft_torque(y))
         record.update(N_contact=N, contact=contact)
         return record

@@ -30,6 +30,24 @@ TOUCH = 1e-12
 FLIGHT_ANGLE = 1e-2
 
 
+def next_breakpoint(breakpoints: list[float], theta: float, direction: float) -> float:
+    """The first of the profile's breakpoints [rad] (sorted over one turn, with 0 and 2 pi) strictly ahead of theta
+    [rad] in the direction of motion."""
+    two_pi = 2.0 * math.pi
+    base = math.floor(theta / two_pi) * two_pi
+    local = theta - base
+    eps = 1e-12 * max(1.0, abs(theta))
+    if direction > 0:
+        for b in breakpoints:
+            if b > local + eps:
+                return base + b
+        return base + two_pi + breakpoints[1]
+    for b in reversed(breakpoints):
+        if b < local - eps:
+            return base + b
+    return base - two_pi + breakpoints[-2]
+
+
 class PieceRun:
     """A hybrid run integrated piece by piece with solve_ivp (the follower's runs here and in voltage_flight.py).
 

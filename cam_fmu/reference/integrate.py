@@ -29,7 +29,7 @@ from ..physics.formulations.consistent import HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
-from .flight import follower_speed_reference
+from .flight import follower_speed_reference, next_breakpoint
 from .voltage_flight import follower_voltage_reference
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
@@ -86,20 +86,7 @@ class _Consistent:
 
     def _next_breakpoint(self, theta: float, direction: float) -> float:
         """The first profile breakpoint strictly ahead of theta in the direction of motion [rad]."""
-        two_pi = 2.0 * math.pi
-        turns = math.floor(theta / two_pi)
-        base = turns * two_pi
-        local = theta - base
-        eps = 1e-12 * max(1.0, abs(theta))
-        if direction > 0:
-            for b in self.breakpoints:
-                if b > local + eps:
-                    return base + b
-            return base + two_pi + self.breakpoints[1]
-        for b in reversed(self.breakpoints):
-            if b < local - eps:
-                return base + b
-        return base - two_pi + self.breakpoints[-2]
+        return next_breakpoint(self.breakpoints, theta, direction)
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
         model, hybrid, u = self.model, self.hybrid, self.u

@@ -1,23 +1,26 @@
 """The reference of the follower of its own on a voltage-driven cam (docs/model.md section 13.6).
 
-scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = (theta, omega, i, s, v) of
-``physics.voltage_follower.VoltageFollower``, with the energy integrals E_in = int u i dt, E_copper = int R i^2 dt
-and E_shaft = int M_f |omega| dt. Terminal events stop it at each lift-off (the contact force P reaches 0),
-touch-down (the gap reaches -TOUCH, as reference/flight.py), the shaft's stop (omega = 0: refused, the
-shaft's static friction with a free follower is not modelled) and input break; the transition is applied at the
-located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = (theta, omega, i, s, v), and
+(phi, omega_m) on a compliant shaft, of ``physics.voltage_follower.VoltageFollower``, with the energy integrals
+E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide = int f |v| dt and
+E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lift-off (the contact force P reaches
+0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
+the friction turns), the shaft's stop (omega = 0: refused, the shaft's static friction with a free follower is
+not modelled) and input break; the transition is applied at the located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations
 
+import math
 
 import numpy as np
 
+from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.signals import Signal
-from ..physics.voltage_follower import VoltageFollower
-from .flight import FLIGHT_ANGLE, TOUCH, PieceRun
+from ..physics.voltage_follower import VoltageFollower, sgn
+from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint
 
-STATE = 5  # theta, omega, i, s, v; then the energy integrals
+ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
 
 
 class VoltageFollowerRun(PieceRun):
@@ -35,13 +38,17 @@ class VoltageFollowerRun(PieceRun):
         self.loss = 0.0  # J, the impacts' losses so far
         self.lift_offs: list[tuple[float, float, float]] = []  # (t [s], s [m], v [m/s]) where the follower left the cam
         self.rebound = 0.0  # s, shorter than the bounce the last rebound starts (reference/flight.py), or 0
+        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [2.0 * math.pi]
+        self.target = 0.0  # rad, the breakpoint the current piece stops at
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
         body, model = self.body, self.body.model
         p = model.params
         theta0, omega0 = p["theta0"], p["omega0"]
         s_cam, s1, _, _ = body.program.derivatives(theta0)
-        y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0] + [0.0, 0.0, 0.0]
+        y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0]
+        y += [0.0, omega0] if body.compliant else []  # the shaft relaxed, the rotor at the cam's speed (model.md 12.1)
+        y += [0.0] * len(ENERGY)
         t = float(grid[0])
         contact, y = self._settle(t, y, 1.0)
         if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
@@ -52,23 +59,38 @@ class VoltageFollowerRun(PieceRun):
         return self.pieces(grid, t, y, contact, sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
 
     def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
-        options = {"method": self.method, "atol": [self.atol] * STATE + [self.atol * 1e-2] * 3}
+        n = self.body.size
+        options = {"method": self.method, "atol": [self.atol] * n + [self.atol * 1e-2] * len(ENERGY)}
         if contact == 0.0 and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
             options["max_step"] = FLIGHT_ANGLE / abs(y[1])  # could hold a gap's crossing and its return
-        return self._events(contact), self._rhs(contact), options
+        sigma = self.body.direction(y) if contact == 0.0 else 0.0  # the flight's friction direction, held
+        events = self._events(contact, sigma, t, y)
+        # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md 6.3): DOP853
+        # stepping over one with guide friction was 2.5e-7 rad/s off.
+        target = self.target = next_breakpoint(self.breakpoints, y[0], 1.0)
 
-    def _rhs(self, contact: float):
-        body, u, energy = self.body, self.u, self.energy
-        R, M_f = body.model.R, body.M_f
+        def breakpoint(t, y):
+            return target - y[0]
+        breakpoint.terminal, breakpoint.direction, breakpoint.kind = True, -1, "breakpoint"
+        return events + [breakpoint], self._rhs(contact, sigma), options
+
+    def _rhs(self, contact: float, sigma: float):
+        body, u, energy, n = self.body, self.u, self.energy, self.body.size
+        R, M_f, d_shaft = body.model.R, body.M_f, body.model.d_shaft
 
         def rhs(t, y):
             u_t = u.value(t)
-            dy = body.rates(y[:STATE], u_t, contact)
-            i = body.current(y[1], y[2], u_t)
-            return dy + ([u_t * i, R * i * i, M_f * abs(y[1])] if energy else [0.0, 0.0, 0.0])
+            state = y[:n]
+            dy = body.rates(state, u_t, contact, sigma)
+            if not energy:
+                return dy + [0.0] * len(ENERGY)
+            i = body.current(state, u_t)
+            slip = body.motor_speed(state) - y[1]
+            return dy + [u_t * i, R * i * i, M_f * abs(y[1]), body.friction_power(state, u_t, contact, sigma),
+                         d_shaft * slip * slip if body.compliant else 0.0]
         return rhs
 
-    def _events(self, contact: float) -> list:
+    def _events(self, contact: float, sigma: float, t0: float, y0: list) -> list:
         body, u = self.body, self.u
         events = []
 
@@ -78,48 +100,59 @@ class VoltageFollowerRun(PieceRun):
 
         add("stop", lambda t, y: y[1])
         if contact:
-            add("lift-off", lambda t, y: body.contact_force(y[:STATE], u.value(t), contact))
+            add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
+            side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
+            if side != 0.0:  # the piece ends just past the kink of |N_r| (by 1e-9 N, docs/model.md 10), no transition
+                add("side", lambda t, y: side * body.side_force(y[:body.size], u.value(t), contact) + SIDE_HYSTERESIS)
             return events
         add("touch-down +1", lambda t, y: body.gap(y, 1.0) + TOUCH)
         if body.two_sided:
             add("touch-down -1", lambda t, y: body.gap(y, -1.0) + TOUCH)
+        if body.f0 > 0.0 and sigma != 0.0:  # the friction's direction turns where v does
+            add("halt", lambda t, y: sigma * y[4])
         return events
 
     def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
-        body, u_t = self.body, self.u.value(t)
+        body, u_t, n = self.body, self.u.value(t), self.body.size
         if kind == "stop":
             raise RuntimeError(f"{self.label}: the shaft stops at t = {t!r} s; its static friction "
                                "with a follower of its own is not modelled (docs/model.md 13.6)")
         if kind == "lift-off":
             s, s1 = body.flank(y[0], contact)
             self.lift_offs.append((t, s, s1 * y[1]))
-            return 0.0, y[:3] + [s, s1 * y[1]] + y[STATE:]
+            return 0.0, y[:3] + [s, s1 * y[1]] + y[5:]
+        if kind == "halt":
+            return 0.0, y[:4] + [0.0] + y[5:]
+        if kind == "side":
+            return contact, y
+        if kind == "breakpoint":  # on from just past it: a root a rounding short of it lies on the piece before
+            return contact, [max(y[0], self.target + 1e-15 * max(1.0, abs(self.target)))] + y[1:]
         s1 = body.program.derivatives(y[0])[1]
         w_before = y[4] - s1 * y[1]
-        after, state, hit = body.land(y[:STATE], u_t, 1.0 if kind == "touch-down +1" else -1.0)
+        after, state, hit = body.land(y[:n], u_t, 1.0 if kind == "touch-down +1" else -1.0)
         self.loss += hit.loss
         w = state[4] - s1 * state[1]
         self.impacts.append((t, w_before, w))
         if after == 0.0 and w != 0.0:
             self.rebound = abs(w) / (2.0 * body.acceleration_scale(state, u_t))
-        return after, state + y[STATE:]
+        return after, state + y[n:]
 
     def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
         """On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s'')."""
         if contact:
             s, s1 = self.body.flank(y[0], contact)
-            y = y[:3] + [s, s1 * y[1]] + y[STATE:]
-            if self.body.contact_force(y[:STATE], self.u.value(t), contact) < 0.0:
+            y = y[:3] + [s, s1 * y[1]] + y[5:]
+            if self.body.contact_force(y[:self.body.size], self.u.value(t), contact) < 0.0:
                 self.lift_offs.append((t, y[3], y[4]))
                 return 0.0, y
         return contact, y
 
     def _row(self, t: float, y, contact: float) -> dict[str, float]:
-        row = self.body.outputs([float(x) for x in y[:STATE]], self.u.value(t), contact)
+        n = self.body.size
+        row = self.body.outputs([float(x) for x in y[:n]], self.u.value(t), contact)
         row["impacts"] = float(len(self.impacts))
         if self.energy:
-            row.update(E_in=float(y[5]), E_copper=float(y[6]), E_shaft=float(y[7]), E_guide=0.0, E_damp=0.0,
-                       E_impact=self.loss)
+            row.update({name: float(value) for name, value in zip(ENERGY, y[n:])}, E_impact=self.loss)
         return row
 
 

@@ -131,4 +131,5 @@ def test_the_follower_is_clean_under_asan_and_ubsan(tmp_path):
                           env={"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0", "UBSAN_OPTIONS": "print_stacktrace=1"})
     assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr, proc.stderr[-3000:]
     assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stderr[-3000:]
-    assert [line.split()[0] for line in proc.stdout.splitlines()[:-1]] == ["spring", "spring", "form", "spring", "form"]  # the last two: voltage
+    assert [line.split()[0] for line in proc.stdout.splitlines()[:-1]] == ["spring", "spring", "form", "spring", "form",
+                                                                 "spring"]  # the last three: voltage, the last with mu, k_shaft

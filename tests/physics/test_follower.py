@@ -243,7 +243,7 @@ def test_a_bouncing_follower_never_leaves_the_groove(c, e, omega):
 
 @pytest.mark.parametrize("params, words", [
     (dict(drive="speed", closure="spring", c=1e-3), "'c'"),
-    (dict(drive="voltage", closure="spring"), "'mu'"),  # the voltage drive's refusals: tests/physics/test_voltage_follower.py
+    (dict(drive="voltage", closure="spring"), "'omega0'"),  # the voltage drive's refusals: tests/physics/test_voltage_follower.py
     (dict(restitution=0.5), "plastic impacts only"),
     (dict(k_spring=100.0), "closure 'spring'"),
     (dict(drive="speed", closure="spring", m=0.0), "'m'"),

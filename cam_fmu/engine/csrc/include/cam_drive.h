@@ -65,6 +65,13 @@ void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, doub
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err);
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[]);
+/* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
+typedef double (*CamEventValue)(void *ctx, int code, double x);
+/* The earliest of the n event functions codes[k] (non-zero codes) to cross, as `crossed(before, after)` says, from
+ * fa[k] at a to fb[k] at b: located by bisection to the last bit (the first x where crossed(fa[k], value) holds); its
+ * code, or 0 for none, and *at (follower.c, voltage_follower.c). */
+int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
+                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at);
 /* Append one transition to a step's log line `events` of `len` bytes (*dropped counts what no longer fits). */
 void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...);
 

@@ -32,6 +32,12 @@ typedef struct {
     double tau0, s0, v0, sigma;         /* a piece of flight from tau0, the friction's direction -sigma */
 } Piece;
 
+typedef struct {                        /* an event function's arguments but its code and time (motion_event) */
+    const Motion *mo;
+    const Piece *p;
+    double contact;
+} Scan;
+
 static double sgn(double x)
 {
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
@@ -122,12 +128,25 @@ static double acceleration_scale(const Motion *mo, double theta, double omega, d
            + fabs(d[1] * omega_dot) + 1e-300;
 }
 
+/* A downward crossing of an event function (solve_ivp's direction -1): from >= 0 to <= 0. */
+static int downward(double before, double after)
+{
+    return before >= 0.0 && after <= 0.0;
+}
+
+static double motion_event(void *ctx, int code, double tau)
+{
+    const Scan *scan = ctx;
+    return event_value(scan->mo, scan->p, scan->contact, code, tau);
+}
+
 /* The first event in (tau, end]: its code (EV_NONE: none) and *at, located by bisection between samples. */
 static int first_event(const Motion *mo, const Piece *p, double contact, double tau, double end, double rebound,
                        double *at)
 {
     int codes[3], n = 0, k, found = EV_NONE;
-    double spacing, a = tau, fa[3], omega_max = fabs(mo->omega0) + fabs(mo->omega_dot) * (end - tau);
+    double spacing, a = tau, fa[3], fb[3], omega_max = fabs(mo->omega0) + fabs(mo->omega_dot) * (end - tau);
+    Scan scan = {mo, p, contact};
     if (contact != 0.0)
         codes[n++] = EV_LIFT_OFF;
     else {
@@ -143,33 +162,44 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
     for (k = 0; k < n; k++)
         fa[k] = event_value(mo, p, contact, codes[k], a);
     while (a < end && found == EV_NONE) {
-        double b = a + (rebound > 0.0 && a - tau < rebound ? fmin(spacing, rebound / 8.0) : spacing), best = end;
+        double b = a + (rebound > 0.0 && a - tau < rebound ? fmin(spacing, rebound / 8.0) : spacing);
         if (b > end || end - b < 1e-3 * spacing)
             b = end;
-        for (k = 0; k < n; k++) {
-            double fb = event_value(mo, p, contact, codes[k], b);
-            if (fa[k] >= 0.0 && fb <= 0.0) {   /* a crossing downward (solve_ivp's direction -1) */
-                double lo = a, hi = b;
-                for (;;) {
-                    double mid = 0.5 * (lo + hi);
-                    if (mid <= lo || mid >= hi)
-                        break;
-                    if (event_value(mo, p, contact, codes[k], mid) > 0.0)
-                        lo = mid;
-                    else
-                        hi = mid;
-                }
-                if (hi < best || found == EV_NONE) {
-                    best = hi;
-                    found = codes[k];
-                }
-            }
-            fa[k] = fb;
-        }
-        if (found != EV_NONE)
-            *at = best;
+        for (k = 0; k < n; k++)
+            fb[k] = event_value(mo, p, contact, codes[k], b);
+        found = cam_locate_first_event(n, codes, a, b, fa, fb, downward, motion_event, &scan, at);
+        for (k = 0; k < n; k++)
+            fa[k] = fb[k];
         a = b;
     }
+    return found;
+}
+
+int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
+                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at)
+{
+    int k, found = 0;
+    double best = b;
+    for (k = 0; k < n; k++) {
+        double lo = a, hi = b;
+        if (!crossed(fa[k], fb[k]))
+            continue;
+        for (;;) {
+            double mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi)
+                break;
+            if (crossed(fa[k], value(ctx, codes[k], mid)))
+                hi = mid;
+            else
+                lo = mid;
+        }
+        if (hi < best || found == 0) {
+            best = hi;
+            found = codes[k];
+        }
+    }
+    if (found != 0)
+        *at = best;
     return found;
 }
 

@@ -350,19 +350,11 @@ static int check_closure(const CamModel *model, CamError *err)
                          cam_num(v[CAM_P_M], a), closure, kinematic);
     if (model->formulation == CAM_FORM_SPEED)
         return CAM_OK;
-    /* The voltage drive: the reference's refusals (docs/model.md 13.6). */
+    /* The voltage drive: the reference's refusals (docs/model.md 13.6); guide friction and a compliant shaft run. */
     if (model->formulation != CAM_FORM_CONSISTENT)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
                          "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
                          "'consistent'", closure);
-    if (v[CAM_P_K_SHAFT] > 0.0)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'k_shaft' = %s N.m/rad: a follower of its own on a "
-                         "compliant shaft is not modelled yet; allowed with drive 'voltage' and closure '%s': "
-                         "k_shaft = 0%s", cam_num(v[CAM_P_K_SHAFT], a), closure, kinematic);
-    if (v[CAM_P_GUIDE_FRICTION] != 0.0 && v[CAM_P_MU] > 0.0)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'mu' = %s: guide friction with a follower of its own on a "
-                         "voltage-driven cam is not modelled yet; allowed with drive 'voltage' and closure '%s': "
-                         "mu = 0 (or guide_friction false)%s", cam_num(v[CAM_P_MU], a), closure, kinematic);
     if (!(v[CAM_P_OMEGA0] > 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'omega0' = %s rad/s: the shaft's static friction with a "
                          "follower of its own is not modelled yet (the run is refused where the shaft stops); allowed "

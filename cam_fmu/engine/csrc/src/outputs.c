@@ -56,9 +56,14 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
 static double mechanical(const CamEnergy *e, const double out[])
 {
     double omega = out[CAM_O_OMEGA], twist, omega_m, s = out[CAM_O_S], v = out[CAM_O_V];
-    if (e->own_follower)   /* the shaft's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
-        return 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s + 0.5 * e->k_spring * s * s
-               - e->F_gx * s;
+    if (e->own_follower) {   /* the cam side's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
+        double own = 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s
+                     + 0.5 * e->k_spring * s * s - e->F_gx * s;
+        if (e->k_shaft == 0.0)
+            return own;
+        twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];   /* and a compliant shaft's rotor and elastic energy */
+        return own + 0.5 * e->J_m * out[CAM_O_OMEGA_M] * out[CAM_O_OMEGA_M] + 0.5 * e->k_shaft * twist * twist;
+    }
     if (e->k_shaft == 0.0)
         return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S];
     twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];

@@ -1,14 +1,19 @@
 /* The follower as a body of its own on a voltage-driven cam, closures 'spring' and 'form' (a groove's flanks at
- * s_cam - c, contact +1, and s_cam + c, contact -1): the consistent formulation with a rigid shaft and no guide
- * friction (docs/model.md section 13.6; its check is the reference's physics/voltage_follower.py and
- * reference/voltage_flight.py, written independently). y = (theta, omega, i, s, v): theta, omega, i in d->x,
- * the follower's s, v, contact (+1, -1 on a flank, 0 in flight), touch-downs and the rebound guard in d->speed (saved
- * with the state). In contact J omega_dot = c_m i - M_f sgn(omega) - (m s'' omega^2 + F_close) s' with J = J_0 + m
- * s'^2 and the force P = m (s'' omega^2 + s' omega_dot) + F_close along X; lift-off where contact P reaches 0; in
- * flight J_0 omega_dot = c_m i - M_f sgn(omega) and m s_dd = -F_close(s); touch-down where a gap reaches -TOUCH,
- * an impact exchanging momentum with the shaft (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic
- * Runge-Kutta steps of at most STEP_ANGLE of cam angle and STEP_PHASE of the flight's period; an event function
- * gone from > 0 to <= 0 over a step is located by bisection on the step's length. A shaft that stops is refused. */
+ * s_cam - c, contact +1, and s_cam + c, contact -1): the consistent formulation with guide friction and a rigid or
+ * compliant shaft (docs/model.md section 13.6; its check is the reference's physics/voltage_follower.py and
+ * reference/voltage_flight.py, written independently). y = (theta, omega, i, s, v, phi, omega_m, sigma): theta,
+ * omega, i and a compliant shaft's twist phi and rotor speed omega_m in d->x, the follower's s, v, contact (+1, -1 on
+ * a flank, 0 in flight), touch-downs and the rebound guard in d->speed (saved with the state); sigma is the flying
+ * follower's direction, held over a step (rate 0). The cam side is driven by T = c_m i (rigid) or the shaft's
+ * k phi + d (omega_m - omega), less M_f sgn(omega). In contact
+ * J omega_dot = T - (m s'' omega^2 + F_close + sgn(v) f) s'
+ * with J = J_0 + m s'^2, the guide friction f solved with omega_dot as model.c's load_terms does (section 4.4 with
+ * F_close in gravity's place), and the force P = m (s'' omega^2 + s' omega_dot) + F_close + sgn(v) f along X;
+ * lift-off where contact P reaches 0; in flight J_0 omega_dot = T and m s_dd = -F_close(s) - sigma f0 (f0 the
+ * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -TOUCH, an impact exchanging
+ * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
+ * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
+ * from > 0 to <= 0 over a step is located by bisection on the step's length. A shaft that stops is refused. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -21,20 +26,43 @@
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
-#define NY 5
+#define NY 8
+#define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
+#define Y_ROTOR 6
+#define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
 
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN };   /* touch-down on flank +1, -1 */
+/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
+enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK, EV_SIDE };
 
 static double sgn(double x)
 {
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
-/* N m: the motor's torque (the state's current with L > 0, else quasi-static) less the shaft's friction. */
+/* A: the armature current, the state's with L > 0, else quasi-static at the rotor's speed. */
+static double current(const CamModel *m, const double y[NY], double u)
+{
+    return m->has_current ? y[2] : (u - m->c_e * (m->compliant ? y[Y_ROTOR] : y[1])) / m->R;
+}
+
+/* N m: a compliant shaft's torque on the cam, k phi + d (omega_m - omega). */
+static double shaft_torque(const CamModel *m, const double y[NY])
+{
+    return m->k_shaft * y[Y_TWIST] + m->d_shaft * (y[Y_ROTOR] - y[1]);
+}
+
+/* N m: what drives the cam side, the motor's torque (rigid) or the shaft's, less the shaft's friction. */
 static double torque(const CamModel *m, const double y[NY], double u)
 {
-    double drive = m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R;
+    double drive = m->compliant ? shaft_torque(m, y)
+                   : (m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R);
     return drive - m->M_f * sgn(y[1]);
+}
+
+/* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
+static double friction0(const CamModel *m)
+{
+    return m->mu * (fabs(m->G_y) + m->N_g);
 }
 
 static double closing(const CamModel *m, double s)
@@ -49,21 +77,73 @@ static double clearance(const CamModel *m)
 }
 
 /* On the flank `contact` at y: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the force P [N] along X of the
- * coupled equations. */
+ * coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot (model.c load_terms with
+ * F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
+static void flank_terms(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                        double *P, double *n_r)
+{
+    double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
+    cam_profile_eval(&m->profile, y[0], d);
+    F = closing(m, d[0] - contact * clearance(m));
+    if (m->mu == 0.0) {
+        *omega_dot = (torque(m, y, u) - (m->m * d[2] * omega * omega + F) * d[1]) / (m->J_0 + m->m * d[1] * d[1]);
+        *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
+        *n_r = 0.0;
+        return;
+    }
+    J = m->J_0 + m->m * d[1] * d[1];
+    inertial = m->m * d[2] * omega * omega + F;
+    x0 = (torque(m, y, u) - inertial * d[1]) / J;
+    sigma = sgn(d[1] * omega);
+    tan_a = d[1] / (m->r_b + d[0]);
+    n0 = (inertial + m->m * d[1] * x0) * tan_a + m->G_y;
+    kappa = m->J_0 / J * tan_a;
+    f = cam_guide_friction(n0, kappa, sigma, m->mu, m->N_g, 0.0);
+    *omega_dot = x0 - sigma * f * d[1] / J;
+    *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
+    *n_r = n0 + sigma * kappa * f;
+}
+
 static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
                      double *P)
 {
-    double omega = y[1], F;
-    cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0] - contact * clearance(m));
-    *omega_dot = (torque(m, y, u) - (m->m * d[2] * omega * omega + F) * d[1]) / (m->J_0 + m->m * d[1] * d[1]);
-    *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
+    double n_r;
+    flank_terms(m, y, u, contact, d, omega_dot, P, &n_r);
+}
+
+/* N: the guide's side force N_r on the flank `contact` at y (0 without guide friction). */
+static double side_force(const CamModel *m, const double y[NY], double u, int contact)
+{
+    double d[4], omega_dot, P, n_r;
+    flank_terms(m, y, u, contact, d, &omega_dot, &P, &n_r);
+    return n_r;
+}
+
+/* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
+static double free_acceleration(const CamModel *m, double s, double sigma)
+{
+    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * friction0(m)) / m->m;
+}
+
+/* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
+ * the guide's static friction (0: held). */
+static double flight_direction(const CamModel *m, const double y[NY])
+{
+    double net;
+    if (y[4] != 0.0)
+        return sgn(y[4]);
+    net = -closing(m, y[3]);
+    return fabs(net) > friction0(m) ? sgn(net) : 0.0;
 }
 
 static void rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
+    double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
-    dy[2] = m->has_current ? (u - m->R * y[2] - m->c_e * y[1]) / m->L : 0.0;
+    dy[2] = m->has_current ? (u - m->R * y[2] - m->c_e * omega_m) / m->L : 0.0;
+    dy[Y_TWIST] = m->compliant ? omega_m - y[1] : 0.0;
+    dy[Y_ROTOR] = m->compliant ? (m->c_m * current(m, y, u) - shaft_torque(m, y)) / m->J_m : 0.0;
+    dy[Y_SIGMA] = 0.0;
     if (contact) {
         double d[4], P;
         on_flank(m, y, u, contact, d, &dy[1], &P);
@@ -73,7 +153,7 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
     }
     dy[1] = torque(m, y, u) / m->J_0;
     dy[3] = y[4];
-    dy[4] = -closing(m, y[3]) / m->m;
+    dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -116,8 +196,21 @@ static double event_value(const CamModel *m, double u, int code, int contact, co
         on_flank(m, y, u, contact, d, &omega_dot, &P);
         return contact * P;
     }
+    if (code == EV_HALT)
+        return y[Y_SIGMA] * y[4];
     cam_profile_eval(&m->profile, y[0], d);
     return code == EV_TOUCH_UP ? y[3] - (d[0] - clearance(m)) + TOUCH : (d[0] + clearance(m)) - y[3] + TOUCH;
+}
+
+/* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
+ * EV_SIDE the side force N_r times its sign at[1] at the step's start, past 0 by CAM_SIDE_HYSTERESIS (|N_r|'s kink). */
+static double event_at(const CamModel *m, double u, int code, int contact, const double at[2], const double y[NY])
+{
+    if (code == EV_BREAK)
+        return at[0] - y[0];
+    if (code == EV_SIDE)
+        return at[1] * side_force(m, y, u, contact) + CAM_SIDE_HYSTERESIS;
+    return event_value(m, u, code, contact, y);
 }
 
 static int crossed(double before, double after)
@@ -125,12 +218,29 @@ static int crossed(double before, double after)
     return (before > 0.0 && after <= 0.0) || (before == 0.0 && after < 0.0);
 }
 
+typedef struct {                /* a Runge-Kutta step from y and its event functions (trial_event) */
+    const CamModel *m;
+    double u;
+    int contact;
+    const double *ends, *y;
+} Trial;
+
+/* The event function `code` at the end of a Runge-Kutta step of h [s] from the trial's y. */
+static double trial_event(void *ctx, int code, double h)
+{
+    const Trial *t = ctx;
+    double out[NY];
+    rk4(t->m, t->u, t->contact, t->y, h, out);
+    return event_at(t->m, t->u, code, t->contact, t->ends, out);
+}
+
 /* m/s2: a bound of the follower's acceleration relative to the flank near y (voltage_follower.acceleration_scale). */
 static double acceleration_scale(const CamModel *m, const double y[NY], double u)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return fabs(closing(m, d[0]) / m->m) + fabs(d[2]) * y[1] * y[1] + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
+    return fabs(closing(m, d[0]) / m->m) + friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+           + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
 /* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
@@ -171,6 +281,9 @@ static void load_y(const CamDrive *d, double y[NY])
     y[2] = d->x[CAM_CURRENT];
     y[3] = d->speed.s;
     y[4] = d->speed.v;
+    y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
+    y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
+    y[Y_SIGMA] = flight_direction(&d->model, y);
 }
 
 static void store_y(CamDrive *d, const double y[NY])
@@ -180,6 +293,10 @@ static void store_y(CamDrive *d, const double y[NY])
     d->x[CAM_CURRENT] = y[2];
     d->speed.s = y[3];
     d->speed.v = y[4];
+    if (d->model.compliant) {
+        d->x[CAM_TWIST] = y[Y_TWIST];
+        d->x[CAM_OMEGA_M] = y[Y_ROTOR];
+    }
     d->speed.theta = y[0];
     d->speed.speed = y[1];
 }
@@ -232,7 +349,11 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     const CamModel *m = &d->model;
     double y[NY], next[NY], trial[NY], u = d->form_u, tau = 0.0, rebound = d->speed.rebound;
     double wn = m->k_spring > 0.0 ? sqrt(m->k_spring / m->m) : 0.0;
-    double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / (m->J_0 * m->L)) : 0.0;
+    double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
+                  : 0.0;
+    double ws = m->compliant ? sqrt(m->k_shaft * (1.0 / m->J_m + 1.0 / m->J_0)) + m->d_shaft * (1.0 / m->J_m
+                                                                                                  + 1.0 / m->J_0)
+                : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
     int contact = (int)d->speed.contact, events = 0;
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
@@ -241,14 +362,18 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
-        int codes[3], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt;
+        int codes[6], n = 0, k, code = EV_NONE;
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
         if (y[1] != 0.0)
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
         if (pole > 0.0)
             dt = fmin(dt, 0.5 / pole);
+        if (ws > 0.0)
+            dt = fmin(dt, STEP_PHASE / ws);
+        if (!contact)
+            y[Y_SIGMA] = flight_direction(m, y);
         if (rebound > 0.0)
             dt = fmin(dt, rebound);   /* a bounce lasts about 4 rebound: the first step cannot hold it */
         if (++taken > MAX_STEPS)
@@ -263,26 +388,22 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
+            if (y[Y_SIGMA] != 0.0 && friction0(m) > 0.0)
+                codes[n++] = EV_HALT;
         }
+        ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
+        if (ends[0] == ends[0])   /* the step ends just past the profile's breakpoint (s'' or s''' jumps there) */
+            codes[n++] = EV_BREAK;
+        if (contact && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
+            codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
         for (k = 0; k < n; k++) {
-            double lo = 0.0, hi = dt, before = event_value(m, u, codes[k], contact, y);
-            if (!crossed(before, event_value(m, u, codes[k], contact, next)))
-                continue;
-            while (hi - lo > 0.0) {
-                double mid = 0.5 * (lo + hi);
-                if (mid <= lo || mid >= hi)
-                    break;
-                rk4(m, u, contact, y, mid, trial);
-                if (crossed(before, event_value(m, u, codes[k], contact, trial)))
-                    hi = mid;
-                else
-                    lo = mid;
-            }
-            if (hi < at || code == EV_NONE) {
-                at = hi;
-                code = codes[k];
-            }
+            before[k] = event_at(m, u, codes[k], contact, ends, y);
+            after[k] = event_at(m, u, codes[k], contact, ends, next);
+        }
+        {
+            Trial tr = {m, u, contact, ends, y};
+            code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
         }
         if (code == EV_NONE) {
             memcpy(y, next, sizeof y);
@@ -297,13 +418,23 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             rebound = fmax(rebound - (code == EV_NONE ? dt : at), 0.0);
         if (code == EV_NONE)
             continue;
+        if (code == EV_SIDE)
+            continue;
+        if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
+            if (contact && !(contact = settle(m, y, u, contact)))
+                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
+                                  "(theta = %.6g rad); ", time + tau, y[0]);
+            continue;
+        }
         if (++events > MAX_EVENTS)
             return cam_error(err, CAM_ERR_SIMULATION, "the follower changed contact more than %d times in one step "
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
         if (code == EV_STOP)
             return cam_error(err, CAM_ERR_SIMULATION, "the shaft stops at t = %.9g s: its static friction with a "
                              "spring-closed follower of its own is not modelled (docs/model.md 13.6)", time + tau);
-        if (code == EV_LIFT_OFF) {
+        if (code == EV_HALT) {
+            y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
+        } else if (code == EV_LIFT_OFF) {
             set_on_flank(m, y, contact);
             cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d at "
                               "t = %.9g s (theta = %.6g rad); ", contact, time + tau, y[0]);
@@ -341,7 +472,7 @@ static void vf_outputs(CamDrive *d, double out[])
     CamLoad load;
     load_y(d, y);
     cam_profile_eval(&m->profile, y[0], dd);
-    i = m->has_current ? y[2] : (d->form_u - m->c_e * y[1]) / m->R;
+    i = current(m, y, d->form_u);
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
     load.s_cam = dd[0];
     load.f = 0.0;
@@ -357,9 +488,15 @@ static void vf_outputs(CamDrive *d, double out[])
         load.M = m->M_f * sgn(y[1]);
         load.J = m->J_0;
         load.v = y[4];
-        load.a = -closing(m, y[3]) / m->m;
+        load.a = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
     }
     cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
+    if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too (outputs.c cam_outputs) */
+        out[CAM_O_J] = load.J + m->J_m;
+        out[CAM_O_THETA_M] = y[0] + y[Y_TWIST];
+        out[CAM_O_OMEGA_M] = y[Y_ROTOR];
+        out[CAM_O_M_SHAFT] = shaft_torque(m, y);
+    }
 }
 
 static void vf_advice(const CamDrive *d, char *buf, size_t len)
