@@ -10,7 +10,8 @@ size, and refuses a folder whose specification differs. Every case's row depends
 table (sorted by case) equals an uninterrupted run's bit for bit.
 
 Memory stays bounded: the driver holds at most ``2 x workers + 1`` batches in flight (their values and rows),
-never the case list or the table. The batch size is chosen from a pilot case timed in the driver: about
+never the case list or the table; dask's message logs keep LOG_LENGTH messages a stream, not 1000. The batch
+size is chosen from a pilot case timed in the driver: about
 BATCH_SECONDS of work a batch (dask's per-task cost, a few ms, is then under 1 %), at least 4 batches a
 worker (the last batches balance), at most MAX_BATCH cases.
 """
