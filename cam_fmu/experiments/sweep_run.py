@@ -10,12 +10,14 @@ size, and refuses a folder whose specification differs. Every case's row depends
 table (sorted by case) equals an uninterrupted run's bit for bit.
 
 Memory stays bounded: the driver holds at most ``2 x workers + 1`` batches in flight (their values and rows),
-never the case list or the table. The batch size is chosen from a pilot case timed in the driver: about
+never the case list or the table; dask's message logs keep LOG_LENGTH messages a stream, not 1000. The batch
+size is chosen from a pilot case timed in the driver: about
 BATCH_SECONDS of work a batch (dask's per-task cost, a few ms, is then under 1 %), at least 4 batches a
 worker (the last batches balance), at most MAX_BATCH cases.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -31,6 +33,11 @@ from .sweep import Design, SweepError, header, run_batch, run_case
 
 BATCH_SECONDS = 1.0  # s of work per batch
 MAX_BATCH = 50_000
+# dask.distributed keeps the last ``distributed.admin.low-level-log-length`` (default 1000) messages of every
+# batched stream for debugging, each under 1 MB kept whole: the scheduler's stream to a worker holds the
+# batches' tasks (their values), the client's to the scheduler the same, so the driver (the local scheduler's
+# process) grew by a batch's values per batch until 1000 a stream. A short log bounds that to a few batches.
+LOG_LENGTH = 8
 SPEC_FILE = "sweep.json"
 FORMAT = 1  # of the dataset's files and sweep.json
 
@@ -225,11 +232,19 @@ def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler
         raise SweepError(f"--batch-size {batch_size}: allowed >= 1")
     t0 = time.perf_counter()
     on_disk = sum(e - f for f, e, _ in done)
+    logs = contextlib.ExitStack()
     if serial:
         n_workers, client, cluster = 1, None, None
     else:
-        client, cluster = _client(workers, scheduler)
-        n_workers = max(1, len(client.scheduler_info()["workers"]))
+        import dask
+
+        logs.enter_context(dask.config.set({"distributed.admin.low-level-log-length": LOG_LENGTH}))
+        try:
+            client, cluster = _client(workers, scheduler)
+            n_workers = max(1, len(client.scheduler_info()["workers"]))
+        except BaseException:
+            logs.close()
+            raise
     try:
         if "batch_size" not in spec:
             spec["batch_size"] = batch_size or choose_batch_size(pilot_seconds(plan), n, n_workers)
@@ -251,6 +266,7 @@ def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler
                 client.close()
                 if cluster is not None:
                     cluster.close()
+        logs.close()
     return Summary(n, counts[0], counts[1], counts[2], time.perf_counter() - t0, spec["batch_size"], n_workers,
                    interrupted)
 

@@ -290,3 +290,33 @@ def test_an_interrupted_serial_sweep_keeps_its_partial_batch_and_resumes_to_the_
     again = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
     assert f"({120 - kept} to run)" in again.stderr
     assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "whole" / "paper_fig6_sweep.csv").read_text()
+
+
+def test_the_driver_holds_a_bounded_number_of_batches_however_many_run(tmp_path):
+    """120 batches on a local cluster (scheduler in this process): the batches' jobs (their values) alive in
+    this process stay a few times the window (2 x workers + 1), not one per batch; dask's message logs, which
+    kept the last 1000 messages of every stream with the jobs in them, hold at most LOG_LENGTH each."""
+    import gc
+
+    from distributed.batched import BatchedSend
+
+    from cam_fmu.experiments.scenes import find_scene
+    from cam_fmu.experiments.sweep_run import LOG_LENGTH, Plan, run_sweep
+
+    plan = Plan("paper_fig6", find_scene("paper_fig6"), Design((parse_vary("m=0.2:0.8"),), ("random", 600)),
+                ("peak_i",), stop_time=0.01)
+    seen: list[tuple[int, int, list[int]]] = []
+
+    def progress(done: int, total: int, failed: int) -> None:
+        if done in (300, total):
+            gc.collect()
+            jobs = sum(1 for o in gc.get_objects() if type(o) is dict and "values" in o and "start" in o)
+            logs = [len(o.recent_message_log) for o in gc.get_objects() if isinstance(o, BatchedSend)]
+            seen.append((done, jobs, logs))
+
+    summary = run_sweep(plan, tmp_path, workers=2, batch_size=5, progress=progress)
+    assert summary.done == 600 and summary.failed == 0
+    assert [d for d, _, _ in seen] == [300, 600]
+    for done, jobs, logs in seen:
+        assert jobs <= 3 * (2 * 2 + 1), (done, jobs)  # 60 and 120 batches submitted by then
+        assert logs and max(logs) <= LOG_LENGTH, (done, logs)
