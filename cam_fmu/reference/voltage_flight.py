@@ -23,6 +23,12 @@ from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
 
 
+def stuck_in_flight(t: float) -> str:
+    """The refusal of a cam held by the shaft's static friction while the follower is off it (docs/model.md 13.6)."""
+    return (f"the shaft is stuck at t = {t:.9g} s with the follower off the cam: a cam held by its static friction while the "
+            "follower flies across to it is not modelled (docs/model.md 13.6)")
+
+
 class VoltageFollowerRun(PieceRun):
     """One run of the voltage drive with a spring-closed follower of its own."""
 
@@ -50,12 +56,15 @@ class VoltageFollowerRun(PieceRun):
         y += [0.0, omega0] if body.compliant else []  # the shaft relaxed, the rotor at the cam's speed (model.md 12.1)
         y += [0.0] * len(ENERGY)
         t = float(grid[0])
-        contact, y = self._settle(t, y, 1.0)
+        body.heading = sgn(omega0)  # from rest: stuck (0) until the break-away rule starts it
+        contact, y = self._hold(t, y, 1.0)
         if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
-            other, y_other = self._settle(t, y, -1.0)
+            other, y_other = self._hold(t, y, -1.0)
             if other != 0.0:
                 self.lift_offs.pop()
                 contact, y = other, y_other
+        if body.heading == 0.0:
+            contact, y = self._rest(t, y, contact)
         return self.pieces(grid, t, y, contact, sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
 
     def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
@@ -98,7 +107,11 @@ class VoltageFollowerRun(PieceRun):
             fn.terminal, fn.direction, fn.kind = True, -1, kind
             events.append(fn)
 
-        add("stop", lambda t, y: y[1])
+        heading = body.heading
+        if heading == 0.0:  # stuck: until the torque on the held cam (a current, a shaft) starts it
+            add("break-away", lambda t, y: -body.start(y[:body.size], u.value(t), contact)[0])
+            return events
+        add("stop", lambda t, y: heading * y[1])
         if contact:
             add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
             side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
@@ -114,9 +127,8 @@ class VoltageFollowerRun(PieceRun):
 
     def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
         body, u_t, n = self.body, self.u.value(t), self.body.size
-        if kind == "stop":
-            raise RuntimeError(f"{self.label}: the shaft stops at t = {t!r} s; its static friction "
-                               "with a follower of its own is not modelled (docs/model.md 13.6)")
+        if kind in ("stop", "break-away"):
+            return self._rest(t, y, contact, kind == "break-away")
         if kind == "lift-off":
             s, s1 = body.flank(y[0], contact)
             self.lift_offs.append((t, s, s1 * y[1]))
@@ -138,6 +150,28 @@ class VoltageFollowerRun(PieceRun):
         return after, state + y[n:]
 
     def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
+        """Before each piece: ``_rest`` while the shaft is stuck (the input may start it), else ``_hold``."""
+        if self.body.heading == 0.0:
+            return self._rest(t, y, contact)
+        return self._hold(t, y, contact)
+
+    def _rest(self, t: float, y: list, contact: float, at_threshold: bool = False) -> tuple[float, list]:
+        """The shaft at rest (the start, an input, a stop, a break-away): stuck with the follower at rest on its flank,
+        or moving off toward where the break-away rule sends it (at a located break-away, where its margin is 0 to
+        rounding, at once). A cam stuck with the follower off it is refused (not modelled)."""
+        body = self.body
+        y = [y[0], 0.0, *y[2:]]
+        body.heading = 0.0
+        contact, y = self._hold(t, y, contact)
+        margin, heading = body.start(y[:body.size], self.u.value(t), contact)
+        if margin > 0.0 or at_threshold:
+            body.heading = heading
+            return self._hold(t, y, contact)
+        if contact == 0.0:
+            raise RuntimeError(f"{self.label}: {stuck_in_flight(t)}")
+        return contact, y
+
+    def _hold(self, t: float, y: list, contact: float) -> tuple[float, list]:
         """On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s'')."""
         if contact:
             s, s1 = self.body.flank(y[0], contact)

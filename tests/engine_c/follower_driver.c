@@ -6,7 +6,8 @@
  *   follower_driver
  *
  * Prints one line per case, "<case> <impact-free checksum> <s at the end>", and "ok" at the end; a broken
- * promise (a state in flight that does not repeat its run bit for bit, a refusal without a message) aborts.
+ * promise (a state in flight that does not repeat its run bit for bit, a refusal without a message) aborts. From rest
+ * (omega0 = 0): a spring-closed cam that stalls and sticks, a state saved while stuck.
  */
 #include <math.h>
 #include <stdio.h>
@@ -116,10 +117,47 @@ int main(void)
         free(saved);
         cam_instance_free(d);
     }
-    {   /* a refusal names its reason */
+    {   /* the voltage drive from rest (omega0 = 0): a spring too strong for the motor stalls the cam on the rise, it
+         * swings back and sticks; a state saved while stuck repeats its run bit for bit */
         CamInstance *d = cam_instance_new();
-        set_string(d, "closure", "spring");   /* the voltage drive from rest (omega0 = 0) */
-        if (cam_instance_initialize(d, 0.0) == CAM_OK || !strstr(cam_instance_message(d), "'omega0'")) abort();
+        unsigned vr_omega = vr_of("omega");
+        double omega = 1.0, first, again;
+        size_t size;
+        unsigned char *saved;
+        int k = 0;
+        if (!d) abort();
+        set_string(d, "closure", "spring");
+        set_real(d, "k_spring", 500.0);
+        set_real(d, "F_spring0", 5.0);
+        set_real(d, "u", 3.5);
+        if (cam_instance_initialize(d, 0.0) != CAM_OK) abort();
+        while (k < 1000 || omega != 0.0) {   /* past the start, to a step that ends stuck */
+            run(d, k, k + 1);
+            k++;
+            if (cam_instance_get_real(d, vr_omega, &omega) != CAM_OK || k > 20000) abort();
+        }
+        size = cam_instance_state_size(d);
+        saved = malloc(size);
+        if (!saved || cam_instance_save(d, saved, size) != CAM_OK) abort();
+        first = run(d, k, k + 2000);
+        if (cam_instance_restore(d, saved, size) != CAM_OK) abort();
+        again = run(d, k, k + 2000);
+        if (first != again) abort();
+        printf("stuck %d %.17g\n", k, first);
+        free(saved);
+        cam_instance_free(d);
+    }
+    {   /* a refusal names its reason: gravity pulls the follower off a cam the motor (u = 0) cannot turn */
+        CamInstance *d = cam_instance_new();
+        if (!d) abort();
+        set_string(d, "closure", "spring");
+        set_real(d, "gamma", 1.5707963267948966);
+        set_real(d, "beta", 0.0);
+        set_real(d, "u", 0.0);
+        if (cam_instance_initialize(d, 0.0) != CAM_OK) abort();
+        if (cam_instance_step(d, 0.0, 1e-4) == CAM_OK
+            || !strstr(cam_instance_message(d), "stuck at t = 0 s with the follower off the cam"))
+            abort();
         cam_instance_free(d);
     }
     printf("ok\n");
