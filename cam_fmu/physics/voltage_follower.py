@@ -20,6 +20,11 @@ m s_dd = -F_close(s) - sgn(v) f0 with the friction at no contact force f0 = mu (
 the friction turns, or holds the follower while |F_close| <= f0. Touch-down where a gap closes: ``follower.impact``
 with the cam side's inertia J_0 (momentum J_0 omega + m s' v kept, w+ = -e w-; the guide's friction gives no
 impulse).
+
+At rest (omega = 0) the shaft is stuck (``heading`` 0: theta, omega, s, v held, the flank's force the static
+F_close(s)) until it would accelerate in one direction with M_f and the guide's friction against it (``start``, the
+consistent formulation's break-away rule with the contact's load); moving, its direction ``heading`` is held until
+a stop.
 """
 from __future__ import annotations
 

@@ -5,8 +5,9 @@ scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = 
 E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide = int f |v| dt and
 E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lift-off (the contact force P reaches
 0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
-the friction turns), the shaft's stop (omega = 0: refused, the shaft's static friction with a free follower is
-not modelled) and input break; the transition is applied at the located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
+follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
+A cam stuck with the follower off it is refused (not modelled). Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations

@@ -13,7 +13,10 @@
  * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -TOUCH, an impact exchanging
  * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
  * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
- * from > 0 to <= 0 over a step is located by bisection on the step's length. A shaft that stops is refused. */
+ * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
+ * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
+ * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
+ * follower off it is refused at run time. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
