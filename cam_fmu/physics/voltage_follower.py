@@ -21,8 +21,8 @@ the friction turns, or holds the follower while |F_close| <= f0. Touch-down wher
 with the cam side's inertia J_0 (momentum J_0 omega + m s' v kept, w+ = -e w-; the guide's friction gives no
 impulse).
 
-At rest (omega = 0) the shaft is stuck (``heading`` 0: theta, omega, s, v held, the flank's force the static
-F_close(s)) until it would accelerate in one direction with M_f and the guide's friction against it (``start``, the
+At rest (omega = 0) the shaft is stuck (``heading`` 0: theta and omega held; on a flank s and v too, the flank's
+force the static F_close(s); off it the follower flies alone and lands on the cam at rest, ``unstick``) until it would accelerate in one direction with M_f and the guide's friction against it (``start``, the
 consistent formulation's break-away rule with the contact's load); moving, its direction ``heading`` is held until
 a stop.
 """
@@ -151,8 +151,8 @@ class VoltageFollower:
         drive = self.torque(y, u)
         omega_m = self.motor_speed(y)
         di = self.motor.current_rate(u, i, omega_m) if self.has_current else 0.0
-        if self.heading == 0.0:  # stuck: the cam, and the follower at rest on its flank, held
-            dy = [0.0, 0.0, di, 0.0, 0.0]
+        if self.heading == 0.0:  # stuck: the cam held, the follower at rest on its flank or flying alone
+            dy = [0.0, 0.0, di, 0.0, 0.0] if contact else [0.0, 0.0, di, v, self.free_acceleration(s, sigma)]
         elif contact:
             omega_dot, _, _ = self.on_flank(theta, omega, drive, contact)
             _, s1, s2, _ = self.program.derivatives(theta)
@@ -207,12 +207,20 @@ class VoltageFollower:
         theta, omega, i, _, v = y[:5]
         s, s1 = self.flank(theta, contact)
         hit = impact(self.J_0, self.m, s1, omega, v, self.e)
+        self.unstick(hit.omega)
         w = hit.v - s1 * hit.omega
         if w * w >= 2.0 * self.acceleration_scale(y, u) * ZENO_HEIGHT:
             return 0.0, [theta, hit.omega, i, s, hit.v, *y[5:]], hit
         hit = impact(self.J_0, self.m, s1, omega, v, 0.0)
+        self.unstick(hit.omega)
         after = [theta, hit.omega, i, s, s1 * hit.omega, *y[5:]]
         return (contact if self.contact_force(after, u, contact) >= 0.0 else 0.0), after, hit
+
+    def unstick(self, omega: float) -> None:
+        """A stuck cam struck by the follower moves off where the impact turned it (the shaft's static friction, a
+        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck."""
+        if self.heading == 0.0 and omega != 0.0:
+            self.heading = sgn(omega)
 
     def stored_energy(self, y) -> float:
         """J, the cam side's and follower's kinetic energy, the spring's F0 s + k s^2/2, gravity's -F_gx s, L i^2/2;

@@ -7,7 +7,7 @@ E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lif
 0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
 the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
 follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
-A cam stuck with the follower off it is refused (not modelled). Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations
@@ -22,12 +22,6 @@ from ..physics.voltage_follower import VoltageFollower, sgn
 from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
-
-
-def stuck_in_flight(t: float) -> str:
-    """The refusal of a cam held by the shaft's static friction while the follower is off it (docs/model.md 13.6)."""
-    return (f"the shaft is stuck at t = {t:.9g} s with the follower off the cam: a cam held by its static friction while the "
-            "follower flies across to it is not modelled (docs/model.md 13.6)")
 
 
 class VoltageFollowerRun(PieceRun):
@@ -73,6 +67,9 @@ class VoltageFollowerRun(PieceRun):
         options = {"method": self.method, "atol": [self.atol] * n + [self.atol * 1e-2] * len(ENERGY)}
         if contact == 0.0 and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
             options["max_step"] = FLIGHT_ANGLE / abs(y[1])  # could hold a gap's crossing and its return
+        elif contact == 0.0 and self.body.heading == 0.0 and self.body.c > 0.0:  # at a stuck cam: a tenth of the gap
+            c, scale = self.body.c, self.body.acceleration_scale(y[:self.body.size], self.u.value(t))
+            options["max_step"] = 0.1 * min(math.sqrt(2.0 * c / scale), c / abs(y[4]) if y[4] else math.inf)
         sigma = self.body.direction(y) if contact == 0.0 else 0.0  # the flight's friction direction, held
         events = self._events(contact, sigma, t, y)
         # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md 6.3): DOP853
@@ -111,8 +108,10 @@ class VoltageFollowerRun(PieceRun):
         heading = body.heading
         if heading == 0.0:  # stuck: until the torque on the held cam (a current, a shaft) starts it
             add("break-away", lambda t, y: -body.start(y[:body.size], u.value(t), contact)[0])
-            return events
-        add("stop", lambda t, y: heading * y[1])
+            if contact:
+                return events
+        else:
+            add("stop", lambda t, y: heading * y[1])
         if contact:
             add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
             side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
@@ -159,7 +158,7 @@ class VoltageFollowerRun(PieceRun):
     def _rest(self, t: float, y: list, contact: float, at_threshold: bool = False) -> tuple[float, list]:
         """The shaft at rest (the start, an input, a stop, a break-away): stuck with the follower at rest on its flank,
         or moving off toward where the break-away rule sends it (at a located break-away, where its margin is 0 to
-        rounding, at once). A cam stuck with the follower off it is refused (not modelled)."""
+        rounding, at once); stuck with the follower off it, the follower flies alone and lands on the cam at rest."""
         body = self.body
         y = [y[0], 0.0, *y[2:]]
         body.heading = 0.0
@@ -168,8 +167,6 @@ class VoltageFollowerRun(PieceRun):
         if margin > 0.0 or at_threshold:
             body.heading = heading
             return self._hold(t, y, contact)
-        if contact == 0.0:
-            raise RuntimeError(f"{self.label}: {stuck_in_flight(t)}")
         return contact, y
 
     def _hold(self, t: float, y: list, contact: float) -> tuple[float, list]:

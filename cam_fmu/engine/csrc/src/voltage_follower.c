@@ -16,7 +16,7 @@
  * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
- * follower off it is refused at run time. */
+ * follower off it: the follower flies alone and lands on the cam at rest (unstick). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -196,7 +196,7 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[Y_ROTOR] = m->compliant ? (m->c_m * current(m, y, u) - shaft_torque(m, y)) / m->J_m : 0.0;
     dy[Y_SIGMA] = 0.0;
     dy[Y_DIR] = 0.0;
-    if (y[Y_DIR] == 0.0) {   /* stuck: the cam and the follower on its flank at rest */
+    if (contact && y[Y_DIR] == 0.0) {   /* stuck: the cam and the follower on its flank at rest */
         dy[0] = dy[1] = dy[3] = dy[4] = 0.0;
         return;
     }
@@ -207,7 +207,7 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
     }
-    dy[1] = torque(m, y, u) / m->J_0;
+    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
@@ -310,6 +310,14 @@ static void impact(const CamModel *m, double y[NY], double s1, double e)
     y[1] -= s1 * P / m->J_0;
 }
 
+/* A stuck cam struck by the follower: its static friction, a finite force, gives no impulse; the cam moves off
+ * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). */
+static void unstick(double y[NY])
+{
+    if (y[Y_DIR] == 0.0 && y[1] != 0.0)
+        y[Y_DIR] = sgn(y[1]);
+}
+
 /* A touch-down on the flank `flank` at y (voltage_follower.land): the contact after; y's follower on the flank,
  * omega and v after. */
 static int land(const CamModel *m, double y[NY], double u, int flank, double *rebound)
@@ -319,6 +327,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     cam_profile_eval(&m->profile, y[0], d);
     y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], m->restitution);
+    unstick(y);
     w = y[4] - d[1] * y[1];
     if (w * w >= 2.0 * scale * ZENO_HEIGHT) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * acceleration_scale(m, y, u)) : 0.0;
@@ -327,6 +336,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
     y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], 0.0);
+    unstick(y);
     y[4] = d[1] * y[1];
     on_flank(m, y, u, flank, d, &omega_dot, &P);
     return flank * P >= 0.0 ? flank : 0;
@@ -375,14 +385,11 @@ static int settle(const CamModel *m, double y[NY], double u, int contact)
     return contact * P >= 0.0 ? contact : 0;
 }
 
-#define STUCK_IN_FLIGHT "the shaft is stuck at t = %.9g s with the follower off the cam: a cam held by its static " \
-    "friction while the follower flies across to it is not modelled (docs/model.md 13.6)"
-
 /* At rest (omega = 0: the start, a new input, a stop, a located break-away): the shaft stays stuck, the follower at
  * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
  * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
- * the follower go. 0, or -1 where the cam stays stuck with the follower off it (STUCK_IN_FLIGHT). */
-static int at_rest(const CamModel *m, double y[NY], double u, int *contact, int at_threshold)
+ * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
+static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int at_threshold)
 {
     double dir, margin;
     y[1] = 0.0;
@@ -392,9 +399,7 @@ static int at_rest(const CamModel *m, double y[NY], double u, int *contact, int 
     if (margin > 0.0 || at_threshold) {
         y[Y_DIR] = dir;
         *contact = settle(m, y, u, *contact);
-        return 0;
     }
-    return *contact ? 0 : -1;
 }
 
 static int vf_init(CamDrive *d, CamError *err)
@@ -417,7 +422,7 @@ static int vf_init(CamDrive *d, CamError *err)
             memcpy(y, other, sizeof other);
     }
     if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-        (void)at_rest(&d->model, y, d->u, &contact, 0);
+        at_rest(&d->model, y, d->u, &contact, 0);
     d->speed.contact = contact;
     store_y(d, y);
     return CAM_OK;
@@ -444,8 +449,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
     load_y(d, y);
-    if (y[1] == 0.0 && at_rest(m, y, u, &contact, 0) != 0)   /* at rest: the step's input may start or hold it */
-        return cam_error(err, CAM_ERR_SIMULATION, STUCK_IN_FLIGHT, time);
+    if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
+        at_rest(m, y, u, &contact, 0);
     if (contact && !(contact = settle(m, y, u, contact)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
@@ -462,6 +467,12 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
+        if (!contact && y[Y_DIR] == 0.0 && clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
+            double c = clearance(m), A = acceleration_scale(m, y, u);
+            dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
+            if (y[4] != 0.0)
+                dt = fmin(dt, 0.1 * c / fabs(y[4]));
+        }
         if (pole > 0.0)
             dt = fmin(dt, 0.5 / pole);
         if (ws > 0.0)
@@ -475,13 +486,11 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
         rk4(m, u, contact, y, dt, next);
-        if (y[Y_DIR] == 0.0) {
-            codes[n++] = EV_BREAK_AWAY;   /* stuck: the follower at rest on its flank, the torque may change */
-        } else if (contact) {
-            codes[n++] = EV_STOP;
-            codes[n++] = EV_LIFT_OFF;
+        codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
+        if (contact) {
+            if (y[Y_DIR] != 0.0)
+                codes[n++] = EV_LIFT_OFF;
         } else {
-            codes[n++] = EV_STOP;
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
@@ -528,8 +537,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
         if (code == EV_STOP || code == EV_BREAK_AWAY) {
             int was = contact;
-            if (at_rest(m, y, u, &contact, code == EV_BREAK_AWAY) != 0)
-                return cam_error(err, CAM_ERR_SIMULATION, STUCK_IN_FLIGHT, time + tau);
+            at_rest(m, y, u, &contact, code == EV_BREAK_AWAY);
             cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
                               "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
                               time + tau, y[0]);
