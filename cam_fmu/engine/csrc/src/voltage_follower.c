@@ -29,6 +29,7 @@
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
+#define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
 #define NY 9
 #define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
@@ -474,7 +475,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
         }
         if (pole > 0.0)
-            dt = fmin(dt, 0.5 / pole);
+            dt = fmin(dt, POLE_STEP / pole);
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
