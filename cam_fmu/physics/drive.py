@@ -115,15 +115,11 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
     if p["drive"] in FOLLOWER_DRIVES:
         return
     # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, with guide
-    # friction and a rigid or compliant shaft, a turning shaft at the start; each other case refused with its reason.
+    # friction and a rigid or compliant shaft, from rest or turning; each other case refused with its reason.
     voltage = f"parameter 'closure' = {closure!r} with drive 'voltage'"
     if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
         raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
                              "with it: formulation 'consistent'")
-    if not p["omega0"] > 0.0:
-        raise ParameterError(f"parameter 'omega0' = {p['omega0']!r} rad/s: the shaft's static friction with a "
-                             "follower of its own is not modelled yet (the run is refused where the shaft stops); "
-                             f"allowed with drive 'voltage' and closure {closure!r}: omega0 > 0{kinematic}")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:

@@ -157,14 +157,14 @@ CLOSURES = ("kinematic", "form", "spring")
 FOLLOWER_DRIVES = ("speed",)  # the drives computing closures 'form' and 'spring' with every effect (docs/model.md 13)
 VOLTAGE_FOLLOWER_FORMULATIONS = ("consistent",)  # the voltage drive's formulations with a follower of its own (13.6)
 # The follower as a body of its own (the speed drive and the consistent voltage drive compute closures 'form' and
-# 'spring', the voltage drive with guide friction and a rigid or compliant shaft, started turning; docs/model.md 13
+# 'spring', the voltage drive with guide friction and a rigid or compliant shaft, from rest or turning; docs/model.md 13
 # and 13.6).
 FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("closure", "", "kinematic", "how the follower is held: 'kinematic' (groove by the paper's rule, eqs. 6-8, in "
        "any formulation: rests in the clearance c until a flank takes it along), 'form' (groove; with a clearance c > 0 "
        "the follower of mass m flies across it under gravity, friction and its momentum; c = 0 or the paper's voltage "
        "formulation: the kinematic rule's motion), 'spring' (one flank and a return spring k_spring, F_spring0; c = 0)."
-       " A flight: speed drive, and voltage drive (consistent, omega0 > 0)",
+       " A flight: speed drive, and voltage drive (consistent; from rest or turning)",
        kind="string", choices=CLOSURES),
     _P("k_spring", "N/m", 0.0, "rate of the return spring (closure 'spring')", low=0.0, high=1e9),
     _P("F_spring0", "N", 0.0, "preload of the return spring at s = 0 (closure 'spring')", low=0.0, high=1e6),

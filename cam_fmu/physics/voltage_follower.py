@@ -20,6 +20,11 @@ m s_dd = -F_close(s) - sgn(v) f0 with the friction at no contact force f0 = mu (
 the friction turns, or holds the follower while |F_close| <= f0. Touch-down where a gap closes: ``follower.impact``
 with the cam side's inertia J_0 (momentum J_0 omega + m s' v kept, w+ = -e w-; the guide's friction gives no
 impulse).
+
+At rest (omega = 0) the shaft is stuck (``heading`` 0: theta and omega held; on a flank s and v too, the flank's
+force the static F_close(s); off it the follower flies alone and lands on the cam at rest, ``unstick``) until it would accelerate in one direction with M_f and the guide's friction against it (``start``, the
+consistent formulation's break-away rule with the contact's load); moving, its direction ``heading`` is held until
+a stop.
 """
 from __future__ import annotations
 
@@ -55,6 +60,7 @@ class VoltageFollower:
         self.f0 = self.mu * (abs(self.G_y) + self.N_g)  # N, the guide's friction at no contact force
         self.compliant = model.compliant
         self.size = 7 if self.compliant else 5
+        self.heading = 1.0  # the shaft's direction at omega = 0: where it starts (+1, -1), 0 while it is stuck
 
     def motor_speed(self, y) -> float:
         """rad/s, the rotor's speed: omega_m on a compliant shaft, else the cam's."""
@@ -70,20 +76,29 @@ class VoltageFollower:
             return 0.0
         return self.model.k_shaft * y[5] + self.model.d_shaft * (y[6] - y[1])
 
-    def torque(self, y, u: float) -> float:
-        """N m, what drives the cam side: the motor's c_m i (rigid) or the shaft's torque, less M_f sgn(omega)."""
+    def torque(self, y, u: float, heading: float | None = None) -> float:
+        """N m, what drives the cam side: the motor's c_m i (rigid) or the shaft's torque, less M_f sgn(omega)
+        (``heading``: the direction the shaft moves in, at omega = 0 the one it starts in, 0 held)."""
         drive = self.shaft_torque(y) if self.compliant else self.model.c_m * self.current(y, u)
-        return drive - self.M_f * sgn(y[1])
+        return drive - self.M_f * (self.moving(y[1]) if heading is None else heading)
 
-    def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0) -> tuple[float, float, float]:
-        """(omega_dot [rad/s2], P [N], f [N]) with the follower on the flank ``contact``: the module's equations."""
+    def moving(self, omega: float) -> float:
+        """The shaft's direction ``heading``, held over a piece (a stop ends it; 0 stuck): sgn(omega) would turn
+        the friction in the integrator's trial steps past omega = 0."""
+        return self.heading
+
+    def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0,
+                 heading: float | None = None) -> tuple[float, float, float]:
+        """(omega_dot [rad/s2], P [N], f [N]) with the follower on the flank ``contact``: the module's equations
+        (the guide's friction against s' times ``heading``, the shaft's direction, sgn(omega) unless given)."""
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         F = closing_force(s_cam - contact * self.c, self.k, self.F0, self.F_gx)
         m, J_0 = self.m, self.J_0
         if self.mu == 0.0:
             omega_dot = (drive - (m * s2 * omega * omega + F) * s1) / (J_0 + m * s1 * s1)
             return omega_dot, m * (s2 * omega * omega + s1 * omega_dot) + F, 0.0
-        sigma, tan_a = sgn(s1 * omega), s1 / (self.model.r_b + s_cam)
+        sigma = sgn(s1 * (self.moving(omega) if heading is None else heading))
+        tan_a = s1 / (self.model.r_b + s_cam)
         for side in (1.0, -1.0):  # the branch where the side force P tan(alpha) + G_y has the sign `side`
             slope = 1.0 - sigma * self.mu * side * tan_a  # dP/dP of P - sgn(v) f on this branch
             rest = m * s2 * omega * omega + F + sigma * self.mu * (side * self.G_y + self.N_g)
@@ -95,6 +110,25 @@ class VoltageFollower:
                 break
         f = self.mu * (abs(P * tan_a + self.G_y) + self.N_g)
         return omega_dot, P, f
+
+    def static_force(self, theta: float, contact: float) -> float:
+        """N, the force P along X of the flank ``contact`` on the follower at rest on it, the cam held: it balances
+        the spring and gravity, F_close(s) (the guide's friction carries nothing at rest)."""
+        s_cam = self.program.derivatives(theta)[0]
+        return closing_force(s_cam - contact * self.c, self.k, self.F0, self.F_gx)
+
+    def start(self, y, u: float, contact: float) -> tuple[float, float]:
+        """(margin [rad/s2], direction) of the shaft at rest: it starts toward ``direction`` where margin > 0 (the
+        consistent formulation's break-away rule, DriveModel.breakaway_direction, with the follower's load on the
+        flank ``contact``: the acceleration with the shaft's and the guide's friction against each direction;
+        the cam side alone where contact is 0)."""
+        at_rest = [y[0], 0.0, *y[2:]]
+        if contact:
+            forward = self.on_flank(y[0], 0.0, self.torque(at_rest, u, 1.0), contact, 1.0)[0]
+            backward = -self.on_flank(y[0], 0.0, self.torque(at_rest, u, -1.0), contact, -1.0)[0]
+        else:
+            forward, backward = self.torque(at_rest, u, 1.0) / self.J_0, -self.torque(at_rest, u, -1.0) / self.J_0
+        return (forward, 1.0) if forward >= backward else (backward, -1.0)
 
     def direction(self, y) -> float:
         """The sign of the flying follower's velocity over the next piece: sgn(v), or at a halt the way the net force
@@ -117,7 +151,9 @@ class VoltageFollower:
         drive = self.torque(y, u)
         omega_m = self.motor_speed(y)
         di = self.motor.current_rate(u, i, omega_m) if self.has_current else 0.0
-        if contact:
+        if self.heading == 0.0:  # stuck: the cam held, the follower at rest on its flank or flying alone
+            dy = [0.0, 0.0, di, 0.0, 0.0] if contact else [0.0, 0.0, di, v, self.free_acceleration(s, sigma)]
+        elif contact:
             omega_dot, _, _ = self.on_flank(theta, omega, drive, contact)
             _, s1, s2, _ = self.program.derivatives(theta)
             dy = [omega, omega_dot, di, s1 * omega, s2 * omega * omega + s1 * omega_dot]
@@ -142,7 +178,10 @@ class VoltageFollower:
         return P * s1 / (self.model.r_b + s_cam) + self.G_y
 
     def contact_force(self, y, u: float, contact: float = 1.0) -> float:
-        """N, contact P: the force the flank ``contact`` must give, along its normal (lift-off: contact while >= 0)."""
+        """N, contact P: the force the flank ``contact`` must give, along its normal (lift-off: contact while >= 0);
+        the cam stuck, the static one."""
+        if self.heading == 0.0:
+            return contact * self.static_force(y[0], contact)
         return contact * self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
 
     def flank(self, theta: float, contact: float) -> tuple[float, float]:
@@ -168,12 +207,20 @@ class VoltageFollower:
         theta, omega, i, _, v = y[:5]
         s, s1 = self.flank(theta, contact)
         hit = impact(self.J_0, self.m, s1, omega, v, self.e)
+        self.unstick(hit.omega)
         w = hit.v - s1 * hit.omega
         if w * w >= 2.0 * self.acceleration_scale(y, u) * ZENO_HEIGHT:
             return 0.0, [theta, hit.omega, i, s, hit.v, *y[5:]], hit
         hit = impact(self.J_0, self.m, s1, omega, v, 0.0)
+        self.unstick(hit.omega)
         after = [theta, hit.omega, i, s, s1 * hit.omega, *y[5:]]
         return (contact if self.contact_force(after, u, contact) >= 0.0 else 0.0), after, hit
+
+    def unstick(self, omega: float) -> None:
+        """A stuck cam struck by the follower moves off where the impact turned it (the shaft's static friction, a
+        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck."""
+        if self.heading == 0.0 and omega != 0.0:
+            self.heading = sgn(omega)
 
     def stored_energy(self, y) -> float:
         """J, the cam side's and follower's kinetic energy, the spring's F0 s + k s^2/2, gravity's -F_gx s, L i^2/2;
@@ -192,8 +239,12 @@ class VoltageFollower:
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
         drive = self.torque(y, u)
-        shaft = self.M_f * sgn(omega)
-        if contact:
+        shaft = self.M_f * self.moving(omega)
+        if contact and self.heading == 0.0:  # stuck: the shaft's static friction takes the drive's torque
+            P, a, M, J = self.static_force(theta, contact), 0.0, drive, self.J_0 + self.m * s1 * s1
+            N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)
+            s, v = s_cam - contact * self.c, 0.0
+        elif contact:
             omega_dot, P, _ = self.on_flank(theta, omega, drive, contact)
             a, M, J = s2 * omega * omega + s1 * omega_dot, shaft + P * s1, self.J_0 + self.m * s1 * s1
             N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: |P| / cos(alpha)

@@ -5,8 +5,9 @@ scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = 
 E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide = int f |v| dt and
 E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lift-off (the contact force P reaches
 0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
-the friction turns), the shaft's stop (omega = 0: refused, the shaft's static friction with a free follower is
-not modelled) and input break; the transition is applied at the located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
+follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
+With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations
@@ -50,12 +51,15 @@ class VoltageFollowerRun(PieceRun):
         y += [0.0, omega0] if body.compliant else []  # the shaft relaxed, the rotor at the cam's speed (model.md 12.1)
         y += [0.0] * len(ENERGY)
         t = float(grid[0])
-        contact, y = self._settle(t, y, 1.0)
+        body.heading = sgn(omega0)  # from rest: stuck (0) until the break-away rule starts it
+        contact, y = self._hold(t, y, 1.0)
         if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
-            other, y_other = self._settle(t, y, -1.0)
+            other, y_other = self._hold(t, y, -1.0)
             if other != 0.0:
                 self.lift_offs.pop()
                 contact, y = other, y_other
+        if body.heading == 0.0:
+            contact, y = self._rest(t, y, contact)
         return self.pieces(grid, t, y, contact, sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
 
     def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
@@ -63,6 +67,9 @@ class VoltageFollowerRun(PieceRun):
         options = {"method": self.method, "atol": [self.atol] * n + [self.atol * 1e-2] * len(ENERGY)}
         if contact == 0.0 and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
             options["max_step"] = FLIGHT_ANGLE / abs(y[1])  # could hold a gap's crossing and its return
+        elif contact == 0.0 and self.body.heading == 0.0 and self.body.c > 0.0:  # at a stuck cam: a tenth of the gap
+            c, scale = self.body.c, self.body.acceleration_scale(y[:self.body.size], self.u.value(t))
+            options["max_step"] = 0.1 * min(math.sqrt(2.0 * c / scale), c / abs(y[4]) if y[4] else math.inf)
         sigma = self.body.direction(y) if contact == 0.0 else 0.0  # the flight's friction direction, held
         events = self._events(contact, sigma, t, y)
         # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md 6.3): DOP853
@@ -98,7 +105,13 @@ class VoltageFollowerRun(PieceRun):
             fn.terminal, fn.direction, fn.kind = True, -1, kind
             events.append(fn)
 
-        add("stop", lambda t, y: y[1])
+        heading = body.heading
+        if heading == 0.0:  # stuck: until the torque on the held cam (a current, a shaft) starts it
+            add("break-away", lambda t, y: -body.start(y[:body.size], u.value(t), contact)[0])
+            if contact:
+                return events
+        else:
+            add("stop", lambda t, y: heading * y[1])
         if contact:
             add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
             side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
@@ -114,9 +127,8 @@ class VoltageFollowerRun(PieceRun):
 
     def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
         body, u_t, n = self.body, self.u.value(t), self.body.size
-        if kind == "stop":
-            raise RuntimeError(f"{self.label}: the shaft stops at t = {t!r} s; its static friction "
-                               "with a follower of its own is not modelled (docs/model.md 13.6)")
+        if kind in ("stop", "break-away"):
+            return self._rest(t, y, contact, kind == "break-away")
         if kind == "lift-off":
             s, s1 = body.flank(y[0], contact)
             self.lift_offs.append((t, s, s1 * y[1]))
@@ -138,6 +150,26 @@ class VoltageFollowerRun(PieceRun):
         return after, state + y[n:]
 
     def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
+        """Before each piece: ``_rest`` while the shaft is stuck (the input may start it), else ``_hold``."""
+        if self.body.heading == 0.0:
+            return self._rest(t, y, contact)
+        return self._hold(t, y, contact)
+
+    def _rest(self, t: float, y: list, contact: float, at_threshold: bool = False) -> tuple[float, list]:
+        """The shaft at rest (the start, an input, a stop, a break-away): stuck with the follower at rest on its flank,
+        or moving off toward where the break-away rule sends it (at a located break-away, where its margin is 0 to
+        rounding, at once); stuck with the follower off it, the follower flies alone and lands on the cam at rest."""
+        body = self.body
+        y = [y[0], 0.0, *y[2:]]
+        body.heading = 0.0
+        contact, y = self._hold(t, y, contact)
+        margin, heading = body.start(y[:body.size], self.u.value(t), contact)
+        if margin > 0.0 or at_threshold:
+            body.heading = heading
+            return self._hold(t, y, contact)
+        return contact, y
+
+    def _hold(self, t: float, y: list, contact: float) -> tuple[float, list]:
         """On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s'')."""
         if contact:
             s, s1 = self.body.flank(y[0], contact)

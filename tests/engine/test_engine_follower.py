@@ -132,4 +132,6 @@ def test_the_follower_is_clean_under_asan_and_ubsan(tmp_path):
     assert "Sanitizer" not in proc.stderr and "runtime error" not in proc.stderr, proc.stderr[-3000:]
     assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stderr[-3000:]
     assert [line.split()[0] for line in proc.stdout.splitlines()[:-1]] == ["spring", "spring", "form", "spring", "form",
-                                                                 "spring"]  # the last three: voltage, the last with mu, k_shaft
+                                                                 "spring", "stuck", "stopped"]
+    # the three before "stuck": voltage, the last with mu, k_shaft; "stuck": from rest, saved while stuck;
+    # "stopped": the cam stuck under the flying follower

@@ -355,11 +355,6 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
                          "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
                          "'consistent'", closure);
-    if (!(v[CAM_P_OMEGA0] > 0.0))
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'omega0' = %s rad/s: the shaft's static friction with a "
-                         "follower of its own is not modelled yet (the run is refused where the shaft stops); allowed "
-                         "with drive 'voltage' and closure '%s': omega0 > 0%s", cam_num(v[CAM_P_OMEGA0], a), closure,
-                         kinematic);
     return CAM_OK;   /* voltage_follower.c */
 }
 

@@ -13,7 +13,10 @@
  * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -TOUCH, an impact exchanging
  * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
  * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
- * from > 0 to <= 0 over a step is located by bisection on the step's length. A shaft that stops is refused. */
+ * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
+ * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
+ * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
+ * follower off it: the follower flies alone and lands on the cam at rest (unstick). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -26,13 +29,16 @@
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
-#define NY 8
+#define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
+#define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
+#define NY 9
 #define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
 #define Y_ROTOR 6
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
+#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
 
 /* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK, EV_SIDE };
+enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK, EV_SIDE };
 
 static double sgn(double x)
 {
@@ -51,12 +57,25 @@ static double shaft_torque(const CamModel *m, const double y[NY])
     return m->k_shaft * y[Y_TWIST] + m->d_shaft * (y[Y_ROTOR] - y[1]);
 }
 
-/* N m: what drives the cam side, the motor's torque (rigid) or the shaft's, less the shaft's friction. */
-static double torque(const CamModel *m, const double y[NY], double u)
+/* The shaft's direction of motion, held over a step (a stop ends it; 0: stuck): a Runge-Kutta stage past omega = 0
+ * with sgn(omega) would turn the friction inside the step and misplace the stop (3.3e-6 rad at steps of 7e-4 s). */
+static double shaft_direction(const double y[NY])
+{
+    return y[Y_DIR];
+}
+
+/* N m: what drives the cam side, the motor's torque (rigid) or the shaft's, less the shaft's friction against the
+ * direction `dir`. */
+static double torque_toward(const CamModel *m, const double y[NY], double u, double dir)
 {
     double drive = m->compliant ? shaft_torque(m, y)
                    : (m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R);
-    return drive - m->M_f * sgn(y[1]);
+    return drive - m->M_f * dir;
+}
+
+static double torque(const CamModel *m, const double y[NY], double u)
+{
+    return torque_toward(m, y, u, shaft_direction(y));
 }
 
 /* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
@@ -76,25 +95,26 @@ static double clearance(const CamModel *m)
     return m->closure == CAM_CHOICE_CLOSURE_FORM ? m->c : 0.0;
 }
 
-/* On the flank `contact` at y: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the force P [N] along X of the
- * coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot (model.c load_terms with
- * F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
-static void flank_terms(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
-                        double *P, double *n_r)
+/* On the flank `contact` at y, the shaft moving toward `dir`: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the
+ * force P [N] along X of the coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot
+ * (model.c load_terms with F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
+static void flank_toward(const CamModel *m, const double y[NY], double u, int contact, double dir, double d[4],
+                         double *omega_dot, double *P, double *n_r)
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
     F = closing(m, d[0] - contact * clearance(m));
     if (m->mu == 0.0) {
-        *omega_dot = (torque(m, y, u) - (m->m * d[2] * omega * omega + F) * d[1]) / (m->J_0 + m->m * d[1] * d[1]);
+        *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
+                     / (m->J_0 + m->m * d[1] * d[1]);
         *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
         *n_r = 0.0;
         return;
     }
     J = m->J_0 + m->m * d[1] * d[1];
     inertial = m->m * d[2] * omega * omega + F;
-    x0 = (torque(m, y, u) - inertial * d[1]) / J;
-    sigma = sgn(d[1] * omega);
+    x0 = (torque_toward(m, y, u, dir) - inertial * d[1]) / J;
+    sigma = sgn(d[1] * dir);
     tan_a = d[1] / (m->r_b + d[0]);
     n0 = (inertial + m->m * d[1] * x0) * tan_a + m->G_y;
     kappa = m->J_0 / J * tan_a;
@@ -102,6 +122,38 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
     *omega_dot = x0 - sigma * f * d[1] / J;
     *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
     *n_r = n0 + sigma * kappa * f;
+}
+
+/* flank_toward in the shaft's direction; the cam stuck: at rest, the contact's force P = F_close(s) balancing the
+ * spring and gravity (the guide's friction at rest carries nothing), omega_dot = 0. */
+static void flank_terms(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                        double *P, double *n_r)
+{
+    if (y[Y_DIR] == 0.0) {
+        cam_profile_eval(&m->profile, y[0], d);
+        *P = closing(m, d[0] - contact * clearance(m));
+        *omega_dot = 0.0;
+        *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
+        return;
+    }
+    flank_toward(m, y, u, contact, shaft_direction(y), d, omega_dot, P, n_r);
+}
+
+/* rad/s2: > 0 where the stuck shaft starts (model.c cam_breakaway_margin with the follower's contact): the larger of
+ * its acceleration forward and backward, each with the shaft's and the guide's friction against that direction. */
+static double breakaway(const CamModel *m, const double y[NY], double u, int contact, double *dir)
+{
+    double d[4], forward, backward, P, n_r;
+    if (contact) {
+        flank_toward(m, y, u, contact, 1.0, d, &forward, &P, &n_r);
+        flank_toward(m, y, u, contact, -1.0, d, &backward, &P, &n_r);
+    } else {
+        forward = torque_toward(m, y, u, 1.0) / m->J_0;
+        backward = torque_toward(m, y, u, -1.0) / m->J_0;
+    }
+    backward = -backward;
+    *dir = forward >= backward ? 1.0 : -1.0;
+    return fmax(forward, backward);
 }
 
 static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
@@ -144,6 +196,11 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[Y_TWIST] = m->compliant ? omega_m - y[1] : 0.0;
     dy[Y_ROTOR] = m->compliant ? (m->c_m * current(m, y, u) - shaft_torque(m, y)) / m->J_m : 0.0;
     dy[Y_SIGMA] = 0.0;
+    dy[Y_DIR] = 0.0;
+    if (contact && y[Y_DIR] == 0.0) {   /* stuck: the cam and the follower on its flank at rest */
+        dy[0] = dy[1] = dy[3] = dy[4] = 0.0;
+        return;
+    }
     if (contact) {
         double d[4], P;
         on_flank(m, y, u, contact, d, &dy[1], &P);
@@ -151,7 +208,7 @@ static void rates(const CamModel *m, double u, int contact, const double y[NY], 
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
     }
-    dy[1] = torque(m, y, u) / m->J_0;
+    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
@@ -191,7 +248,9 @@ static double event_value(const CamModel *m, double u, int code, int contact, co
 {
     double d[4], omega_dot, P;
     if (code == EV_STOP)
-        return y[1];
+        return y[Y_DIR] * y[1];
+    if (code == EV_BREAK_AWAY)
+        return -breakaway(m, y, u, contact, &omega_dot);
     if (code == EV_LIFT_OFF) {
         on_flank(m, y, u, contact, d, &omega_dot, &P);
         return contact * P;
@@ -252,6 +311,14 @@ static void impact(const CamModel *m, double y[NY], double s1, double e)
     y[1] -= s1 * P / m->J_0;
 }
 
+/* A stuck cam struck by the follower: its static friction, a finite force, gives no impulse; the cam moves off
+ * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). */
+static void unstick(double y[NY])
+{
+    if (y[Y_DIR] == 0.0 && y[1] != 0.0)
+        y[Y_DIR] = sgn(y[1]);
+}
+
 /* A touch-down on the flank `flank` at y (voltage_follower.land): the contact after; y's follower on the flank,
  * omega and v after. */
 static int land(const CamModel *m, double y[NY], double u, int flank, double *rebound)
@@ -261,6 +328,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     cam_profile_eval(&m->profile, y[0], d);
     y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], m->restitution);
+    unstick(y);
     w = y[4] - d[1] * y[1];
     if (w * w >= 2.0 * scale * ZENO_HEIGHT) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * acceleration_scale(m, y, u)) : 0.0;
@@ -269,6 +337,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
     y[3] = d[0] - flank * clearance(m);
     impact(m, y, d[1], 0.0);
+    unstick(y);
     y[4] = d[1] * y[1];
     on_flank(m, y, u, flank, d, &omega_dot, &P);
     return flank * P >= 0.0 ? flank : 0;
@@ -284,6 +353,7 @@ static void load_y(const CamDrive *d, double y[NY])
     y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
     y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
     y[Y_SIGMA] = flight_direction(&d->model, y);
+    y[Y_DIR] = d->mode.stuck ? 0.0 : d->mode.direction;
 }
 
 static void store_y(CamDrive *d, const double y[NY])
@@ -299,6 +369,9 @@ static void store_y(CamDrive *d, const double y[NY])
     }
     d->speed.theta = y[0];
     d->speed.speed = y[1];
+    d->mode.stuck = y[Y_DIR] == 0.0;
+    if (y[Y_DIR] != 0.0)
+        d->mode.direction = y[Y_DIR];
 }
 
 /* On the flank `contact`: the follower set on it, or lifted off at once where contact P is already < 0 (a jump of
@@ -311,6 +384,23 @@ static int settle(const CamModel *m, double y[NY], double u, int contact)
     set_on_flank(m, y, contact);
     on_flank(m, y, u, contact, d, &omega_dot, &P);
     return contact * P >= 0.0 ? contact : 0;
+}
+
+/* At rest (omega = 0: the start, a new input, a stop, a located break-away): the shaft stays stuck, the follower at
+ * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
+ * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
+ * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
+static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int at_threshold)
+{
+    double dir, margin;
+    y[1] = 0.0;
+    y[Y_DIR] = 0.0;
+    *contact = settle(m, y, u, *contact);
+    margin = breakaway(m, y, u, *contact, &dir);
+    if (margin > 0.0 || at_threshold) {
+        y[Y_DIR] = dir;
+        *contact = settle(m, y, u, *contact);
+    }
 }
 
 static int vf_init(CamDrive *d, CamError *err)
@@ -332,6 +422,8 @@ static int vf_init(CamDrive *d, CamError *err)
         if ((contact = settle(&d->model, other, d->u, -1)) != 0)
             memcpy(y, other, sizeof other);
     }
+    if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
+        at_rest(&d->model, y, d->u, &contact, 0);
     d->speed.contact = contact;
     store_y(d, y);
     return CAM_OK;
@@ -358,6 +450,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
     load_y(d, y);
+    if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
+        at_rest(m, y, u, &contact, 0);
     if (contact && !(contact = settle(m, y, u, contact)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
@@ -366,10 +460,22 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
         if (y[1] != 0.0)
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
+        if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {   /* from rest: STEP_ANGLE at the acceleration */
+            double rate[NY];
+            rates(m, u, contact, y, rate);
+            if (rate[1] != 0.0)
+                dt = fmin(dt, sqrt(2.0 * STEP_ANGLE / fabs(rate[1])));
+        }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
+        if (!contact && y[Y_DIR] == 0.0 && clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
+            double c = clearance(m), A = acceleration_scale(m, y, u);
+            dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
+            if (y[4] != 0.0)
+                dt = fmin(dt, 0.1 * c / fabs(y[4]));
+        }
         if (pole > 0.0)
-            dt = fmin(dt, 0.5 / pole);
+            dt = fmin(dt, POLE_STEP / pole);
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
@@ -381,10 +487,11 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
         rk4(m, u, contact, y, dt, next);
-        codes[n++] = EV_STOP;
-        if (contact)
-            codes[n++] = EV_LIFT_OFF;
-        else {
+        codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
+        if (contact) {
+            if (y[Y_DIR] != 0.0)
+                codes[n++] = EV_LIFT_OFF;
+        } else {
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
@@ -394,7 +501,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
         if (ends[0] == ends[0])   /* the step ends just past the profile's breakpoint (s'' or s''' jumps there) */
             codes[n++] = EV_BREAK;
-        if (contact && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
+        if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
             codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
         for (k = 0; k < n; k++) {
@@ -429,10 +536,16 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (++events > MAX_EVENTS)
             return cam_error(err, CAM_ERR_SIMULATION, "the follower changed contact more than %d times in one step "
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
-        if (code == EV_STOP)
-            return cam_error(err, CAM_ERR_SIMULATION, "the shaft stops at t = %.9g s: its static friction with a "
-                             "spring-closed follower of its own is not modelled (docs/model.md 13.6)", time + tau);
-        if (code == EV_HALT) {
+        if (code == EV_STOP || code == EV_BREAK_AWAY) {
+            int was = contact;
+            at_rest(m, y, u, &contact, code == EV_BREAK_AWAY);
+            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
+                              "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
+                              time + tau, y[0]);
+            if (was && !contact)
+                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank "
+                                  "%+d at t = %.9g s (theta = %.6g rad); ", was, time + tau, y[0]);
+        } else if (code == EV_HALT) {
             y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
         } else if (code == EV_LIFT_OFF) {
             set_on_flank(m, y, contact);
@@ -459,7 +572,6 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
-    d->mode.direction = y[1] >= 0.0 ? 1.0 : -1.0;
     *steps = taken;
     return CAM_OK;
 }
@@ -479,13 +591,14 @@ static void vf_outputs(CamDrive *d, double out[])
     if (d->speed.contact != 0.0) {
         int contact = (int)d->speed.contact;
         on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
-        load.M = m->M_f * sgn(y[1]) + P * dd[1];
+        load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
+                 : m->M_f * shaft_direction(y) + P * dd[1];
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
         y[3] = dd[0] - contact * clearance(m);
     } else {
-        load.M = m->M_f * sgn(y[1]);
+        load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;
         load.v = y[4];
         load.a = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
