@@ -123,12 +123,12 @@ class VoltageFollower:
         if contact:
             omega_dot, P = self.on_flank(theta, omega, drive, contact)
             a, M, J = s2 * omega * omega + s1 * omega_dot, shaft + P * s1, self.J_0 + self.m * s1 * s1
-            N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: |P| / cos(alpha)
+            N = P * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: P / cos(alpha), signed as contact
             s, v = s_cam - contact * self.c, s1 * omega
         else:
             a, M, J, N = self.free_acceleration(s), shaft, self.J_0, 0.0
         record = output_record(omega=omega, theta=theta, s=s, i=self.current(omega, i_state, u), M=M, J=J, v=v,
                                a=a, alpha=math.atan(tan_a), s_cam=s_cam, voltage=u, theta_m=theta, omega_m=omega,
-                               M_shaft=0.0)
-        record.update(N_contact=N, contact=contact)
+                               M_shaft=0.0, N_contact=N)
+        record.update(contact=contact)
         return record

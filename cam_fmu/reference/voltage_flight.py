@@ -5,7 +5,7 @@ scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = 
 and E_shaft = int M_f |omega| dt. Terminal events stop it at each lift-off (the contact force P reaches 0),
 touch-down (the gap reaches -TOUCH, as reference/flight.py), the shaft's stop (omega = 0: refused, the
 shaft's static friction with a free follower is not modelled) and input break; the transition is applied at the
-located time. Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+located time. Rows are the drive's outputs with the follower's own s, v, a and N_contact [N], plus contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations

@@ -44,7 +44,7 @@ def test_the_engine_is_the_reference(name, label):
     assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10               # m (measured 9.4e-12)
     assert np.max(np.abs(got["v"] - ref["v"])) < 2e-8                # m/s (measured 2.0e-9)
     assert np.max(np.abs(got["a"] - ref["a"])) < 2e-6                # m/s2 (measured 2.5e-7)
-    for key in ("M", "i", "J"):
+    for key in ("M", "i", "J", "N_contact"):
         assert np.max(np.abs(got[key] - ref[key])) < 1e-8 * np.max(np.abs(ref[key])), key
 
 
