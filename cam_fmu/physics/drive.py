@@ -285,7 +285,7 @@ class DriveModel:
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
         M = shaft + (push + sigma * f) * s1
         J = self.J_0 + self.m * s1 * s1
-        N = (push + sigma * f) / math.cos(alpha)  # X: N cos(alpha) = m a - F_gx + sigma f
+        N = (push + sigma * f) * math.sqrt(1.0 + tan_a * tan_a)  # X: N cos(alpha) = m a - F_gx + sigma f (the C bits)
         return LoadState(omega_dot, M, J, f, v, a, alpha, s, N)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True,
