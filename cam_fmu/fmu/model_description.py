@@ -213,7 +213,7 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
     # ModelStructure: every output in Outputs and InitialUnknowns (all are 'calculated').
     # Outputs: in co-simulation a new input (u, omega_ref) changes no output before the next fmi2DoStep;
     # in Model Exchange the outputs follow the host's state and inputs at once, and those of
-    # variables.FEEDTHROUGH (i, M, a, voltage) depend on u directly. One model description serves both:
+    # variables.FEEDTHROUGH (i, M, a, voltage, N_contact) depend on u directly. One model description serves both:
     # they list u (Model Exchange's truth, and safe for a co-simulation master), the others list nothing,
     # so a master need not iterate a loop closed around cam.fmu through omega, theta or s.
     # InitialUnknowns: no dependencies attribute (= may depend on every input and parameter), which

@@ -165,6 +165,7 @@ class LoadState:
     a: float  # m/s2, follower acceleration
     alpha: float  # rad, pressure angle
     s_cam: float  # m, cam lift at the contact
+    N: float = 0.0  # N, the cam's normal force on the roller along the contact normal, signed along X (4.2)
 
 
 class DriveModel:
@@ -272,8 +273,8 @@ class DriveModel:
 
         v = s' omega, a = s'' omega^2 + s' omega_dot; the guide friction with
         kappa = tan(alpha) (omega_dot given, no coupling left); M = M_f d +
-        (m a - F_gx + sigma f) s'. Free in the gap (``engaged`` False): only M_f d
-        and J_m.
+        (m a - F_gx + sigma f) s' and the normal force N = (m a - F_gx + sigma f) / cos(alpha).
+        Free in the gap (``engaged`` False): only M_f d and J_m, N = 0.
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (self.r_b + s)
@@ -288,7 +289,8 @@ class DriveModel:
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
         M = shaft + (push + sigma * f) * s1
         J = self.J_0 + self.m * s1 * s1
-        return LoadState(omega_dot, M, J, f, v, a, alpha, s)
+        N = (push + sigma * f) * math.sqrt(1.0 + tan_a * tan_a)  # X: N cos(alpha) = m a - F_gx + sigma f (the C bits)
+        return LoadState(omega_dot, M, J, f, v, a, alpha, s, N)
 
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True,
                             engaged_backward: bool | None = None) -> float:

@@ -113,7 +113,7 @@ class SpeedFollower:
             M, J, force = load(theta)
             s, v = s_cam - contact * self.c, s1 * omega
             a = s2 * omega * omega + s1 * omega_dot
-            N = abs(force) * math.sqrt(1.0 + tan_a * tan_a)  # N, along the normal: |force along X| / cos(alpha)
+            N = force * math.sqrt(1.0 + tan_a * tan_a)  # N, along the normal: force along X / cos(alpha), signed
         else:
             M, J, N = shaft, model.J_0, 0.0
             a = self.free_acceleration(s, self._sign(v)) if self.m > 0.0 else 0.0
@@ -123,6 +123,6 @@ class SpeedFollower:
             d = 1e-6
             voltage += model.L * omega * (load(theta + d)[0] - load(theta - d)[0]) / (2 * d) / model.c_m
         record = output_record(omega=omega, theta=theta, s=s, i=i, M=M, J=J, v=v, a=a, alpha=math.atan(tan_a),
-                               s_cam=s_cam, voltage=voltage, theta_m=theta, omega_m=omega, M_shaft=0.0)
-        record.update(N_contact=N, contact=contact)   # variables.FOLLOWER_COLUMNS, with impacts (the reference's count)
+                               s_cam=s_cam, voltage=voltage, theta_m=theta, omega_m=omega, M_shaft=0.0, N_contact=N)
+        record.update(contact=contact)   # variables.FOLLOWER_COLUMNS, with impacts (the reference's count)
         return record

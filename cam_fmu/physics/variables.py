@@ -28,11 +28,13 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("theta_m", "rad", "motor angle (a rigid shaft: theta)"),
     ("omega_m", "rad/s", "motor angular velocity (a rigid shaft: omega)"),
     ("M_shaft", "N.m", "torque of the compliant shaft on the cam, k_shaft twist + d_shaft twist rate (rigid: 0)"),
+    ("N_contact", "N", "the cam's normal force on the follower's roller along the contact normal (pressure angle "
+     "alpha): > 0 where the cam pushes along the rise, < 0 where a groove's other flank pushes; 0 off the cam or "
+     "free in the clearance"),
 )
 # The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
 # section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
 FOLLOWER_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("N_contact", "N", "the cam's normal force on the follower (0 while it is off the cam)"),
     ("contact", "1", "+1 on the flank pushing along the rise, -1 on a groove's other flank, 0 off the cam"),
     ("impacts", "1", "touch-downs so far"),
 )
@@ -66,9 +68,9 @@ STATES: tuple[tuple[str, str, str, str], ...] = (
     ("x_omega_m", "rad/s", "rad/s2", "continuous state: the motor's speed (held when k_shaft = 0: omega_m = omega)"),
 )
 # The outputs that depend directly on an input at a fixed state in Model Exchange, and those inputs: the
-# quasi-static current (L = 0) and the voltage follow u, the load torque and the follower's acceleration
-# follow the cam's acceleration, hence u (tests/fmu_me/test_engine_fmu_me.py measures it both ways).
-FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage")
+# quasi-static current (L = 0) and the voltage follow u, the load torque, the follower's acceleration and
+# the contact force follow the cam's acceleration, hence u (tests/fmu_me/test_engine_fmu_me.py measures it both ways).
+FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage", "N_contact")
 FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).

@@ -247,13 +247,13 @@ class VoltageFollower:
         elif contact:
             omega_dot, P, _ = self.on_flank(theta, omega, drive, contact)
             a, M, J = s2 * omega * omega + s1 * omega_dot, shaft + P * s1, self.J_0 + self.m * s1 * s1
-            N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: |P| / cos(alpha)
+            N = P * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: P / cos(alpha), signed as contact
             s, v = s_cam - contact * self.c, s1 * omega
         else:
             a, M, J, N = self.free_acceleration(s, self.direction(y)), shaft, self.J_0, 0.0
         theta_m, omega_m = (theta + y[5], y[6]) if self.compliant else (theta, omega)
         record = output_record(omega=omega, theta=theta, s=s, i=self.current(y, u), M=M,
                                J=J + (model.J_m if self.compliant else 0.0), v=v, a=a, alpha=math.atan(tan_a),
-                               s_cam=s_cam, voltage=u, theta_m=theta_m, omega_m=omega_m, M_shaft=self.shaft_torque(y))
-        record.update(N_contact=N, contact=contact)
+                               s_cam=s_cam, voltage=u, theta_m=theta_m, omega_m=omega_m, M_shaft=self.shaft_torque(y), N_contact=N)
+        record.update(contact=contact)
         return record

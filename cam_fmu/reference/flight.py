@@ -5,7 +5,8 @@ the follower's (s, v) under spring, gravity along the stroke and guide friction 
 events stop it at each lift-off (the flank's force reaches 0: ``SpeedFollower.held``), touch-down (a gap
 reaches 0), halt in flight (v = 0, where the friction turns) and input break; the transition is applied at
 the located time and the integration restarts there. Rows are the speed drive's outputs with the
-follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0 in flight) and impacts (how many so far).
+follower's own s, v, a and N_contact [N] (0 in flight), plus contact (+1, -1, 0 in flight) and impacts (how
+many so far).
 """
 from __future__ import annotations
 

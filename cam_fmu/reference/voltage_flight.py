@@ -7,7 +7,7 @@ E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lif
 0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
 the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
 follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
-With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, plus N_contact [N], contact (+1, -1, 0),
+With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, and N_contact [N], plus contact (+1, -1, 0),
 impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
 """
 from __future__ import annotations

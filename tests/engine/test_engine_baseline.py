@@ -110,7 +110,7 @@ def test_every_shipped_scene_is_recorded_with_every_solver_and_formulation():
 
 # Outputs added after the record was made (the compliant shaft, docs/model.md section 12): every recorded
 # run has a rigid shaft, where the rotor turns with the cam and no shaft torque is reported.
-ADDED_OUTPUTS = {"theta_m", "omega_m", "M_shaft"}
+ADDED_OUTPUTS = {"theta_m", "omega_m", "M_shaft", "N_contact"}
 
 
 @pytest.mark.parametrize("name", ["paper_fig6", "backlash", "inductance"])

@@ -50,7 +50,7 @@ def test_the_engine_is_the_reference(name):
         assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10, run.label   # m (measured 2e-12)
         assert np.max(np.abs(got["v"] - ref["v"])) < 1e-8, run.label    # m/s (measured 5e-10)
         assert np.max(np.abs(got["a"] - ref["a"])) < 1e-7, run.label    # m/s2 (measured 4e-9)
-        for key in ("M", "i", "voltage"):
+        for key in ("M", "i", "voltage", "N_contact"):
             assert np.max(np.abs(got[key] - ref[key])) < 1e-9 * max(1.0, np.max(np.abs(ref[key]))), (run.label, key)
 
 

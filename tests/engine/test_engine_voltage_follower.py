@@ -44,7 +44,7 @@ def test_the_engine_is_the_reference(name, label):
     assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10               # m (measured 3.7e-13)
     assert np.max(np.abs(got["v"] - ref["v"])) < 2e-8                # m/s (measured 3.4e-10)
     assert np.max(np.abs(got["a"] - ref["a"])) < 2e-6                # m/s2 (measured 9.6e-9)
-    for key in ("M", "i", "J"):
+    for key in ("M", "i", "J", "N_contact"):
         assert np.max(np.abs(got[key] - ref[key])) < 1e-8 * np.max(np.abs(ref[key])), key
 
 

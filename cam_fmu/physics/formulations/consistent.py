@@ -367,4 +367,4 @@ class HybridDrive:
             rotor = dict(theta_m=theta + y[TWIST], omega_m=y[OMEGA_M],
                          M_shaft=self.drive_torque(y, u, 0.0 if mode.stuck else omega))
         return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=J, v=load.v, a=load.a,
-                             alpha=load.alpha, s_cam=load.s_cam, voltage=u, **rotor)
+                             alpha=load.alpha, s_cam=load.s_cam, voltage=u, N_contact=load.N, **rotor)

@@ -113,10 +113,23 @@ class PaperScheme:
         self.M = model.M_f * sign(self.omega) + self.M_l
         return n
 
+    def contact_force(self) -> float:
+        """N, the normal force of step 7's balance, (m a - F_gx + sgn(v) f) / cos(alpha) with the recorded a and v,
+        while the follower follows the profile (it moved in the last step, or c = 0); 0 at rest in the clearance."""
+        model = self.model
+        if self.v == 0.0 and model.c > 0.0:
+            return 0.0
+        s_cam, s1, _, _ = model.program.derivatives(self.theta)
+        tan_a = s1 / (model.r_b + s_cam)
+        push, sigma = model.m * self.a - model.F_gx, sign(self.v)
+        f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g)
+        return (push + sigma * f) / math.cos(math.atan(tan_a))
+
     def outputs(self) -> dict[str, float]:
         s_cam = self.model.program.derivatives(self.theta)[0]
         return output_record(omega=self.omega, theta=self.theta, s=self.s, i=self.i, M=self.M, J=self.J,
                              v=self.v, a=self.a, alpha=self.alpha, s_cam=s_cam, voltage=self.voltage,
+                             N_contact=self.contact_force(),
                              theta_m=self.theta, omega_m=self.omega, M_shaft=0.0)  # a rigid drive-train
 
 

@@ -27,5 +27,5 @@ def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot
         voltage += model.L * omega * dM / model.c_m
     s_cam = model.program.derivatives(theta)[0]
     return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
-                         alpha=load.alpha, s_cam=s_cam, voltage=voltage,
+                         alpha=load.alpha, s_cam=s_cam, voltage=voltage, N_contact=load.N,
                          theta_m=theta, omega_m=omega, M_shaft=0.0)  # a rigid drive-train

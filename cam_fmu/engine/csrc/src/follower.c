@@ -4,8 +4,9 @@
  * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
  * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -TOUCH, an impact with
  * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
- * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The normal
- * force N_contact is the reference's column only so far (not an output of the FMUs). */
+ * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The output
+ * N_contact is the flank's force along X (with the guide friction) over cos(alpha), signed: > 0 on the +1 flank,
+ * < 0 on a groove's -1 flank, 0 in flight (docs/model.md 13.1). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -312,7 +313,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
     Motion mo = {m, st->theta, st->speed, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double omega = st->speed, theta = st->theta, d[4], tan_a, shaft, i, voltage, s = st->s, v = st->v, a;
-    double M, J;
+    double M, J, N = 0.0;
     CamLoad load;
     cam_profile_eval(&m->profile, theta, d);
     tan_a = d[1] / (m->r_b + d[0]);
@@ -328,6 +329,8 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
             sigma = sgn(e[1] * omega);
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);
             Ms[k] = shaft + (push + sigma * f) * e[1];
+            if (k == 0)   /* the force along X over cos(alpha): > 0 on the +1 flank, < 0 on a groove's -1 flank */
+                N = (push + sigma * f) * sqrt(1.0 + t_a * t_a);
         }
         M = Ms[0];
         J = m->J_0 + m->m * d[1] * d[1];
@@ -347,6 +350,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
     }
     load.M = M;
     load.J = J;
+    load.N = N;
     load.f = 0.0;
     load.v = v;
     load.a = a;

@@ -156,7 +156,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     if (!engaged) {
         out->M = shaft;
         out->J = m->J_0;
-        out->f = out->v = out->a = 0.0;
+        out->f = out->v = out->a = out->N = 0.0;
         return;
     }
     v = s1 * omega;
@@ -165,6 +165,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     push = m->m * a - m->F_gx;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;
+    out->N = (push + sigma * f) * sqrt(1.0 + tan_a * tan_a);   /* N cos(alpha) = the force along X (4.2) */
     out->J = m->J_0 + m->m * s1 * s1;
     out->f = f;
     out->v = v;

@@ -49,6 +49,7 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
     out[CAM_O_THETA_M] = theta;   /* a rigid drive: the rotor turns with the cam, no shaft torque */
     out[CAM_O_OMEGA_M] = omega;
     out[CAM_O_M_SHAFT] = 0.0;
+    out[CAM_O_N_CONTACT] = load->N;
 }
 
 /* E_mech [J] of published outputs: kinetic + gravity potential; compliant: the cam side's and the rotor's

@@ -223,12 +223,24 @@ static int paper_advance(CamDrive *d, double h, double time, long *steps, CamErr
     return CAM_OK;
 }
 
+/* N [N]: step 7's force along X over cos(alpha), (m a - F_gx + sgn(v) f) / cos(alpha), while the follower follows
+ * the profile (it moved in the last calculation step, v != 0, or c = 0); 0 while it rests in the clearance. */
+static double paper_contact_force(const CamModel *m, const CamPaperState *p, const double dd[4])
+{
+    double tan_a = dd[1] / (m->r_b + dd[0]), push = m->m * p->a - m->F_gx, sigma = sign(p->v), f;
+    if (p->v == 0.0 && m->c > 0.0)
+        return 0.0;
+    f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
+    return (push + sigma * f) * sqrt(1.0 + tan_a * tan_a);
+}
+
 static void paper_outputs(CamDrive *d, double out[])
 {
     const CamPaperState *p = &d->paper;
     double dd[4];
     CamLoad load;
     cam_profile_eval(&d->model.profile, p->theta, dd);
+    load.N = paper_contact_force(&d->model, p, dd);
     load.M = p->M;
     load.J = p->J;
     load.f = 0.0;

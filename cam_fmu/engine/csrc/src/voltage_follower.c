@@ -588,11 +588,14 @@ static void vf_outputs(CamDrive *d, double out[])
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
     load.s_cam = dd[0];
     load.f = 0.0;
+    load.N = 0.0;   /* in flight */
     if (d->speed.contact != 0.0) {
         int contact = (int)d->speed.contact;
+        double tan_a = dd[1] / (m->r_b + dd[0]);
         on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
                  : m->M_f * shaft_direction(y) + P * dd[1];
+        load.N = P * sqrt(1.0 + tan_a * tan_a);   /* P / cos(alpha), signed as contact */
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
