@@ -150,6 +150,23 @@ def result_line(stdout: str):
 
 
 # --------------------------------------------------------------------------- other platforms (engine/targets.py)
+# The scenes every platform's binary runs against x86_64 Linux's: the drive of fig. 6, with a clearance, and the
+# spring-closed follower of its own bouncing (spring_voltage's parameters: lift-offs, impacts, the Zeno guard), as
+# host.c commands over variable names (value references differ between FMUs).
+PLATFORM_SCENES = {
+    "fig6": [],
+    "backlash": [("setr", "c", "0.002")],
+    "spring": [("sets", "closure", "spring"), ("setr", "k_spring", "800"), ("setr", "F_spring0", "20"),
+               ("setr", "restitution", "0.5"), ("setr", "omega0", "60"), ("setr", "J_cam", "0.05"),
+               ("setr", "gamma", "3.141592653589793"), ("setr", "u", "11")],
+}
+
+
+def scene_commands(scene: str, vr: Dict[str, object]) -> List[str]:
+    """host.c's commands setting a PLATFORM_SCENES scene's parameters, by the FMU's value references."""
+    return [word for cmd, name, value in PLATFORM_SCENES[scene] for word in (cmd, str(vr[name]), value)]
+
+
 WINE = Path("/usr/lib/wine/wine64")  # Debian's wine64 package (the `wine` wrapper is another package)
 QEMU_AARCH64 = "qemu-aarch64-static"  # Debian's qemu-user-static
 AARCH64_ROOT = Path("/usr/aarch64-linux-gnu")  # Debian's libc6-arm64-cross: the aarch64 loader and libc

@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from cam_fmu.engine.build import fmi_headers
-from native_support import HOST_C, WINE, compile_host, require, runner, zig_host
+from native_support import HOST_C, PLATFORM_SCENES, WINE, compile_host, require, runner, scene_commands, value_references, zig_host
 
 
 @pytest.fixture(scope="module")
@@ -67,11 +67,10 @@ def _vr(fmu_dir: Path, name: str) -> str:
     raise AssertionError(name)
 
 
-@pytest.mark.parametrize("scene", ["fig6", "backlash"])
+@pytest.mark.parametrize("scene", sorted(PLATFORM_SCENES))
 def test_win64_binary_agrees_with_linux64(hosts, fmu_dir, scene):
-    outputs = ",".join(_vr(fmu_dir, n) for n in ("omega", "theta", "s", "i", "M", "J"))
-    setup = ["setr", _vr(fmu_dir, "c"), "0.002"] if scene == "backlash" else []
-    commands = ["inst", *setup, "init", "step", "500", "0.001", "getr", outputs, "step", "1500", "0.001", "getr",
+    outputs = ",".join(_vr(fmu_dir, n) for n in ("omega", "theta", "s", "v", "i", "M", "J", "N_contact"))
+    commands = ["inst", *scene_commands(scene, value_references(fmu_dir)), "init", "step", "500", "0.001", "getr", outputs, "step", "1500", "0.001", "getr",
                 outputs, "free"]
     linux, windows = (_values(_run(hosts, fmu_dir, p, *commands)) for p in ("linux64", "win64"))
     assert len(linux) == len(windows) == 2

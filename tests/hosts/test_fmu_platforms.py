@@ -23,7 +23,7 @@ import pytest
 from cam_fmu.engine import build as engine_build
 from cam_fmu.engine import targets
 from cam_fmu.fmu import macho
-from native_support import HOST_C, compile_host, require, runner, zig_host
+from native_support import HOST_C, PLATFORM_SCENES, compile_host, require, runner, scene_commands, zig_host
 
 HERE = Path(__file__).resolve().parents[1]
 HOST3_C = HERE / "native_host" / "host3.c"
@@ -238,15 +238,14 @@ def aarch64_hosts(tmp_path_factory) -> dict[str, Path]:
             "x86_64": compile_host(folder / "host_x86_64")}
 
 
-@pytest.mark.parametrize("scene", ["fig6", "backlash"])
+@pytest.mark.parametrize("scene", sorted(PLATFORM_SCENES))
 def test_the_aarch64_binary_agrees_with_x86_64_under_qemu(unzipped, aarch64_hosts, scene):
     """The C host (tests/native_host/host.c) built for aarch64 by zig dlopens binaries/aarch64-linux/cam.so under
     qemu-aarch64: the same statuses as x86_64's linux64/cam.so, outputs to 1e-12 relative, and a state saved,
     serialised and restored gives the same bits as the run it was saved from."""
     fmu, vr = unzipped[2], _vr(unzipped[2])
-    outputs = ",".join(vr[n] for n in ("omega", "theta", "s", "i", "M", "J"))
-    setup = ["setr", vr["c"], "0.002"] if scene == "backlash" else []
-    commands = ["guid", _guid(fmu), "inst", *setup, "init", "step", "500", "0.001", "save", "serial", "getr", outputs,
+    outputs = ",".join(vr[n] for n in ("omega", "theta", "s", "v", "i", "M", "J", "N_contact"))
+    commands = ["guid", _guid(fmu), "inst", *scene_commands(scene, vr), "init", "step", "500", "0.001", "save", "serial", "getr", outputs,
                 "step", "1500", "0.001", "getr", outputs, "restore", "step", "1500", "0.001", "getr", outputs, "free"]
     runs = {}
     for name, cmd in (("x86_64", [str(aarch64_hosts["x86_64"]), str(fmu / "binaries" / "linux64" / "cam.so")]),
