@@ -295,6 +295,9 @@ def rerecord(why: str, directory: Path = RECORD_DIR, keep: dict[str, Any] | None
             moved.append(case["name"])
             if keep:
                 kept.append(old)
+            names = case["result"]["outputs"]  # the outputs the record holds (outputs added since are not in it)
+            now = dict(now, outputs={k: now["outputs"][k] for k in names},
+                       final={k: v for k, v in now["final"].items() if k in names})
             cases.append(dict(case, result=now))
         if not moved:
             continue
