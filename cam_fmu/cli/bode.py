@@ -62,11 +62,12 @@ def run(args) -> int:
     params = scene.primary.params
     from ..physics.drive import own_follower
 
-    if own_follower(params["closure"], params["c"] if params["backlash"] else 0.0, params["formulation"],
-                    params["drive"]):
+    if own_follower(params):
+        kinematic = (" (or --set closure=kinematic: the paper's rule, the follower resting in the clearance until a "
+                     "flank takes it along)") if params["closure"] == "form" else ""
         raise ValueError(f"scene {scene.name}: closure {params['closure']!r}: the frequency response linearises the "
                          "drive with the follower on the cam (backlash off, the kinematic rule); a follower that can "
-                         "leave the cam has no small-signal model there (docs/model.md section 13)")
+                         f"leave the cam has no small-signal model there (docs/model.md section 13){kinematic}")
     f = np.geomspace(args.fmin, args.fmax, args.points)
     theta0 = None if args.u0 is not None else math.radians(args.theta or 0.0)
     try:

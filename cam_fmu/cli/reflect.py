@@ -9,8 +9,9 @@ they occur; ``--json`` prints them as one JSON object instead (keys J_min, J_max
 [kg m^2], M_min, M_max [N m], f_r_min, f_r_max, f_a_min, f_a_max [Hz], each with its
 theta_<key> [rad]; the resonance keys are null when the drive-train is rigid,
 k_shaft = 0; and assumes, what the map assumes of the follower). It holds the follower on the cam at
-every angle (closure 'kinematic', a clearance ignored; 'form' where it cannot fly: c = 0 or the paper's formulation)
-and refuses closure 'spring' and 'form' with a clearance, whose follower can leave the cam (`cam-fmu jump`). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
+every angle (closure 'kinematic', a clearance ignored; 'form' where it cannot fly: c = 0, no follower mass or the
+paper's formulation) and refuses closure 'spring' and 'form' with a clearance, whose follower can leave the cam
+(`cam-fmu jump`; for 'form', `--set closure=kinematic` gives the map with the follower held on the cam). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
 figure a third panel.
 """
 from __future__ import annotations

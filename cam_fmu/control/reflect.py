@@ -51,7 +51,9 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
     if model.free_follower:
         raise ValueError(f"closure {model.closure!r}: the map holds the follower on the cam at every angle (the "
                          "kinematic rule), while this follower can leave it (docs/model.md section 13); for where "
-                         "and at what speed it does, use cam-fmu jump")
+                         "and at what speed it does, use cam-fmu jump"
+                         + ("; for the map with the follower held on the cam (the clearance ignored), --set "
+                            "closure=kinematic" if model.closure == "form" else ""))
     omega = rpm * 2.0 * math.pi / 60.0
     direction = 1.0 if omega > 0.0 else -1.0
     thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)

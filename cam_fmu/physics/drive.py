@@ -19,8 +19,8 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import (FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError, law_spec,
-                         mounting_component, resolve)
+from .parameters import (BY_NAME, FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError,
+                         law_spec, mounting_component, resolve)
 
 
 def sign(x: float) -> float:
@@ -80,18 +80,32 @@ def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
             raise ParameterError(f"{k}: {reason}; allowed with {name} {choice!r}: k_shaft = 0{instead}")
 
 
-def own_follower(closure: str, c: float, formulation: str, drive: str) -> bool:
+def effective_clearance(p: Mapping[str, Any]) -> float:
+    """The clearance c [m] the model uses: c where the backlash effect is on, else 0 (docs/model.md 6.2)."""
+    return p["c"] if p["backlash"] else 0.0
+
+
+def follower_mass(p: Mapping[str, Any]) -> float:
+    """The follower's mass m [kg] the model uses: m where the follower's inertia is on, else 0."""
+    return p["m"] if p["follower_inertia"] else 0.0
+
+
+def own_follower(p: Mapping[str, Any]) -> bool:
     """Does the follower move as a body of its own (docs/model.md 13)? Closure 'spring' always; 'form' where the
-    groove has a clearance c > 0 [m] to fly across and the formulation has the follower's momentum (the paper's
-    voltage-drive formulation models the clearance by its eqs. 6-8, the rule of closure 'kinematic')."""
-    if closure == "spring":
+    groove has a clearance c > 0 to fly across, the follower a mass m > 0 to carry its momentum across it (without
+    one no force moves it: gravity and friction scale with m), and the formulation has the follower's momentum (the
+    paper's voltage-drive formulation models the clearance by its eqs. 6-8). Else 'form' is the rule of closure
+    'kinematic', bit for bit. model.c's free_follower is this rule (tests/engine/test_engine_model.py)."""
+    if p["closure"] == "spring":
         return True
-    return closure == "form" and c > 0.0 and (drive in FOLLOWER_DRIVES or formulation in VOLTAGE_FOLLOWER_FORMULATIONS)
+    return (p["closure"] == "form" and effective_clearance(p) > 0.0 and follower_mass(p) > 0.0
+            and (p["drive"] in FOLLOWER_DRIVES or p["formulation"] in VOLTAGE_FOLLOWER_FORMULATIONS))
 
 
-def check_closure(p: Mapping[str, Any], c: float) -> None:
+def check_closure(p: Mapping[str, Any]) -> None:
     """Raise ParameterError where the closure's parameters contradict each other (docs/model.md 13)."""
     closure = p["closure"]
+    c = effective_clearance(p)
     if closure != "spring" and (p["k_spring"] != 0.0 or p["F_spring0"] != 0.0):
         raise ParameterError(f"parameters 'k_spring' = {p['k_spring']!r} N/m, 'F_spring0' = {p['F_spring0']!r} N: "
                              f"a return spring needs closure 'spring' (closure is {closure!r}); allowed with it: 0")
@@ -106,12 +120,14 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
     if closure == "spring" and c != 0.0:
         raise ParameterError(f"parameter 'c' = {c!r} m: closure 'spring' holds the follower on one flank, there is "
                              "no clearance; allowed with it: c = 0")
-    if not own_follower(closure, c, p["formulation"], p["drive"]):
-        return  # a groove without clearance: held on both sides, the kinematic rule's motion exactly
-    kinematic = " (or closure 'kinematic', the paper's rule)" if closure == "form" else ""
-    if not (p["m"] > 0.0 and p["follower_inertia"]):
-        raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure {closure!r} moves the follower as a body of its "
-                             f"own, which needs its mass; allowed with it: m > 0 and follower_inertia true{kinematic}")
+    if closure == "spring" and not p["follower_inertia"]:
+        raise ParameterError("parameter 'follower_inertia' = false: closure 'spring' moves the follower as a body of "
+                             "its own, which needs its mass; allowed with it: follower_inertia true (and m > 0)")
+    if closure == "spring" and not p["m"] > 0.0:
+        raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure 'spring' moves the follower as a body of its "
+                             "own, which needs its mass; allowed with it: m > 0")
+    if not own_follower(p):
+        return  # a groove without clearance, or a follower without mass: the kinematic rule's motion exactly
     if p["drive"] in FOLLOWER_DRIVES:
         return
     # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, with guide
@@ -120,6 +136,11 @@ def check_closure(p: Mapping[str, Any], c: float) -> None:
     if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
         raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
                              "with it: formulation 'consistent'")
+    if p["solver"] != BY_NAME["solver"].default:
+        kinematic = "; closure 'kinematic' (the paper's rule) runs the chosen solver" if closure == "form" else ""
+        raise ParameterError(f"parameter 'solver' = {p['solver']!r}: a follower of its own (closure {closure!r}) "
+                             "in the voltage drive takes its own event-located Runge-Kutta steps (docs/model.md "
+                             f"13.6); allowed with it: {BY_NAME['solver'].default!r}{kinematic}")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
@@ -188,7 +209,7 @@ class DriveModel:
         self.compliant = self.k_shaft > 0.0
         self.J_0 = p["J_cam"] if self.compliant else self.J_m + p["J_cam"]  # kg m2, turning with the cam
         self.M_f = p["M_f"] if p["shaft_friction"] else 0.0
-        self.m = p["m"] if p["follower_inertia"] else 0.0
+        self.m = follower_mass(p)
         G = p["G"] if p["gravity"] else 0.0
         # Each sine and cosine of the mounting is exactly 0 where the angle makes it 0 (docs/model.md 4.1).
         gamma, beta = p["gamma"], p["beta"]
@@ -199,7 +220,7 @@ class DriveModel:
         self.N_g = abs(G * cos_g)  # N, guide support |N_g|
         self.mu = p["mu"] if p["guide_friction"] else 0.0
         self.r_b = p["r_b"]
-        self.c = p["c"] if p["backlash"] else 0.0
+        self.c = effective_clearance(p)
         self.formulation = p["formulation"]
         self.drive = p["drive"]
         # Does the follower load the shaft at all? (inertia, gravity or friction)
@@ -207,8 +228,8 @@ class DriveModel:
         # The follower as a body of its own (docs/model.md section 13): 'kinematic' is the paper's rule.
         self.closure = p["closure"]
         self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
-        check_closure(p, self.c)
-        self.free_follower = own_follower(self.closure, self.c, self.formulation, self.drive)
+        check_closure(p)
+        self.free_follower = own_follower(p)
         if self.compliant:
             check_compliant(p, self.J_0)
         if self.mu > 0.0:

@@ -2,6 +2,7 @@
 
     python -m cam_fmu.tools.baseline --write    # record (the engine of this checkout)
     python -m cam_fmu.tools.baseline --check    # replay and compare; prints the largest difference
+    python -m cam_fmu.tools.baseline --rerecord WHY [--keep NAME=VALUE]   # re-record only the moved cases
 
 Engine-agnostic: a case runs through the public in-process API only,
 ``DriveSimulator(params)``, ``set_inputs``, ``do_step(t, h, u, omega_ref, omega_dot_ref)``
@@ -39,7 +40,9 @@ round-trips exactly. The files also hold the Python, numpy, scipy and hypothesis
 (the first records also the Cython version of the engine they recorded) and the git commit the
 record was made at; a change of the engine that moves answers on purpose re-records only the cases
 it moves, and the file's "re_recorded" list names them with the commit they were re-recorded on and
-why (``load`` reads it; ``write`` records everything anew).
+why (``rerecord``; ``load`` reads it; ``write`` records everything anew). Where the move is a changed default
+(closure 'form'), ``--keep closure=kinematic`` keeps each moved case's former record beside it, under the old
+default named explicitly, so the old behaviour stays held to the former engine's record.
 
 The comparison (``compare``): every recorded sample to RTOL = 1e-12 relative, where a value
 below ZERO = 1e-3 of its output's scale (the largest |value| of that output over the case's
@@ -264,6 +267,53 @@ def load(directory: Path = RECORD_DIR) -> dict[str, dict[str, Any]]:
     return {path.stem: json.loads(path.read_text()) for path in sorted(directory.glob("*.json"))}
 
 
+def rerecord(why: str, directory: Path = RECORD_DIR, keep: dict[str, Any] | None = None) -> list[str]:
+    """Re-record only the cases a change of the engine moves on purpose, and name them with ``why`` and the commit
+    in their file's "re_recorded" list; every other case keeps its record. Without ``keep`` a case moved where its
+    replay differs from its record. ``keep``: the parameters of the old behaviour where a default changed (e.g.
+    {"closure": "kinematic"}): a case moved where its replay differs from its replay under them, and its record is
+    kept beside the new one, under them (" [k=v]" appended to its name), still the former engine's. Returns the
+    names of the moved cases."""
+    moved_all: list[str] = []
+    commit = provenance()["commit"]
+    tag = "".join(f" [{k}={v}]" for k, v in (keep or {}).items())
+    for stem, data in load(directory).items():
+        cases, moved, kept = [], [], []
+        for case in data["cases"]:
+            now = replay(case)
+            if keep:
+                if case["name"].endswith(tag):
+                    kept.append(case)
+                    continue
+                old = dict(case, name=case["name"] + tag, params={**case["params"], **keep})
+                unmoved = compare(replay(old), now)[0] == []
+            else:
+                unmoved = compare(case["result"], now)[0] == []
+            if unmoved:
+                cases.append(case)
+                continue
+            moved.append(case["name"])
+            if keep:
+                kept.append(old)
+            names = case["result"]["outputs"]  # the outputs the record holds (outputs added since are not in it)
+            now = dict(now, outputs={k: now["outputs"][k] for k in names},
+                       final={k: v for k, v in now["final"].items() if k in names})
+            cases.append(dict(case, result=now))
+        if not moved:
+            continue
+        data["cases"] = cases + kept
+        data.setdefault("re_recorded", []).append({"commit": commit, "why": why, "cases": moved})
+        if keep:
+            data["re_recorded"][-1]["kept_as"] = tag.strip()
+        path = directory / f"{stem}.json"
+        rows = ",\n".join(json.dumps(case, separators=(",", ":")) for case in data["cases"])
+        path.write_text(f'{{"recorded_with":{json.dumps(data["recorded_with"])},\n'
+                        f'"re_recorded":{json.dumps(data["re_recorded"])},\n"cases":[\n{rows}]}}\n')
+        print(f"{path}: {len(moved)} case(s) re-recorded: {', '.join(moved)}", flush=True)
+        moved_all += moved
+    return moved_all
+
+
 def check(directory: Path = RECORD_DIR) -> int:
     """Replay every recorded case; print the problems and the largest difference."""
     failures, worst = 0, 0.0
@@ -283,10 +333,18 @@ def main(argv: list[str] | None = None) -> int:
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--write", action="store_true", help=f"record the baseline into {RECORD_DIR}")
     what.add_argument("--check", action="store_true", help="replay the recorded cases and compare")
+    what.add_argument("--rerecord", metavar="WHY", help="re-record only the cases that moved, naming them with WHY")
+    parser.add_argument("--keep", action="append", default=[], metavar="NAME=VALUE",
+                        help="with --rerecord: keep each moved case's record beside it under this parameter "
+                             "(repeatable; e.g. closure=kinematic when a default moved)")
     parser.add_argument("--dir", type=Path, default=RECORD_DIR, help="where the JSON files are")
     args = parser.parse_args(argv)
     if args.write:
         write(args.dir)
+        return 0
+    if args.rerecord:
+        keep = dict(item.split("=", 1) for item in args.keep)
+        rerecord(args.rerecord, args.dir, keep)
         return 0
     return check(args.dir)
 

@@ -63,6 +63,9 @@ def test_jump_prints_its_results(tmp_path):
     (["jump", "spring_jump", "--rpm", "-3"], "--rpm -3"),
     (["reflect", "spring_jump"], "use cam-fmu jump"),
     (["bode", "paper_fig6", "--set", "closure=spring"], "no small-signal model"),
+    # a groove with a clearance (closure 'form', the default): the follower can fly; the paper's rule on request
+    (["reflect", "backlash"], "closure 'form'"), (["reflect", "backlash"], "--set closure=kinematic"),
+    (["bode", "backlash"], "closure 'form'"), (["bode", "backlash"], "--set closure=kinematic"),
 ])
 def test_refusals_say_why(args, message, tmp_path):
     done = cli(*args, "--out", str(tmp_path), cwd=tmp_path)
@@ -70,7 +73,8 @@ def test_refusals_say_why(args, message, tmp_path):
 
 
 def test_reflect_says_what_it_assumes(tmp_path):
-    done = cli("reflect", "backlash", "--json", "--no-plot", "--out", str(tmp_path), cwd=tmp_path)
+    done = cli("reflect", "backlash", "--set", "closure=kinematic", "--json", "--no-plot", "--out", str(tmp_path),
+               cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "a clearance c is ignored" in json.loads(done.stdout)["assumes"]
 

@@ -56,7 +56,8 @@ def _check(lines: dict[str, list[str]]) -> None:
     assert _same(lines["fig6"], _python_line({}, 2000))
     assert _same(lines["backlash"], _python_line({"c": 5e-4}, 2000))
     assert _same(lines["paper"], _python_line({"formulation": "paper"}, 2000))
-    assert _same(lines["etdrk4"], _python_line({"c": 5e-4, "solver": "etdrk4", "h_max": 1e-4, "L": 1e-3}, 1000))
+    assert _same(lines["etdrk4"], _python_line({"c": 5e-4, "solver": "etdrk4", "h_max": 1e-4, "L": 1e-3,
+                                                   "closure": "kinematic"}, 1000))
     shaft = {"J_m": 3e-5, "J_cam": 1.41e-5, "k_shaft": 50.0, "d_shaft": 1e-3}
     assert _same(lines["compliant"], _python_line(shaft, 2000))
     stick_slip = {"J_m": 3e-5, "J_cam": 1.41e-5, "k_shaft": 0.5, "M_f": 0.02, "follower_inertia": False,

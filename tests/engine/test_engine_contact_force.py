@@ -154,7 +154,7 @@ def test_the_kinematic_rule_reports_no_force_while_the_follower_rests_in_the_cle
     for extra in ({}, {"formulation": "paper"}, {"drive": "speed"}):
         c = 5e-4
         speed = extra.get("drive") == "speed"
-        got = run(dict(c=c, **extra), np.linspace(0.0, 0.6, 601), u=0.0 if speed else 3.5, omega=30.0 if speed else 0.0)
+        got = run(dict(c=c, closure="kinematic", **extra), np.linspace(0.0, 0.6, 601), u=0.0 if speed else 3.5, omega=30.0 if speed else 0.0)
         gap, N = got["s"] - got["s_cam"], got["N_contact"]
         free = np.abs(np.abs(gap) - c) > 1e-12
         assert free.any() and np.all(N[free] == 0.0), extra

@@ -130,7 +130,7 @@ static int check(fmi2Status status, const char *what)
     return 1;
 }
 
-/* A parameter by value reference: vr=value or vr=true|false. */
+/* A parameter by value reference: vr=value, vr=true|false or vr=s:text (a string). */
 static int set_parameter(fmi2Component c, const char *arg)
 {
     fmi2ValueReference vr = (fmi2ValueReference)strtoul(arg, NULL, 10);
@@ -138,6 +138,10 @@ static int set_parameter(fmi2Component c, const char *arg)
     if (!value)
         return 0;
     value++;
+    if (strncmp(value, "s:", 2) == 0) {
+        fmi2String text = value + 2;
+        return fmi2SetString(c, &vr, 1, &text) == fmi2OK;
+    }
     if (strcmp(value, "true") == 0 || strcmp(value, "false") == 0) {
         fmi2Boolean b = value[0] == 't';
         return fmi2SetBoolean(c, &vr, 1, &b) == fmi2OK;

@@ -245,10 +245,14 @@ def test_a_bouncing_follower_never_leaves_the_groove(c, e, omega):
     (dict(drive="speed", closure="spring", c=1e-3), "'c'"),
     (dict(drive="voltage", closure="spring", formulation="paper"), "formulation 'consistent'"),  # the voltage drive's
     # refusals: tests/physics/test_voltage_follower.py
-    (dict(restitution=0.5), "plastic impacts only"),
+    (dict(closure="kinematic", restitution=0.5), "plastic impacts only"),
     (dict(k_spring=100.0), "closure 'spring'"),
-    (dict(drive="speed", closure="spring", m=0.0), "'m'"),
-    (dict(drive="speed", closure="form", c=1e-3, m=0.0), "or closure 'kinematic'"),
+    (dict(drive="speed", closure="spring", m=0.0), "^parameter 'm' = 0.0 kg: .* allowed with it: m > 0$"),
+    (dict(closure="spring", follower_inertia=False), "^parameter 'follower_inertia' = false: .* allowed with it: "
+     "follower_inertia true"),
+    (dict(c=1e-3, solver="euler"), "^parameter 'solver' = 'euler': a follower of its own .* own event-located "
+     "Runge-Kutta steps .* allowed with it: 'rk45'; closure 'kinematic' .* runs the chosen solver$"),
+    (dict(closure="spring", solver="etdrk4"), "^parameter 'solver' = 'etdrk4': .* allowed with it: 'rk45'$"),
     (dict(closure="form", c=1e-3, formulation="paper", restitution=0.5), "paper's formulation"),
 ])
 def test_contradicting_closure_parameters_are_refused_with_the_reason(params, words):
@@ -261,8 +265,10 @@ def test_the_engine_refuses_what_the_model_refuses_with_the_same_words():
     from cam_fmu.fmu.engine import DriveSimulator
 
     for params in (dict(drive="speed", closure="spring", c=1e-3), dict(closure="spring", formulation="paper"),
-                   dict(restitution=0.5), dict(k_spring=100.0), dict(drive="speed", closure="spring", m=0.0),
-                   dict(drive="speed", closure="form", c=1e-3, m=0.0), dict(closure="form", c=1e-3, m=0.0),
+                   dict(closure="kinematic", restitution=0.5), dict(k_spring=100.0),
+                   dict(drive="speed", closure="spring", m=0.0), dict(closure="spring", follower_inertia=False),
+                   dict(drive="speed", closure="spring", follower_inertia=False, m=0.0),
+                   dict(c=1e-3, solver="rk4"), dict(closure="spring", solver="euler"),
                    dict(closure="form", c=1e-3, formulation="paper", restitution=0.5)):
         with pytest.raises(ParameterError) as python:
             DriveModel(params)
@@ -275,10 +281,15 @@ def test_the_engine_refuses_what_the_model_refuses_with_the_same_words():
     dict(closure="form", m=0.0, restitution=0.5),                    # no clearance: nothing to fly across
     dict(closure="form", c=5e-4, formulation="paper", omega0=0.0),  # the paper's formulation: its eqs. 6-8
     dict(drive="speed", closure="form", c=0.0, m=0.0),
+    dict(c=5e-4, m=0.0, omega0=0.0),                                 # no mass: nothing carries it across
+    dict(c=5e-4, follower_inertia=False, omega0=3.0, solver="euler"),
+    dict(drive="speed", c=5e-4, follower_inertia=False),
 ])
 def test_a_groove_without_a_flight_is_the_kinematic_rule_to_the_bit(params):
-    """Closure 'form' where the follower cannot fly (c = 0, or the paper's voltage formulation, which models the
-    clearance by its eqs. 6-8) runs the kinematic rule: the same outputs, bit for bit, as closure 'kinematic'."""
+    """Closure 'form' where the follower cannot fly (c = 0; no mass, m = 0 or follower_inertia false, so no
+    momentum carries it across and no force moves it: gravity and friction scale with m; or the paper's voltage
+    formulation, which models the clearance by its eqs. 6-8) runs the kinematic rule: the same outputs, bit for bit,
+    as closure 'kinematic', in the C engine and in physics/drive.py (own_follower, model.c's free_follower)."""
     from cam_fmu.fmu.engine import DriveSimulator
 
     kinematic = dict(params, closure="kinematic", restitution=0.0)

@@ -165,7 +165,7 @@ C = 0.002  # m
 
 def test_engagement_keeps_generalised_momentum_direct():
     """HybridDrive.apply_event(ENGAGE_UP/DOWN): J_m omega- = (J_m + m s'^2) omega+ (s' by hand)."""
-    drive = HybridDrive(DriveModel(dict(c=C)))
+    drive = HybridDrive(DriveModel(dict(c=C, closure="kinematic")))
     for theta, name, omega in ((0.4, ENGAGE_UP, 7.0), (1.5, ENGAGE_UP, 3.0), (math.pi + 0.5, ENGAGE_DOWN, 5.0),
                                (0.4, ENGAGE_DOWN, -2.0)):
         s, s1, _ = paper_profile(theta)
@@ -206,9 +206,9 @@ def test_backlash_run_lag_momentum_and_energy(engine, spy_events):
     """
     if engine == "simulator":  # the C engine: its own event log
         events: list = []
-        out = _run_sim(dict(c=C), 3.5, 2000, events=events)
+        out = _run_sim(dict(c=C, closure="kinematic"), 3.5, 2000, events=events)
     else:  # the reference: the readable model's transitions, spied
-        out = simulate_reference(dict(c=C), 2.0, 1e-3)
+        out = simulate_reference(dict(c=C, closure="kinematic"), 2.0, 1e-3)
         events = spy_events
     engagements = [e for e in events if e[0] in (ENGAGE_UP, ENGAGE_DOWN)]
     assert len(engagements) >= 2 * int(out["theta"][-1] / (2 * math.pi))  # two per turn
@@ -243,7 +243,7 @@ def test_backlash_energy_only_lost_at_impacts(spy_events):
     E_in - E_copper - E_shaft - E_guide - Delta(1/2 J omega^2), never decreases, and at the
     end equals the sum of the impact losses 1/2 (J_m omega-^2 - J omega+^2) seen at the
     engagements (to 1e-9 J of a 2.9e-2 J total; measured: steps >= -4e-13 J)."""
-    out = simulate_reference(dict(c=C, c_e=C_M), 2.0, 1e-3, energy=True)
+    out = simulate_reference(dict(c=C, c_e=C_M, closure="kinematic"), 2.0, 1e-3, energy=True)
     kinetic = 0.5 * out["J"] * out["omega"] ** 2
     missing = out["E_in"] - out["E_copper"] - out["E_shaft"] - out["E_guide"] - (kinetic - kinetic[0])
     assert np.all(np.diff(missing) > -1e-9)  # energy is never gained

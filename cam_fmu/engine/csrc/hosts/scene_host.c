@@ -86,7 +86,8 @@ int main(void)
     set(&p, "gamma", 1.5707963267948966, &err);
     scene("speed", &p, 3.5, 1e-3, 2000);
     cam_params_free(&p);
-    cam_params_defaults(&p);
+    cam_params_defaults(&p);   /* the solvers on the paper's rule (a free follower takes its own steps) */
+    set_text(&p, "closure", "kinematic", &err);
     set(&p, "c", 5e-4, &err);
     set_text(&p, "solver", "euler", &err);
     set(&p, "h_max", 1e-4, &err);

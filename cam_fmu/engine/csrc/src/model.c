@@ -325,7 +325,7 @@ static int check_closure(const CamModel *model, CamError *err)
     char a[40], b[40];
     const double *v = model->params.v;
     const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
-    const char *kinematic = model->closure == CAM_CHOICE_CLOSURE_FORM ? " (or closure 'kinematic', the paper's rule)" : "";
+    const CamParamSpec *solver = cam_param_spec(CAM_P_SOLVER);
     int paper = model->formulation == CAM_FORM_PAPER;
     if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
@@ -343,12 +343,15 @@ static int check_closure(const CamModel *model, CamError *err)
     if (model->closure == CAM_CHOICE_CLOSURE_SPRING && model->c != 0.0)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'c' = %s m: closure 'spring' holds the follower on one "
                          "flank, there is no clearance; allowed with it: c = 0", cam_num(model->c, a));
+    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && v[CAM_P_FOLLOWER_INERTIA] == 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'follower_inertia' = false: closure 'spring' moves the "
+                         "follower as a body of its own, which needs its mass; allowed with it: follower_inertia true "
+                         "(and m > 0)");
+    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && !(v[CAM_P_M] > 0.0))
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure 'spring' moves the follower as a "
+                         "body of its own, which needs its mass; allowed with it: m > 0", cam_num(v[CAM_P_M], a));
     if (!model->free_follower)
-        return CAM_OK;   /* a groove without clearance: held on both sides, the kinematic rule's motion exactly */
-    if (!(v[CAM_P_M] > 0.0 && v[CAM_P_FOLLOWER_INERTIA] != 0.0))
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure '%s' moves the follower as a body "
-                         "of its own, which needs its mass; allowed with it: m > 0 and follower_inertia true%s",
-                         cam_num(v[CAM_P_M], a), closure, kinematic);
+        return CAM_OK;   /* a groove without clearance, or a follower without mass: the kinematic rule exactly */
     if (model->formulation == CAM_FORM_SPEED)
         return CAM_OK;
     /* The voltage drive: the reference's refusals (docs/model.md 13.6); guide friction and a compliant shaft run. */
@@ -356,6 +359,13 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
                          "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
                          "'consistent'", closure);
+    if (model->solver != (int)solver->default_value)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'solver' = '%s': a follower of its own (closure '%s') in "
+                         "the voltage drive takes its own event-located Runge-Kutta steps (docs/model.md 13.6); "
+                         "allowed with it: '%s'%s", solver->choices[model->solver], closure,
+                         solver->choices[(int)solver->default_value],
+                         model->closure == CAM_CHOICE_CLOSURE_FORM
+                         ? "; closure 'kinematic' (the paper's rule) runs the chosen solver" : "");
     return CAM_OK;   /* voltage_follower.c */
 }
 
@@ -417,9 +427,11 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->k_spring = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_K_SPRING] : 0.0;
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
     model->restitution = v[CAM_P_RESTITUTION];
-    /* physics.drive.own_follower: the paper's voltage-drive formulation models a groove's clearance by its eqs. 6-8 */
+    /* physics.drive.own_follower: a groove's follower flies where it has a clearance to cross and a mass to carry
+     * its momentum (without one no force moves it); the paper's voltage-drive formulation models the clearance by
+     * its eqs. 6-8. Elsewhere closure 'form' is the kinematic rule, bit for bit. */
     model->free_follower = model->closure == CAM_CHOICE_CLOSURE_SPRING
-                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0
+                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0 && model->m > 0.0
                                && model->formulation != CAM_FORM_PAPER);
     if ((status = check_closure(model, err)) != CAM_OK) {
         cam_model_free(model);
