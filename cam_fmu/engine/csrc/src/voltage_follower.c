@@ -386,20 +386,60 @@ static int settle(const CamModel *m, double y[NY], double u, int contact)
     return contact * P >= 0.0 ? contact : 0;
 }
 
+/* settle, and *left the flank the follower lets go of where it does. */
+static int settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
+{
+    int after = settle(m, y, u, contact);
+    if (contact && !after)
+        *left = contact;
+    return after;
+}
+
+/* The lift-off or touch-down `code` from the contact `contact` at y at time [s] (a touch-down: the impact and the
+ * rebound guard of land, *rebound its guard), for co-simulation's step and Model Exchange's event update alike: the
+ * contact after, *left the flank the follower leaves (its gap's origin in Model Exchange); its line appended to
+ * d->step_events. */
+static int transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
+                      int *left, long *dropped)
+{
+    const CamModel *m = &d->model;
+    double dd[4], w_before, w_after;
+    int flank = code == EV_TOUCH_UP ? 1 : -1;
+    if (code == EV_LIFT_OFF) {
+        set_on_flank(m, y, contact);
+        cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: lift-off from flank %+d at "
+                          "t = %.9g s (theta = %.6g rad); ", contact, time, y[0]);
+        *left = contact;
+        return 0;
+    }
+    cam_profile_eval(&m->profile, y[0], dd);
+    w_before = y[4] - dd[1] * y[1];
+    *rebound = 0.0;
+    contact = land(m, y, u, flank, rebound);
+    w_after = y[4] - dd[1] * y[1];
+    d->speed.impacts += 1.0;
+    if (!contact)
+        *left = flank;
+    cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: touch-down on flank %+d at "
+                      "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank, time, y[0],
+                      w_before, w_after);
+    return contact;
+}
+
 /* At rest (omega = 0: the start, a new input, a stop, a located break-away): the shaft stays stuck, the follower at
  * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
  * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
  * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
-static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int at_threshold)
+static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
 {
     double dir, margin;
     y[1] = 0.0;
     y[Y_DIR] = 0.0;
-    *contact = settle(m, y, u, *contact);
+    *contact = settle_from(m, y, u, *contact, left);
     margin = breakaway(m, y, u, *contact, &dir);
     if (margin > 0.0 || at_threshold) {
         y[Y_DIR] = dir;
-        *contact = settle(m, y, u, *contact);
+        *contact = settle_from(m, y, u, *contact, left);
     }
 }
 
@@ -407,7 +447,7 @@ static int vf_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
     double y[NY], other[NY];
-    int contact;
+    int contact, left = 1;
     (void)err;
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
     d->mode.contact = 1;   /* the kinematic backlash's mode is not this follower's (d->speed.contact is): held engaged */
@@ -423,8 +463,10 @@ static int vf_init(CamDrive *d, CamError *err)
             memcpy(y, other, sizeof other);
     }
     if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-        at_rest(&d->model, y, d->u, &contact, 0);
+        at_rest(&d->model, y, d->u, &contact, &left, 0);
     d->speed.contact = contact;
+    d->speed.left = contact != 0 ? contact : left;   /* in flight from the start: it was set on flank +1 */
+    d->speed.sigma = flight_direction(&d->model, y);
     store_y(d, y);
     return CAM_OK;
 }
@@ -446,13 +488,13 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     double ws = m->compliant ? sqrt(m->k_shaft * (1.0 / m->J_m + 1.0 / m->J_0)) + m->d_shaft * (1.0 / m->J_m
                                                                                                   + 1.0 / m->J_0)
                 : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
-    int contact = (int)d->speed.contact, events = 0;
+    int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
     load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
-        at_rest(m, y, u, &contact, 0);
-    if (contact && !(contact = settle(m, y, u, contact)))
+        at_rest(m, y, u, &contact, &left, 0);
+    if (contact && !(contact = settle_from(m, y, u, contact, &left)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
@@ -528,7 +570,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (code == EV_SIDE)
             continue;
         if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
-            if (contact && !(contact = settle(m, y, u, contact)))
+            if (contact && !(contact = settle_from(m, y, u, contact, &left)))
                 cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                                   "(theta = %.6g rad); ", time + tau, y[0]);
             continue;
@@ -538,7 +580,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
         if (code == EV_STOP || code == EV_BREAK_AWAY) {
             int was = contact;
-            at_rest(m, y, u, &contact, code == EV_BREAK_AWAY);
+            at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
             cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
                               "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
                               time + tau, y[0]);
@@ -547,23 +589,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                                   "%+d at t = %.9g s (theta = %.6g rad); ", was, time + tau, y[0]);
         } else if (code == EV_HALT) {
             y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
-        } else if (code == EV_LIFT_OFF) {
-            set_on_flank(m, y, contact);
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d at "
-                              "t = %.9g s (theta = %.6g rad); ", contact, time + tau, y[0]);
-            contact = 0;
         } else {
-            double dd[4], w_before, w_after;
-            int flank = code == EV_TOUCH_UP ? 1 : -1;
-            cam_profile_eval(&m->profile, y[0], dd);
-            w_before = y[4] - dd[1] * y[1];
-            rebound = 0.0;
-            contact = land(m, y, u, flank, &rebound);
-            w_after = y[4] - dd[1] * y[1];
-            d->speed.impacts += 1.0;
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: touch-down on flank %+d at "
-                              "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank,
-                              time + tau, y[0], w_before, w_after);
+            contact = transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
         }
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
@@ -572,6 +599,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
+    d->speed.left = left;
+    d->speed.sigma = flight_direction(m, y);   /* Model Exchange's (co-simulation decides it at each step) */
     *steps = taken;
     return CAM_OK;
 }
@@ -624,3 +653,142 @@ static void vf_advice(const CamDrive *d, char *buf, size_t len)
 const CamFormulation cam_voltage_follower = {
     "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice,
 };
+
+/* ------------------------------------------------------------------ Model Exchange (cam_drive.h cam_vf_me_*)
+ * The same rates, event functions, impact law and rebound guard, driven by a host's solver (fmi/exchange.c). In
+ * flight the follower's states are its gap g = left (s - s_flank) to the flank it left last and the gap's rate w:
+ * both start at 0 at a lift-off (exactly: the event update sets them), so the host integrates the gap's t^3 opening
+ * with its relative accuracy, not with theta's absolute error times s' (absolute s, v as states chattered between
+ * lift-off and touch-down at 1e-11 m: docs/model.md 13.6). In contact both are 0 with derivative 0 and the follower
+ * is on its flank. */
+
+#define EV_TOUCH EV_TOUCH_UP    /* Model Exchange: the touch-down on the nearer flank (one indicator for both) */
+
+typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
+
+/* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
+static void me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
+{
+    const CamModel *m = &d->model;
+    double dd[4];
+    int contact = (int)d->speed.contact, left = (int)d->speed.left;
+    load_y(d, y);
+    y[0] = x[CAM_THETA];
+    y[1] = x[CAM_OMEGA];
+    y[2] = x[CAM_CURRENT];
+    y[Y_TWIST] = m->compliant ? x[CAM_TWIST] : 0.0;
+    y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
+    cam_profile_eval(&m->profile, y[0], dd);
+    if (contact) {
+        y[3] = dd[0] - contact * clearance(m);
+        y[4] = dd[1] * y[1];
+    } else {
+        y[3] = dd[0] - left * clearance(m) + left * x[CAM_ME_GAP];
+        y[4] = dd[1] * y[1] + left * x[CAM_ME_RATE];
+    }
+    y[Y_SIGMA] = d->speed.sigma;
+}
+
+void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX])
+{
+    const CamModel *m = &d->model;
+    double dd[4];
+    int left = (int)d->speed.left;
+    memcpy(x, d->x, sizeof d->x);
+    x[CAM_ME_GAP] = x[CAM_ME_RATE] = 0.0;
+    if (d->speed.contact != 0.0)
+        return;
+    cam_profile_eval(&m->profile, d->x[CAM_THETA], dd);
+    x[CAM_ME_GAP] = left * (d->speed.s - (dd[0] - left * clearance(m)));
+    x[CAM_ME_RATE] = left * (d->speed.v - dd[1] * d->x[CAM_OMEGA]);
+}
+
+void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
+{
+    double y[NY];
+    memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
+    me_load(d, x, y);
+    d->speed.s = y[3];
+    d->speed.v = y[4];
+    d->speed.theta = y[0];
+    d->speed.speed = y[1];
+    d->stale = 1;
+}
+
+void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
+{
+    double y[NY], dy[NY], dd[4];
+    me_load(d, x, y);
+    rates(&d->model, d->form_u, (int)d->speed.contact, y, dy);
+    dx[CAM_THETA] = dy[0];
+    dx[CAM_OMEGA] = dy[1];
+    dx[CAM_CURRENT] = dy[2];
+    dx[CAM_TWIST] = dy[Y_TWIST];
+    dx[CAM_OMEGA_M] = dy[Y_ROTOR];
+    dx[CAM_ME_GAP] = dx[CAM_ME_RATE] = 0.0;
+    if (d->speed.contact != 0.0)
+        return;
+    cam_profile_eval(&d->model.profile, y[0], dd);   /* the follower's acceleration less the flank's */
+    dx[CAM_ME_GAP] = x[CAM_ME_RATE];
+    dx[CAM_ME_RATE] = d->speed.left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1]));
+}
+
+int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
+{
+    int n = 0;
+    codes[n++] = EV_STOP;
+    if (d->speed.contact != 0.0) {
+        codes[n++] = EV_LIFT_OFF;
+        return n;
+    }
+    codes[n++] = EV_TOUCH;
+    if (d->speed.sigma != 0.0 && friction0(&d->model) > 0.0)
+        codes[n++] = EV_HALT;
+    return n;
+}
+
+double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
+{
+    const CamModel *m = &d->model;
+    double y[NY], g = x[CAM_ME_GAP];
+    if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
+        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * clearance(m) - g) : g) + TOUCH;
+    me_load(d, x, y);
+    return event_value(m, d->form_u, code, (int)d->speed.contact, y);
+}
+
+int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
+{
+    const CamModel *m = &d->model;
+    double x[CAM_ME_NX], y[NY], u = d->form_u, rebound = d->speed.rebound;
+    int contact = (int)d->speed.contact, left = (int)d->speed.left;
+    long dropped = 0;
+    d->step_events[0] = '\0';
+    cam_vf_me_states(d, x);
+    me_load(d, x, y);
+    if (code == EV_STOP)
+        return cam_error(err, CAM_ERR_SIMULATION, "the shaft stops at t = %.9g s (theta = %g rad) with the follower "
+                         "of its own %s: the shaft at rest (its static friction, the break-away, the cam stuck under "
+                         "a flying follower) has no event indicators in Model Exchange; co-simulation "
+                         "(fmi2CoSimulation) runs it (docs/model.md 13.6)", d->time, y[0],
+                         contact ? "on its flank" : "in flight");
+    if (code == EV_HALT) {
+        y[4] = 0.0;   /* the friction turns, or holds the follower (its direction below) */
+    } else if (code == EV_TOUCH) {
+        int flank = m->closure == CAM_CHOICE_CLOSURE_FORM && x[CAM_ME_GAP] > clearance(m) ? -left : left;
+        contact = transition(d, y, u, flank > 0 ? EV_TOUCH_UP : EV_TOUCH_DOWN, contact, d->time, &rebound, &left,
+                             &dropped);
+    } else if (code == EV_LIFT_OFF) {
+        contact = transition(d, y, u, code, contact, d->time, &rebound, &left, &dropped);
+    } else if (contact && !(contact = settle_from(m, y, u, contact, &left))) {   /* a breakpoint's jump of s'' */
+        cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
+                          "(theta = %.6g rad); ", d->time, y[0]);
+    }
+    store_y(d, y);
+    d->speed.contact = contact;
+    d->speed.left = left;
+    d->speed.sigma = contact ? 0.0 : flight_direction(m, y);
+    d->speed.rebound = rebound;
+    d->stale = 1;
+    return CAM_OK;
+}
