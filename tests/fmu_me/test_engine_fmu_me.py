@@ -272,11 +272,7 @@ def test_a_stop_with_stiction_holds_the_shaft(engine_fmu_path):
 
 @pytest.mark.parametrize("start, words", [
     ({"formulation": "paper"}, ("formulation 'paper'", "co-simulation only", "formulation 'consistent'")),
-    ({"drive": "speed"}, ("drive 'speed'", "co-simulation only", "drive 'voltage'")),
-    ({"closure": "spring", "mu": 0.0, "omega0": 0.0, "u": 0.0, "k_spring": 800.0, "F_spring0": 20.0},
-     ("closure 'spring'", "shaft at rest", "co-simulation only", "omega0 != 0")),
-    ({"closure": "form", "c": 5e-4, "omega0": 0.0, "u": 0.0},
-     ("closure 'form'", "shaft at rest", "co-simulation only", "omega0 != 0"))])
+    ({"drive": "speed"}, ("drive 'speed'", "co-simulation only", "drive 'voltage'"))])
 def test_what_is_no_ode_is_refused_at_initialisation_with_its_reason(engine_fmu_path, start, words):
     logged: list[str] = []
 

@@ -85,11 +85,6 @@ int cam_exchange_attach(CamExchange *e)
                     "follower through a play operator (memory in the gap, a jump to the rest position at "
                     "standstill): no ODE for a host's solver, and co-simulation computes it exactly, so it runs "
                     "in co-simulation only (fmi2CoSimulation); in Model Exchange use drive 'voltage'");
-    if (follower(d) && (d->mode.stuck || d->x[CAM_OMEGA] == 0.0))
-        return fail(e, CAM_ERR_PARAMETER, "closure '%s' with the shaft at rest (omega0 = 0): the follower of its own's shaft at rest (its static friction, the break-away) has no "
-                    "event indicators in Model Exchange, so it runs in co-simulation only (fmi2CoSimulation); in "
-                    "Model Exchange start the shaft moving (omega0 != 0)",
-                    cam_param_spec(CAM_P_CLOSURE)->choices[d->model.closure]);
     e->drive = d;
     d->solver.k1_valid = 0;   /* outputs compute omega_dot at the host's state, never a solver's stage */
     cam_exchange_sync(e);
@@ -240,7 +235,7 @@ static int due(const CamExchange *e, const double z[CAM_EXCHANGE_NZ], const int 
             return k;
         if (z[k] > 0.0)
             continue;
-        if (!follower(d) && codes[k] == CAM_EV_BREAK_AWAY && !e->broke_away)
+        if (codes[k] == (follower(d) ? CAM_VF_BREAK_AWAY : CAM_EV_BREAK_AWAY) && !e->broke_away)
             return k;
         if (!have) {
             cam_drive_me_states(d, x);
@@ -281,6 +276,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
             return status;
         fired->code = k >= 0 ? codes[k] : -1;
         fired->note = d->step_events;
+        e->broke_away |= k >= 0 && codes[k] == CAM_VF_BREAK_AWAY;
     } else if (k >= 0) {   /* one transition, logged as the co-simulation integrator logs its own */
         CamEventRecord *record = &d->event_log[d->events_logged % CAM_EVENT_LOG];
         fired->code = codes[k];

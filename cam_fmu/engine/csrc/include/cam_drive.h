@@ -126,7 +126,8 @@ typedef struct CamDrive {
  * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
  * follower's events, its transitions and the refusals of the modes Model Exchange does not run are
  * voltage_follower.c's (cam_vf_*); exchange.c drives them. */
-enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3 };
+enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
+       CAM_VF_BREAK_AWAY = 6 /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
 /* The derivatives at x under the input d->form_u (the drive's mode and contact). */
@@ -139,7 +140,7 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
 /* At the drive's state: the transition `code` (lift-off, touch-down with the impact law and the rebound guard, a halt
  * in flight), or with code 0 the contact settled (lifted at once where the force pulls); its log line into
- * d->step_events. A mode Model Exchange does not run (the shaft's stop) is refused with the reason. */
+ * d->step_events; the shaft's stop or break-away: stuck, or moving off (co-simulation's rule at rest). */
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
 
 /* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */

@@ -665,6 +665,7 @@ const CamFormulation cam_voltage_follower = {
 #define EV_TOUCH EV_TOUCH_UP    /* Model Exchange: the touch-down on the nearer flank (one indicator for both) */
 
 typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
+typedef char cam_vf_me_break_away_code[(int)CAM_VF_BREAK_AWAY == (int)EV_BREAK_AWAY ? 1 : -1];
 
 /* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
 static void me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
@@ -735,10 +736,11 @@ void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM
 
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
 {
-    int n = 0;
-    codes[n++] = EV_STOP;
+    int n = 0, stuck = d->mode.stuck;
+    codes[n++] = stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the input and the current may start it */
     if (d->speed.contact != 0.0) {
-        codes[n++] = EV_LIFT_OFF;
+        if (!stuck)
+            codes[n++] = EV_LIFT_OFF;
         return n;
     }
     codes[n++] = EV_TOUCH;
@@ -766,13 +768,18 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     d->step_events[0] = '\0';
     cam_vf_me_states(d, x);
     me_load(d, x, y);
-    if (code == EV_STOP)
-        return cam_error(err, CAM_ERR_SIMULATION, "the shaft stops at t = %.9g s (theta = %g rad) with the follower "
-                         "of its own %s: the shaft at rest (its static friction, the break-away, the cam stuck under "
-                         "a flying follower) has no event indicators in Model Exchange; co-simulation "
-                         "(fmi2CoSimulation) runs it (docs/model.md 13.6)", d->time, y[0],
-                         contact ? "on its flank" : "in flight");
-    if (code == EV_HALT) {
+    (void)err;
+    if (code == EV_STOP || code == EV_BREAK_AWAY || (code == EV_NONE && y[1] == 0.0)) {
+        int was = contact;   /* at rest: stuck with the follower on its flank (or flying), or moving off */
+        at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
+        if (code != EV_NONE || y[Y_DIR] != 0.0)
+            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
+                              "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
+                              d->time, y[0]);
+        if (was && !contact)
+            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d "
+                              "at t = %.9g s (theta = %.6g rad); ", was, d->time, y[0]);
+    } else if (code == EV_HALT) {
         y[4] = 0.0;   /* the friction turns, or holds the follower (its direction below) */
     } else if (code == EV_TOUCH) {
         int flank = m->closure == CAM_CHOICE_CLOSURE_FORM && x[CAM_ME_GAP] > clearance(m) ? -left : left;
