@@ -33,7 +33,7 @@ static int fail(CamExchange *e, int status, const char *fmt, ...)
 }
 
 /* The follower of its own on a voltage-driven cam (closures 'form', 'spring'): its states, events and transitions
- * are voltage_follower.c's (cam_drive.h cam_vf_me_*). */
+ * are voltage_follower_me.c's (cam_drive.h cam_vf_me_*) on voltage_follower.c's equations. */
 static int follower(const CamDrive *d)
 {
     return d->form == &cam_voltage_follower;

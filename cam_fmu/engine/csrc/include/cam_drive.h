@@ -125,7 +125,7 @@ typedef struct CamDrive {
  * (closures 'form', 'spring'; docs/model.md 13.6) as its gap g = left (s - s_flank(theta)) [m] to the flank it left
  * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
  * follower's events, its transitions and the refusals of the modes Model Exchange does not run are
- * voltage_follower.c's (cam_vf_*); exchange.c drives them. */
+ * voltage_follower_me.c's (cam_vf_me_*); exchange.c drives them. */
 enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
        CAM_VF_BREAK_AWAY = 6 /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);

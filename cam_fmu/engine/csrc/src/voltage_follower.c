@@ -21,9 +21,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cam_drive.h"
+#include "cam_voltage_follower.h"
 
-#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
 #define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
 #define STEP_ANGLE 1e-4         /* rad: cam angle of one Runge-Kutta step */
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
@@ -31,14 +30,7 @@
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
-#define NY 9
-#define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
-#define Y_ROTOR 6
-#define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
-#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
 
-/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK, EV_SIDE };
 
 static double sgn(double x)
 {
@@ -79,7 +71,7 @@ static double torque(const CamModel *m, const double y[NY], double u)
 }
 
 /* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
-static double friction0(const CamModel *m)
+double cam_vf_friction0(const CamModel *m)
 {
     return m->mu * (fabs(m->G_y) + m->N_g);
 }
@@ -90,7 +82,7 @@ static double closing(const CamModel *m, double s)
 }
 
 /* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
-static double clearance(const CamModel *m)
+double cam_vf_clearance(const CamModel *m)
 {
     return m->closure == CAM_CHOICE_CLOSURE_FORM ? m->c : 0.0;
 }
@@ -103,7 +95,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0] - contact * clearance(m));
+    F = closing(m, d[0] - contact * cam_vf_clearance(m));
     if (m->mu == 0.0) {
         *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
@@ -131,7 +123,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 {
     if (y[Y_DIR] == 0.0) {
         cam_profile_eval(&m->profile, y[0], d);
-        *P = closing(m, d[0] - contact * clearance(m));
+        *P = closing(m, d[0] - contact * cam_vf_clearance(m));
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -174,21 +166,21 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
 static double free_acceleration(const CamModel *m, double s, double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * friction0(m)) / m->m;
+    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * cam_vf_friction0(m)) / m->m;
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
  * the guide's static friction (0: held). */
-static double flight_direction(const CamModel *m, const double y[NY])
+double cam_vf_flight_direction(const CamModel *m, const double y[NY])
 {
     double net;
     if (y[4] != 0.0)
         return sgn(y[4]);
     net = -closing(m, y[3]);
-    return fabs(net) > friction0(m) ? sgn(net) : 0.0;
+    return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
 }
 
-static void rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -218,7 +210,7 @@ static void set_on_flank(const CamModel *m, double y[NY], int contact)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - contact * clearance(m);
+    y[3] = d[0] - contact * cam_vf_clearance(m);
     y[4] = d[1] * y[1];
 }
 
@@ -227,16 +219,16 @@ static void rk4(const CamModel *m, double u, int contact, const double y[NY], do
 {
     double k1[NY], k2[NY], k3[NY], k4[NY], t[NY];
     int j;
-    rates(m, u, contact, y, k1);
+    cam_vf_rates(m, u, contact, y, k1);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + 0.5 * h * k1[j];
-    rates(m, u, contact, t, k2);
+    cam_vf_rates(m, u, contact, t, k2);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + 0.5 * h * k2[j];
-    rates(m, u, contact, t, k3);
+    cam_vf_rates(m, u, contact, t, k3);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + h * k3[j];
-    rates(m, u, contact, t, k4);
+    cam_vf_rates(m, u, contact, t, k4);
     for (j = 0; j < NY; j++)
         out[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
     if (contact)
@@ -244,7 +236,7 @@ static void rk4(const CamModel *m, double u, int contact, const double y[NY], do
 }
 
 /* The event function `code` at y on or off the flank `contact` (> 0: nothing happens). */
-static double event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
+double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
 {
     double d[4], omega_dot, P;
     if (code == EV_STOP)
@@ -258,7 +250,7 @@ static double event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - clearance(m)) + TOUCH : (d[0] + clearance(m)) - y[3] + TOUCH;
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + TOUCH;
 }
 
 /* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
@@ -269,7 +261,7 @@ static double event_at(const CamModel *m, double u, int code, int contact, const
         return at[0] - y[0];
     if (code == EV_SIDE)
         return at[1] * side_force(m, y, u, contact) + CAM_SIDE_HYSTERESIS;
-    return event_value(m, u, code, contact, y);
+    return cam_vf_event_value(m, u, code, contact, y);
 }
 
 static int crossed(double before, double after)
@@ -298,7 +290,7 @@ static double acceleration_scale(const CamModel *m, const double y[NY], double u
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return fabs(closing(m, d[0]) / m->m) + friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+    return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -326,7 +318,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     double d[4], before[NY], w, omega_dot, P, scale = acceleration_scale(m, y, u);
     memcpy(before, y, sizeof before);
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - flank * clearance(m);
+    y[3] = d[0] - flank * cam_vf_clearance(m);
     impact(m, y, d[1], m->restitution);
     unstick(y);
     w = y[4] - d[1] * y[1];
@@ -335,7 +327,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
         return 0;
     }
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0] - flank * clearance(m);
+    y[3] = d[0] - flank * cam_vf_clearance(m);
     impact(m, y, d[1], 0.0);
     unstick(y);
     y[4] = d[1] * y[1];
@@ -343,7 +335,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     return flank * P >= 0.0 ? flank : 0;
 }
 
-static void load_y(const CamDrive *d, double y[NY])
+void cam_vf_load_y(const CamDrive *d, double y[NY])
 {
     y[0] = d->x[CAM_THETA];
     y[1] = d->x[CAM_OMEGA];
@@ -352,11 +344,11 @@ static void load_y(const CamDrive *d, double y[NY])
     y[4] = d->speed.v;
     y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
     y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
-    y[Y_SIGMA] = flight_direction(&d->model, y);
+    y[Y_SIGMA] = cam_vf_flight_direction(&d->model, y);
     y[Y_DIR] = d->mode.stuck ? 0.0 : d->mode.direction;
 }
 
-static void store_y(CamDrive *d, const double y[NY])
+void cam_vf_store_y(CamDrive *d, const double y[NY])
 {
     d->x[CAM_THETA] = y[0];
     d->x[CAM_OMEGA] = y[1];
@@ -387,7 +379,7 @@ static int settle(const CamModel *m, double y[NY], double u, int contact)
 }
 
 /* settle, and *left the flank the follower lets go of where it does. */
-static int settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
+int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
 {
     int after = settle(m, y, u, contact);
     if (contact && !after)
@@ -399,7 +391,7 @@ static int settle_from(const CamModel *m, double y[NY], double u, int contact, i
  * rebound guard of land, *rebound its guard), for co-simulation's step and Model Exchange's event update alike: the
  * contact after, *left the flank the follower leaves (its gap's origin in Model Exchange); its line appended to
  * d->step_events. */
-static int transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
+int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
                       int *left, long *dropped)
 {
     const CamModel *m = &d->model;
@@ -430,16 +422,16 @@ static int transition(CamDrive *d, double y[NY], double u, int code, int contact
  * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
  * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
  * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
-static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
+void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
 {
     double dir, margin;
     y[1] = 0.0;
     y[Y_DIR] = 0.0;
-    *contact = settle_from(m, y, u, *contact, left);
+    *contact = cam_vf_settle_from(m, y, u, *contact, left);
     margin = breakaway(m, y, u, *contact, &dir);
     if (margin > 0.0 || at_threshold) {
         y[Y_DIR] = dir;
-        *contact = settle_from(m, y, u, *contact, left);
+        *contact = cam_vf_settle_from(m, y, u, *contact, left);
     }
 }
 
@@ -455,7 +447,7 @@ static int vf_init(CamDrive *d, CamError *err)
     d->form_u = d->u;
     memset(&d->speed, 0, sizeof d->speed);
     d->speed.contact = 1.0;
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     contact = settle(&d->model, y, d->u, 1);
     if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
         memcpy(other, y, sizeof other);
@@ -463,11 +455,11 @@ static int vf_init(CamDrive *d, CamError *err)
             memcpy(y, other, sizeof other);
     }
     if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-        at_rest(&d->model, y, d->u, &contact, &left, 0);
+        cam_vf_at_rest(&d->model, y, d->u, &contact, &left, 0);
     d->speed.contact = contact;
     d->speed.left = contact != 0 ? contact : left;   /* in flight from the start: it was set on flank +1 */
-    d->speed.sigma = flight_direction(&d->model, y);
-    store_y(d, y);
+    d->speed.sigma = cam_vf_flight_direction(&d->model, y);
+    cam_vf_store_y(d, y);
     return CAM_OK;
 }
 
@@ -491,10 +483,10 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
-        at_rest(m, y, u, &contact, &left, 0);
-    if (contact && !(contact = settle_from(m, y, u, contact, &left)))
+        cam_vf_at_rest(m, y, u, &contact, &left, 0);
+    if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
@@ -504,14 +496,14 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
         if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {   /* from rest: STEP_ANGLE at the acceleration */
             double rate[NY];
-            rates(m, u, contact, y, rate);
+            cam_vf_rates(m, u, contact, y, rate);
             if (rate[1] != 0.0)
                 dt = fmin(dt, sqrt(2.0 * STEP_ANGLE / fabs(rate[1])));
         }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
-        if (!contact && y[Y_DIR] == 0.0 && clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
-            double c = clearance(m), A = acceleration_scale(m, y, u);
+        if (!contact && y[Y_DIR] == 0.0 && cam_vf_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
+            double c = cam_vf_clearance(m), A = acceleration_scale(m, y, u);
             dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
             if (y[4] != 0.0)
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
@@ -521,7 +513,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
-            y[Y_SIGMA] = flight_direction(m, y);
+            y[Y_SIGMA] = cam_vf_flight_direction(m, y);
         if (rebound > 0.0)
             dt = fmin(dt, rebound);   /* a bounce lasts about 4 rebound: the first step cannot hold it */
         if (++taken > MAX_STEPS)
@@ -537,7 +529,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
-            if (y[Y_SIGMA] != 0.0 && friction0(m) > 0.0)
+            if (y[Y_SIGMA] != 0.0 && cam_vf_friction0(m) > 0.0)
                 codes[n++] = EV_HALT;
         }
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
@@ -570,7 +562,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (code == EV_SIDE)
             continue;
         if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
-            if (contact && !(contact = settle_from(m, y, u, contact, &left)))
+            if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
                 cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                                   "(theta = %.6g rad); ", time + tau, y[0]);
             continue;
@@ -580,7 +572,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
         if (code == EV_STOP || code == EV_BREAK_AWAY) {
             int was = contact;
-            at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
+            cam_vf_at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
             cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
                               "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
                               time + tau, y[0]);
@@ -590,17 +582,17 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         } else if (code == EV_HALT) {
             y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
         } else {
-            contact = transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
+            contact = cam_vf_transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
         }
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more", dropped);
-    store_y(d, y);
+    cam_vf_store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
     d->speed.left = left;
-    d->speed.sigma = flight_direction(m, y);   /* Model Exchange's (co-simulation decides it at each step) */
+    d->speed.sigma = cam_vf_flight_direction(m, y);   /* Model Exchange's (co-simulation decides it at each step) */
     *steps = taken;
     return CAM_OK;
 }
@@ -611,7 +603,7 @@ static void vf_outputs(CamDrive *d, double out[])
     const CamModel *m = &d->model;
     double y[NY], dd[4], omega_dot, P, i;
     CamLoad load;
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     cam_profile_eval(&m->profile, y[0], dd);
     i = current(m, y, d->form_u);
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
@@ -628,7 +620,7 @@ static void vf_outputs(CamDrive *d, double out[])
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
-        y[3] = dd[0] - contact * clearance(m);
+        y[3] = dd[0] - contact * cam_vf_clearance(m);
     } else {
         load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;
@@ -653,149 +645,3 @@ static void vf_advice(const CamDrive *d, char *buf, size_t len)
 const CamFormulation cam_voltage_follower = {
     "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice,
 };
-
-/* ------------------------------------------------------------------ Model Exchange (cam_drive.h cam_vf_me_*)
- * The same rates, event functions, impact law and rebound guard, driven by a host's solver (fmi/exchange.c). In
- * flight the follower's states are its gap g = left (s - s_flank) to the flank it left last and the gap's rate w:
- * both start at 0 at a lift-off (exactly: the event update sets them), so the host integrates the gap's t^3 opening
- * with its relative accuracy, not with theta's absolute error times s' (absolute s, v as states chattered between
- * lift-off and touch-down at 1e-11 m: docs/model.md 13.6). In contact both are 0 with derivative 0 and the follower
- * is on its flank. */
-
-#define EV_TOUCH EV_TOUCH_UP    /* Model Exchange: the touch-down on the nearer flank (one indicator for both) */
-
-typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
-typedef char cam_vf_me_break_away_code[(int)CAM_VF_BREAK_AWAY == (int)EV_BREAK_AWAY ? 1 : -1];
-
-/* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
-static void me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
-{
-    const CamModel *m = &d->model;
-    double dd[4];
-    int contact = (int)d->speed.contact, left = (int)d->speed.left;
-    load_y(d, y);
-    y[0] = x[CAM_THETA];
-    y[1] = x[CAM_OMEGA];
-    y[2] = x[CAM_CURRENT];
-    y[Y_TWIST] = m->compliant ? x[CAM_TWIST] : 0.0;
-    y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
-    cam_profile_eval(&m->profile, y[0], dd);
-    if (contact) {
-        y[3] = dd[0] - contact * clearance(m);
-        y[4] = dd[1] * y[1];
-    } else {
-        y[3] = dd[0] - left * clearance(m) + left * x[CAM_ME_GAP];
-        y[4] = dd[1] * y[1] + left * x[CAM_ME_RATE];
-    }
-    y[Y_SIGMA] = d->speed.sigma;
-}
-
-void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX])
-{
-    const CamModel *m = &d->model;
-    double dd[4];
-    int left = (int)d->speed.left;
-    memcpy(x, d->x, sizeof d->x);
-    x[CAM_ME_GAP] = x[CAM_ME_RATE] = 0.0;
-    if (d->speed.contact != 0.0)
-        return;
-    cam_profile_eval(&m->profile, d->x[CAM_THETA], dd);
-    x[CAM_ME_GAP] = left * (d->speed.s - (dd[0] - left * clearance(m)));
-    x[CAM_ME_RATE] = left * (d->speed.v - dd[1] * d->x[CAM_OMEGA]);
-}
-
-void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
-{
-    double y[NY];
-    memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
-    me_load(d, x, y);
-    d->speed.s = y[3];
-    d->speed.v = y[4];
-    d->speed.theta = y[0];
-    d->speed.speed = y[1];
-    d->stale = 1;
-}
-
-void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
-{
-    double y[NY], dy[NY], dd[4];
-    me_load(d, x, y);
-    rates(&d->model, d->form_u, (int)d->speed.contact, y, dy);
-    dx[CAM_THETA] = dy[0];
-    dx[CAM_OMEGA] = dy[1];
-    dx[CAM_CURRENT] = dy[2];
-    dx[CAM_TWIST] = dy[Y_TWIST];
-    dx[CAM_OMEGA_M] = dy[Y_ROTOR];
-    dx[CAM_ME_GAP] = dx[CAM_ME_RATE] = 0.0;
-    if (d->speed.contact != 0.0)
-        return;
-    cam_profile_eval(&d->model.profile, y[0], dd);   /* the follower's acceleration less the flank's */
-    dx[CAM_ME_GAP] = x[CAM_ME_RATE];
-    dx[CAM_ME_RATE] = d->speed.left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1]));
-}
-
-int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
-{
-    int n = 0, stuck = d->mode.stuck;
-    codes[n++] = stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the input and the current may start it */
-    if (d->speed.contact != 0.0) {
-        if (!stuck)
-            codes[n++] = EV_LIFT_OFF;
-        return n;
-    }
-    codes[n++] = EV_TOUCH;
-    if (d->speed.sigma != 0.0 && friction0(&d->model) > 0.0)
-        codes[n++] = EV_HALT;
-    return n;
-}
-
-double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
-{
-    const CamModel *m = &d->model;
-    double y[NY], g = x[CAM_ME_GAP];
-    if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
-        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * clearance(m) - g) : g) + TOUCH;
-    me_load(d, x, y);
-    return event_value(m, d->form_u, code, (int)d->speed.contact, y);
-}
-
-int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
-{
-    const CamModel *m = &d->model;
-    double x[CAM_ME_NX], y[NY], u = d->form_u, rebound = d->speed.rebound;
-    int contact = (int)d->speed.contact, left = (int)d->speed.left;
-    long dropped = 0;
-    d->step_events[0] = '\0';
-    cam_vf_me_states(d, x);
-    me_load(d, x, y);
-    (void)err;
-    if (code == EV_STOP || code == EV_BREAK_AWAY || (code == EV_NONE && y[1] == 0.0)) {
-        int was = contact;   /* at rest: stuck with the follower on its flank (or flying), or moving off */
-        at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
-        if (code != EV_NONE || y[Y_DIR] != 0.0)
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
-                              "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
-                              d->time, y[0]);
-        if (was && !contact)
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d "
-                              "at t = %.9g s (theta = %.6g rad); ", was, d->time, y[0]);
-    } else if (code == EV_HALT) {
-        y[4] = 0.0;   /* the friction turns, or holds the follower (its direction below) */
-    } else if (code == EV_TOUCH) {
-        int flank = m->closure == CAM_CHOICE_CLOSURE_FORM && x[CAM_ME_GAP] > clearance(m) ? -left : left;
-        contact = transition(d, y, u, flank > 0 ? EV_TOUCH_UP : EV_TOUCH_DOWN, contact, d->time, &rebound, &left,
-                             &dropped);
-    } else if (code == EV_LIFT_OFF) {
-        contact = transition(d, y, u, code, contact, d->time, &rebound, &left, &dropped);
-    } else if (contact && !(contact = settle_from(m, y, u, contact, &left))) {   /* a breakpoint's jump of s'' */
-        cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
-                          "(theta = %.6g rad); ", d->time, y[0]);
-    }
-    store_y(d, y);
-    d->speed.contact = contact;
-    d->speed.left = left;
-    d->speed.sigma = contact ? 0.0 : flight_direction(m, y);
-    d->speed.rebound = rebound;
-    d->stale = 1;
-    return CAM_OK;
-}
