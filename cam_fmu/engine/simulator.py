@@ -28,7 +28,7 @@ NX, NX_RIGID = 5, 3  # cam_model.h CAM_NX, CAM_NX_RIGID: the state slots (theta,
 S_STUCK = S_X + 5  # CAM_NX slots
 S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE, S_FORM_U, S_HAVE_BUDGET = range(S_STUCK + 1, S_STUCK + 7)
 S_BUDGET = S_HAVE_BUDGET + 1  # work_in, work_abs, theta, i, e_mech0, e_mag0
-S_SPEED = S_BUDGET + 6 + 11  # after the paper scheme's 11: the speed drive's and a free follower's 8 (CAM_S_SPEED)
+S_SPEED = S_BUDGET + 6 + 11  # after the paper scheme's 11: the speed drive's and a free follower's 10 (CAM_S_SPEED)
 BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
 STATE_VERSION = 2.0  # cam_drive.h CAM_STATE_VERSION
 
@@ -260,7 +260,7 @@ class DriveSimulator:
         if energy is not None:
             s[S_BUDGET:S_BUDGET + 6] = array("d", [float(energy[key]) for key in BUDGET_KEYS])
         if "engine" in state:  # a follower of its own (closure 'spring'): its s, v, contact, touch-downs, guard
-            s[S_SPEED:S_SPEED + 8] = array("d", [float(x) for x in state["engine"][S_SPEED:S_SPEED + 8]])
+            s[S_SPEED:S_SPEED + 10] = array("d", [float(x) for x in state["engine"][S_SPEED:S_SPEED + 10]])
         self.set_state_array(s)
 
     def events(self) -> list[dict[str, Any]]:

@@ -56,16 +56,21 @@ def output_record(**values: Any) -> dict[str, float]:
     """Every output, in table order, from keyword values (a missing one is a KeyError)."""
     return {name: values[name] for name in OUTPUT_NAMES}
 
-# The engine's continuous state x[CAM_NX] (cam_model.h's slots, in order): Model Exchange's states,
-# each with its derivative variable ``der(<name>)``; value references after the parameters (the
-# co-simulation references above stay where they were). The C build checks the count against CAM_NX.
-# A rigid drive carries the first three only: the last two are then held (derivative 0).
+# Model Exchange's states: the engine's x[CAM_NX] (cam_model.h's slots, in order), then a free follower's gap and
+# its rate (cam_drive.h CAM_ME_GAP, docs/model.md 13.6), each with its derivative variable ``der(<name>)``; value
+# references after the parameters (the co-simulation references above stay where they were). The C build checks the
+# count against CAM_ME_NX. A rigid drive carries the first three only: x_twist and x_omega_m are then held
+# (derivative 0); x_gap and x_gap_rate are held at 0 in contact and without a follower of its own.
 STATES: tuple[tuple[str, str, str, str], ...] = (
     ("x_theta", "rad", "rad/s", "continuous state: the cam angle (= output theta)"),
     ("x_omega", "rad/s", "rad/s2", "continuous state: the cam speed (= output omega)"),
     ("x_i", "A", "A/s", "continuous state: the armature current (held at 0 when L = 0: i is then quasi-static)"),
     ("x_twist", "rad", "rad/s", "continuous state: the shaft's twist theta_m - theta (held at 0 when k_shaft = 0)"),
     ("x_omega_m", "rad/s", "rad/s2", "continuous state: the motor's speed (held when k_shaft = 0: omega_m = omega)"),
+    ("x_gap", "m", "m/s", "continuous state: a free follower's gap to the flank it left last, in flight (closures "
+     "'form', 'spring'; held at 0 in contact and without one)"),
+    ("x_gap_rate", "m/s", "m/s2", "continuous state: the rate of x_gap (held at 0 in contact and without a free "
+     "follower)"),
 )
 # The outputs that depend directly on an input at a fixed state in Model Exchange, and those inputs: the
 # quasi-static current (L = 0) and the voltage follow u, the load torque, the follower's acceleration and

@@ -106,7 +106,7 @@ static int load(void)
 }
 #endif
 
-#define NX 5   /* the engine's slots; a rigid drive holds the shaft's two */
+#define NX 7   /* the engine's five slots, a free follower's gap and rate; a drive holds the slots it does not carry */
 #define NZ 4
 #define MAX_VARS 200
 
@@ -130,7 +130,8 @@ static int check(fmi2Status status, const char *what)
     return 1;
 }
 
-/* A parameter by value reference: vr=value, vr=true|false or vr=s:text (a string). */
+/* A parameter by value reference: vr=value, vr=true|false, or vr=text (a string such as a closure; vr=s:text
+ * sets a string that reads as a number). */
 static int set_parameter(fmi2Component c, const char *arg)
 {
     fmi2ValueReference vr = (fmi2ValueReference)strtoul(arg, NULL, 10);
@@ -147,7 +148,10 @@ static int set_parameter(fmi2Component c, const char *arg)
         return fmi2SetBoolean(c, &vr, 1, &b) == fmi2OK;
     }
     {
-        fmi2Real r = strtod(value, NULL);
+        char *end;
+        fmi2Real r = strtod(value, &end);
+        if (end == value || *end != '\0')
+            return fmi2SetString(c, &vr, 1, &value) == fmi2OK;
         return fmi2SetReal(c, &vr, 1, &r) == fmi2OK;
     }
 }

@@ -81,7 +81,7 @@ def test_model_description_complete(md_root):
     assert listed == {index_of[n] for n in outputs}
     # Model Exchange: the states and their derivatives are initial unknowns too (calculated)
     states = {n for n, v in by_name.items() if v.get("causality") == "local"}
-    assert initial == listed | {index_of[n] for n in states} and len(states) == 10
+    assert initial == listed | {index_of[n] for n in states} and len(states) == 14
     assert by_name["omega"].find("Real").get("unit") == "rad/s"
 
 

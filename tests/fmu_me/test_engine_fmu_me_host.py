@@ -97,3 +97,28 @@ def test_valgrind_finds_no_error(tmp_path):
     assert "definitely lost: 0 bytes" in log.read_text() or "definitely lost" not in log.read_text()
     assert result["events"] >= 3
     assert os.path.getsize(log) > 0
+
+
+def _follower_params() -> tuple[dict, list[str]]:
+    """spring_voltage (the follower of its own, e = 0.5) as start values and as the C host's vr=value arguments."""
+    from cam_fmu.experiments.scenes import find_scene
+    scene = find_scene("spring_voltage")
+    start = dict(next(r for r in scene.runs if r.label == "e_0.5").start_values(), u=scene.u.value(0.0))
+    text = {True: "true", False: "false"}
+    return start, [f"{VR[k]}={text[v] if isinstance(v, bool) else v}" for k, v in start.items()]
+
+
+def test_the_follower_of_its_own_is_clean_under_asan_and_ubsan_and_follows_fmpys_euler(tmp_path, engine_fmu_path):
+    """The C host's Euler at 2e-6 s through the lift-off and three bounces of spring_voltage (closure 'spring'), under
+    ASan/UBSan, with a saved state in flight's run: the same final theta and omega as fmpy's Euler on the packed FMU."""
+    start, params = _follower_params()
+    step, stop = 2e-6, 0.06
+    result = run(compile_host(tmp_path, SANITIZE), params=params, step=step, stop=stop)
+    euler = fmpy.simulate_fmu(str(engine_fmu_path), fmi_type="ModelExchange", solver="Euler", step_size=step,
+                              output_interval=step, stop_time=stop, start_values=start)
+    t, theta, omega, _ = result["final"]
+    assert t == pytest.approx(stop, rel=1e-12)
+    assert result["events"] >= 4  # the lift-off and three touch-downs (and the profile's breakpoints)
+    assert theta == pytest.approx(euler["theta"][-1], rel=1e-9)
+    assert omega == pytest.approx(euler["omega"][-1], rel=1e-6)
+    assert result["refused"] == [3, 3, 3, 3]

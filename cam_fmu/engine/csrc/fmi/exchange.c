@@ -32,6 +32,13 @@ static int fail(CamExchange *e, int status, const char *fmt, ...)
     return status;
 }
 
+/* The follower of its own on a voltage-driven cam (closures 'form', 'spring'): its states, events and transitions
+ * are voltage_follower_me.c's (cam_drive.h cam_vf_me_*) on voltage_follower.c's equations. */
+static int follower(const CamDrive *d)
+{
+    return d->form == &cam_voltage_follower;
+}
+
 void cam_exchange_init(CamExchange *e, CamInstance *instance)
 {
     memset(e, 0, sizeof *e);
@@ -78,11 +85,6 @@ int cam_exchange_attach(CamExchange *e)
                     "follower through a play operator (memory in the gap, a jump to the rest position at "
                     "standstill): no ODE for a host's solver, and co-simulation computes it exactly, so it runs "
                     "in co-simulation only (fmi2CoSimulation); in Model Exchange use drive 'voltage'");
-    if (d->model.free_follower)
-        return fail(e, CAM_ERR_PARAMETER, "closure '%s' moves the follower as a body of its own: its lift-offs "
-                    "and touch-downs have no event indicators in Model Exchange yet (docs/model.md 13.6), so it runs in "
-                    "co-simulation only (fmi2CoSimulation); in Model Exchange use closure 'kinematic' (the paper's rule)",
-                    cam_param_spec(CAM_P_CLOSURE)->choices[d->model.closure]);
     e->drive = d;
     d->solver.k1_valid = 0;   /* outputs compute omega_dot at the host's state, never a solver's stage */
     cam_exchange_sync(e);
@@ -115,46 +117,44 @@ static int check_count(CamExchange *e, size_t n, size_t expected, const char *wh
 int cam_exchange_set_states(CamExchange *e, const double x[], size_t nx)
 {
     size_t k;
-    if (check_count(e, nx, CAM_NX, "continuous states") != CAM_OK)
+    if (check_count(e, nx, CAM_ME_NX, "continuous states") != CAM_OK)
         return CAM_ERR_SIMULATION;
-    for (k = 0; k < CAM_NX; k++)
+    for (k = 0; k < CAM_ME_NX; k++)
         if (!isfinite(x[k]))
             return fail(e, CAM_ERR_SIMULATION, "continuous state '%s' = %g is not finite",
                         cam_state_spec((int)k)->name, x[k]);
-    /* a rigid drive holds the shaft's slots at 0 (their derivatives are 0: a host's solver leaves them) */
-    memcpy(e->drive->x, x, (size_t)e->drive->model.slots * sizeof x[0]);
-    e->drive->stale = 1;
+    cam_drive_set_me_states(e->drive, x);
     return CAM_OK;
 }
 
 int cam_exchange_get_states(CamExchange *e, double x[], size_t nx)
 {
-    if (check_count(e, nx, CAM_NX, "continuous states") != CAM_OK)
+    if (check_count(e, nx, CAM_ME_NX, "continuous states") != CAM_OK)
         return CAM_ERR_SIMULATION;
-    memcpy(x, e->drive->x, sizeof e->drive->x);
+    cam_drive_me_states(e->drive, x);
     return CAM_OK;
 }
 
 int cam_exchange_derivatives(CamExchange *e, double dx[], size_t nx)
 {
-    CamDrive *d = e->drive;
-    int k;
-    if (check_count(e, nx, CAM_NX, "state derivatives") != CAM_OK)
+    double x[CAM_ME_NX];
+    if (check_count(e, nx, CAM_ME_NX, "state derivatives") != CAM_OK)
         return CAM_ERR_SIMULATION;
     cam_exchange_sync(e);
-    cam_rhs(&d->model, &d->mode, d->x, d->u, dx);
-    for (k = d->model.slots; k < CAM_NX; k++)   /* a rigid drive holds the shaft's slots */
-        dx[k] = 0.0;
+    cam_drive_me_states(e->drive, x);
+    cam_drive_me_rates(e->drive, x, dx);
     return CAM_OK;
 }
 
 int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx)
 {
     size_t k;
-    if (check_count(e, nx, CAM_NX, "nominals of the continuous states") != CAM_OK)
+    if (check_count(e, nx, CAM_ME_NX, "nominals of the continuous states") != CAM_OK)
         return CAM_ERR_SIMULATION;
     for (k = 0; k < nx; k++)
         nominal[k] = 1.0;
+    nominal[CAM_ME_GAP] = 1e-3;    /* m, m/s: a follower's flight (a groove's clearance, a bounce's height) is of */
+    nominal[CAM_ME_RATE] = 1e-2;   /* millimetres; a host's absolute tolerance is its relative one times these */
     return CAM_OK;
 }
 
@@ -162,18 +162,29 @@ int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx)
  * co-simulation settles at each step's input but here the input changes continuously. */
 static int active_codes(const CamDrive *d, int codes[CAM_MAX_EVENTS])
 {
-    int n = cam_event_codes(&d->model, &d->mode, codes);
+    int n;
+    if (follower(d))
+        return cam_vf_me_codes(d, codes);
+    n = cam_event_codes(&d->model, &d->mode, codes);
     if (d->mode.stuck && !d->model.has_current && !d->model.compliant && n < CAM_MAX_EVENTS)
         codes[n++] = CAM_EV_BREAK_AWAY;
     return n;
+}
+
+/* The event function `code` of the drive's mode at the states x. */
+static double event_value(const CamDrive *d, int code, const double x[CAM_ME_NX])
+{
+    return follower(d) ? cam_vf_me_event(d, code, x) : cam_event_value(&d->model, &d->mode, code, x, d->u);
 }
 
 /* Every indicator into z[CAM_EXCHANGE_NZ]; the codes of the slots into codes (n of them). */
 static int indicators(const CamDrive *d, double target, double z[CAM_EXCHANGE_NZ], int codes[CAM_MAX_EVENTS])
 {
     int n = active_codes(d, codes), k;
+    double x[CAM_ME_NX];
+    cam_drive_me_states(d, x);
     for (k = 0; k < CAM_MAX_EVENTS; k++)
-        z[k] = k < n ? cam_event_value(&d->model, &d->mode, codes[k], d->x, d->u) : CAM_EXCHANGE_IDLE;
+        z[k] = k < n ? event_value(d, codes[k], x) : CAM_EXCHANGE_IDLE;
     z[CAM_EXCHANGE_BREAKPOINT] = d->mode.stuck || target != target ? CAM_EXCHANGE_IDLE
                                                                     : d->mode.direction * (target - d->x[CAM_THETA]);
     return n;
@@ -217,22 +228,23 @@ static int below_zero(const double z[CAM_EXCHANGE_NZ], int n)
 static int due(const CamExchange *e, const double z[CAM_EXCHANGE_NZ], const int codes[CAM_MAX_EVENTS], int n)
 {
     const CamDrive *d = e->drive;
-    double dx[CAM_NX] = {0.0, 0.0, 0.0, 0.0, 0.0}, probe[CAM_NX];
+    double x[CAM_ME_NX], dx[CAM_ME_NX], probe[CAM_ME_NX];
     int k, j, have = 0;
     for (k = 0; k < n; k++) {
         if (z[k] < 0.0)
             return k;
         if (z[k] > 0.0)
             continue;
-        if (codes[k] == CAM_EV_BREAK_AWAY && !e->broke_away)
+        if (codes[k] == (follower(d) ? CAM_VF_BREAK_AWAY : CAM_EV_BREAK_AWAY) && !e->broke_away)
             return k;
         if (!have) {
-            cam_rhs(&d->model, &d->mode, d->x, d->u, dx);
-            for (j = 0; j < CAM_NX; j++)
-                probe[j] = d->x[j] + CAM_EXCHANGE_PROBE * dx[j];
+            cam_drive_me_states(d, x);
+            cam_drive_me_rates(d, x, dx);
+            for (j = 0; j < CAM_ME_NX; j++)
+                probe[j] = x[j] + CAM_EXCHANGE_PROBE * dx[j];
             have = 1;
         }
-        if (cam_event_value(&d->model, &d->mode, codes[k], probe, d->u) < 0.0)
+        if (event_value(d, codes[k], probe) < 0.0)
             return k;
     }
     return -1;
@@ -247,6 +259,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     *values_changed = 0;
     *needed = 0;
     fired->code = -1;
+    fired->note = NULL;
     fired->time = d->time;
     cam_exchange_sync(e);
     if (e->iterations >= CAM_EXCHANGE_MAX_ITERATIONS)
@@ -254,10 +267,17 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
                     "(theta = %g rad, omega = %g rad/s): the drive's mode cannot be decided there", d->time,
                     CAM_EXCHANGE_MAX_ITERATIONS, d->x[CAM_THETA], d->x[CAM_OMEGA]);
     e->iterations += 1;
-    memcpy(fired->x_before, d->x, sizeof d->x);
+    cam_drive_me_states(d, fired->x_before);
     n = indicators(d, e->target, z, codes);
     k = due(e, z, codes, n);
-    if (k >= 0) {   /* one transition, logged as the co-simulation integrator logs its own */
+    if (follower(d)) {   /* a lift-off, touch-down or halt, else the contact settled; its log line is the note */
+        int status = cam_vf_me_apply(d, k >= 0 ? codes[k] : 0, cam_instance_error(e->instance));
+        if (status != CAM_OK)
+            return status;
+        fired->code = k >= 0 ? codes[k] : -1;
+        fired->note = d->step_events;
+        e->broke_away |= k >= 0 && codes[k] == CAM_VF_BREAK_AWAY;
+    } else if (k >= 0) {   /* one transition, logged as the co-simulation integrator logs its own */
         CamEventRecord *record = &d->event_log[d->events_logged % CAM_EVENT_LOG];
         fired->code = codes[k];
         record->code = codes[k];
@@ -271,8 +291,8 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     } else {   /* at rest: stay stuck or start under the input now; the friction branch */
         cam_settle(m, &d->mode, d->x, d->u, 0);
     }
-    memcpy(fired->x_after, d->x, sizeof d->x);
-    for (k = 0; k < CAM_NX; k++)
+    cam_drive_me_states(d, fired->x_after);
+    for (k = 0; k < CAM_ME_NX; k++)
         if (fired->x_after[k] != fired->x_before[k])
             *values_changed = 1;
     d->stale = 1;

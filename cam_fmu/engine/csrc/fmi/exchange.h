@@ -1,12 +1,13 @@
-/* Model Exchange over the model contract (cam_model.h): the host's solver integrates x[CAM_NX] of the
+/* Model Exchange over the model contract (cam_model.h): the host's solver integrates x[CAM_ME_NX] of the
  * consistent formulation, the FMU gives derivatives, event indicators and the transitions at events.
  *
  * FMI-free, like cam_instance.h: an FMI 2.0 glue (fmi2.c) and an FMI 3.0 one call the same functions.
  * The layer works on the drive of a CamInstance (cam_instance_drive) and holds only what Model
  * Exchange adds to it: the breakpoint ahead, the energy bound's booking point, the event iteration.
  *
- * - States: x[CAM_NX] in cam_model.h's slots (with L = 0 the current slot is held at 0, derivative 0;
- *   a rigid shaft, k_shaft = 0, holds the twist and the motor's speed at 0 the same way).
+ * - States: x[CAM_ME_NX], cam_model.h's slots (with L = 0 the current slot is held at 0, derivative 0;
+ *   a rigid shaft, k_shaft = 0, holds the twist and the motor's speed at 0 the same way), then a free
+ *   follower's gap and its rate (cam_drive.h CAM_ME_GAP; held at 0 in contact and without one).
  * - Inputs are continuous: every evaluation uses the inputs the host set last.
  * - Event indicators, CAM_EXCHANGE_NZ of them: slots 0..CAM_MAX_EVENTS-1 hold the event functions of
  *   the mode (cam_event_codes' order; the break-away function also at rest with L = 0, where the input
@@ -47,9 +48,10 @@ typedef struct {
 
 /* A transition applied by an event update (code -1: none), for the host's log. */
 typedef struct {
-    int code;                   /* CAM_EV_* or -1 */
+    int code;                   /* CAM_EV_* (a follower of its own: voltage_follower.c's code) or -1 */
     double time;                /* s */
-    double x_before[CAM_NX], x_after[CAM_NX];
+    double x_before[CAM_ME_NX], x_after[CAM_ME_NX];
+    const char *note;           /* a follower of its own: its lift-off or touch-down line ("" or NULL: none) */
 } CamExchangeEvent;
 
 void cam_exchange_init(CamExchange *e, CamInstance *instance);
@@ -65,7 +67,7 @@ int cam_exchange_set_states(CamExchange *e, const double x[], size_t nx);
 int cam_exchange_get_states(CamExchange *e, double x[], size_t nx);
 int cam_exchange_derivatives(CamExchange *e, double dx[], size_t nx);
 int cam_exchange_indicators(CamExchange *e, double z[], size_t nz);
-/* 1 rad, 1 rad/s, 1 A: the states' scale (no drive needed). */
+/* 1 rad, 1 rad/s, 1 A, 1e-3 m, 1e-2 m/s: the states' scale (no drive needed). */
 int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx);
 
 void cam_exchange_enter_event_mode(CamExchange *e);

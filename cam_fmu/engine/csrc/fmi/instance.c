@@ -20,7 +20,7 @@ struct CamInstance {
     double start_time;                  /* s */
     int preview_valid;                  /* preview holds the outputs of params and inputs */
     double preview[CAM_N_OUTPUTS];      /* outputs before initialisation */
-    double preview_x[CAM_NX], preview_dx[CAM_NX];   /* the states and derivatives then */
+    double preview_x[CAM_ME_NX], preview_dx[CAM_ME_NX];   /* the states and derivatives then */
     CamError error;                     /* the last refusal, of this layer or of Model Exchange's */
 };
 
@@ -188,9 +188,8 @@ static const double *preview(CamInstance *d)
         return NULL;
     }
     memcpy(d->preview, cam_drive_outputs(&scratch), sizeof d->preview);
-    memcpy(d->preview_x, scratch.x, sizeof d->preview_x);
-    memset(d->preview_dx, 0, sizeof d->preview_dx);   /* a rigid drive's shaft slots are held */
-    cam_rhs(&scratch.model, &scratch.mode, scratch.x, scratch.form_u, d->preview_dx);
+    cam_drive_me_states(&scratch, d->preview_x);
+    cam_drive_me_rates(&scratch, d->preview_x, d->preview_dx);
     cam_drive_free(&scratch);
     d->preview_valid = 1;
     return d->preview;
@@ -207,7 +206,7 @@ static int state_value(CamInstance *d, unsigned vr, double *value)
     int derivative = vr >= (unsigned)CAM_VR_DERIVATIVES;
     int k = (int)(vr - (derivative ? CAM_VR_DERIVATIVES : CAM_VR_STATES));
     const char *name = derivative ? cam_derivative_spec(k)->name : cam_state_spec(k)->name;
-    double dx[CAM_NX] = {0.0, 0.0, 0.0, 0.0, 0.0};   /* a rigid drive's shaft slots are held */
+    double x[CAM_ME_NX], dx[CAM_ME_NX];
     if ((int)d->params.v[CAM_P_FORMULATION] != CAM_CHOICE_FORMULATION_CONSISTENT
         || (int)d->params.v[CAM_P_DRIVE] != CAM_CHOICE_DRIVE_VOLTAGE)
         return cam_error(&d->error, CAM_ERR_SIMULATION, "variable '%s' belongs to the consistent formulation under "
@@ -219,11 +218,12 @@ static int state_value(CamInstance *d, unsigned vr, double *value)
         *value = derivative ? d->preview_dx[k] : d->preview_x[k];
         return CAM_OK;
     }
+    cam_drive_me_states(&d->drive, x);
     if (!derivative) {
-        *value = d->drive.x[k];
+        *value = x[k];
         return CAM_OK;
     }
-    cam_rhs(&d->drive.model, &d->drive.mode, d->drive.x, d->drive.form_u, dx);
+    cam_drive_me_rates(&d->drive, x, dx);
     *value = dx[k];
     return CAM_OK;
 }

@@ -164,7 +164,9 @@ static int me_event_update(void *m, int *values_changed, int *needed, char *log,
     CamExchangeEvent fired;
     int status = cam_exchange_event_update(&((CamFmuModel *)m)->me, &fired, values_changed, needed);
     log[0] = '\0';
-    if (status == CAM_OK && fired.code >= 0)
+    if (status == CAM_OK && fired.note != NULL && fired.note[0] != '\0')
+        snprintf(log, log_len, "%s", fired.note);   /* a follower of its own, as co-simulation logs it */
+    else if (status == CAM_OK && fired.code >= 0 && fired.note == NULL)
         snprintf(log, log_len, "t = %.17g s: event '%s' at theta = %.17g rad, omega %.17g -> %.17g rad/s",
                  fired.time, cam_exchange_event_name(fired.code), fired.x_before[CAM_THETA],
                  fired.x_before[CAM_OMEGA], fired.x_after[CAM_OMEGA]);

@@ -57,6 +57,8 @@ typedef struct {
     double impacts;             /* touch-downs so far */
     double rebound;             /* s: shorter than the flight the last rebound starts (the scan's first step), or 0 */
     double fresh;               /* 1 until the first step: the start's contact follows the inputs set */
+    double left;                /* the voltage drive's follower: the flank it last left (+1, -1), its gap's origin */
+    double sigma;               /* and its direction in flight, sgn(v) held between events (0: held by friction) */
 } CamSpeedState;
 
 /* The follower as a body of its own in the speed drive (follower.c; docs/model.md section 13): its contact at the
@@ -119,6 +121,28 @@ typedef struct CamDrive {
     CamEventRecord event_log[CAM_EVENT_LOG];
 } CamDrive;
 
+/* Model Exchange's continuous state (physics/variables.py STATES): x[CAM_NX], then the voltage drive's free follower
+ * (closures 'form', 'spring'; docs/model.md 13.6) as its gap g = left (s - s_flank(theta)) [m] to the flank it left
+ * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
+ * follower's events, its transitions and the refusals of the modes Model Exchange does not run are
+ * voltage_follower_me.c's (cam_vf_me_*); exchange.c drives them. */
+enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
+       CAM_VF_BREAK_AWAY = 6 /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
+void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
+void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
+/* The derivatives at x under the input d->form_u (the drive's mode and contact). */
+void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX]);
+void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
+void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+/* The follower's event functions in this mode (their codes, how many) and one's value at x (> 0: nothing happens). */
+int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
+double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
+/* At the drive's state: the transition `code` (lift-off, touch-down with the impact law and the rebound guard, a halt
+ * in flight), or with code 0 the contact settled (lifted at once where the force pulls); its log line into
+ * d->step_events; the shaft's stop or break-away: stuck, or moving off (co-simulation's rule at rest). */
+int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
+
 /* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */
 int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err);
 /* Start the drive's clock at t0 [s] (finite, |t0| <= 1e15) instead of 0; only before its first step. */
@@ -140,8 +164,8 @@ enum { CAM_S_VERSION = 0, CAM_S_FORMULATION, CAM_S_TIME, CAM_S_U, CAM_S_OMEGA_RE
        CAM_S_H_NEXT, CAM_S_STEPS_TAKEN, CAM_S_X /* CAM_NX slots */, CAM_S_STUCK = CAM_S_X + CAM_NX, CAM_S_DIRECTION,
        CAM_S_CONTACT, CAM_S_S_FREE, CAM_S_SIDE, CAM_S_FORM_U, CAM_S_HAVE_BUDGET,
        CAM_S_WORK_IN, CAM_S_WORK_ABS, CAM_S_BUDGET_THETA, CAM_S_BUDGET_I, CAM_S_E_MECH0, CAM_S_E_MAG0,
-       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 8 slots */,
-       CAM_S_END = CAM_S_SPEED + 8 };
+       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 10 slots */,
+       CAM_S_END = CAM_S_SPEED + 10 };
 #define CAM_STATE_VERSION 2.0   /* 2: the compliant shaft's two slots in x */
 #define CAM_STATE_LEN 48          /* CAM_S_END rounded up: room for slots a later version adds */
 typedef char cam_state_len_covers_the_layout[CAM_S_END <= CAM_STATE_LEN ? 1 : -1];

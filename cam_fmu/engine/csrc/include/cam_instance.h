@@ -4,7 +4,7 @@
  *
  * Value references are those of the generated table (cam_params.h, generated from
  * cam_fmu/physics/parameters.py and variables.py): the inputs, then the outputs, then the
- * parameters, in table order, from 0; then the continuous states x[CAM_NX] and their derivatives
+ * parameters, in table order, from 0; then the continuous states x[CAM_ME_NX] and their derivatives
  * (Model Exchange's; read-only, of the consistent formulation).
  *
  * Every function that can refuse returns a CamStatus other than CAM_OK (CAM_ERR_REJECTED for a step
@@ -21,8 +21,9 @@
 
 typedef struct CamInstance CamInstance;
 
-/* physics/variables.py's STATES name every slot of cam_model.h's x[CAM_NX] (a compile error if not) */
-typedef char cam_states_name_every_slot[CAM_N_STATES == CAM_NX ? 1 : -1];
+/* physics/variables.py's STATES name every slot of Model Exchange's x[CAM_ME_NX] (cam_model.h's x[CAM_NX], then a
+ * free follower's gap and rate: cam_drive.h; a compile error if not) */
+typedef char cam_states_name_every_slot[CAM_N_STATES == CAM_ME_NX ? 1 : -1];
 #define CAM_VR_END (CAM_VR_DERIVATIVES + CAM_N_STATES)   /* one past the last value reference */
 
 /* The kind and name of value reference vr; 0 if vr is no variable. */

@@ -173,3 +173,40 @@ int cam_drive_run(CamDrive *d, long n_steps, const double *table, double *out, l
     }
     return CAM_OK;
 }
+
+/* ------------------------------------------------------------------ Model Exchange's state (cam_drive.h) */
+
+void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX])
+{
+    if (d->form == &cam_voltage_follower) {
+        cam_vf_me_states(d, x);
+        return;
+    }
+    memcpy(x, d->x, sizeof d->x);
+    x[CAM_ME_GAP] = x[CAM_ME_RATE] = 0.0;
+}
+
+void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
+{
+    if (d->form == &cam_voltage_follower) {
+        cam_vf_set_me_states(d, x);
+        return;
+    }
+    /* a rigid drive holds the shaft's slots at 0 (their derivatives are 0: a host's solver leaves them) */
+    memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
+    d->stale = 1;
+}
+
+void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
+{
+    int k;
+    if (d->form == &cam_voltage_follower) {
+        cam_vf_me_rates(d, x, dx);
+        return;
+    }
+    for (k = 0; k < CAM_ME_NX; k++)   /* the held slots */
+        dx[k] = 0.0;
+    cam_rhs(&d->model, &d->mode, x, d->form_u, dx);
+    for (k = d->model.slots; k < CAM_ME_NX; k++)
+        dx[k] = 0.0;
+}

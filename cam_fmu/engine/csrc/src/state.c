@@ -51,6 +51,8 @@ void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
     s[CAM_S_SPEED + 5] = d->speed.impacts;
     s[CAM_S_SPEED + 6] = d->speed.rebound;
     s[CAM_S_SPEED + 7] = d->speed.fresh;
+    s[CAM_S_SPEED + 8] = d->speed.left;
+    s[CAM_S_SPEED + 9] = d->speed.sigma;
 }
 
 static const char *const ENTRY[] = {"version", "formulation", "time", "u", "omega_ref", "omega_dot_ref", "h_next",
@@ -89,6 +91,8 @@ static void apply_state(CamDrive *d, const double s[CAM_STATE_LEN], const CamMod
     d->speed.impacts = s[CAM_S_SPEED + 5];
     d->speed.rebound = s[CAM_S_SPEED + 6];
     d->speed.fresh = s[CAM_S_SPEED + 7];
+    d->speed.left = s[CAM_S_SPEED + 8];
+    d->speed.sigma = s[CAM_S_SPEED + 9];
     d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
     if (d->have_budget) {
         const double *out = cam_drive_outputs(d);
@@ -128,6 +132,12 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
             return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
                              "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
                              ? " or -1 (on the groove's other flank)" : "");
+        if (d->form == &cam_voltage_follower && s[CAM_S_SPEED + 8] != 1.0 && s[CAM_S_SPEED + 8] != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %s: allowed +1%s",
+                             cam_num(s[CAM_S_SPEED + 8], a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
+        if (d->form == &cam_voltage_follower && !(s[CAM_S_SPEED + 9] == 0.0 || fabs(s[CAM_S_SPEED + 9]) == 1.0))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower direction in flight %s: allowed -1, 0, +1",
+                             cam_num(s[CAM_S_SPEED + 9], a));
     }
     if (m->formulation != CAM_FORM_CONSISTENT)
         return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */

@@ -21,9 +21,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cam_drive.h"
+#include "cam_voltage_follower.h"
 
-#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
 #define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
 #define STEP_ANGLE 1e-4         /* rad: cam angle of one Runge-Kutta step */
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
@@ -31,14 +30,7 @@
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
-#define NY 9
-#define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
-#define Y_ROTOR 6
-#define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
-#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
 
-/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK, EV_SIDE };
 
 static double sgn(double x)
 {
@@ -79,7 +71,7 @@ static double torque(const CamModel *m, const double y[NY], double u)
 }
 
 /* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
-static double friction0(const CamModel *m)
+double cam_vf_friction0(const CamModel *m)
 {
     return m->mu * (fabs(m->G_y) + m->N_g);
 }
@@ -90,7 +82,7 @@ static double closing(const CamModel *m, double s)
 }
 
 /* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
-static double clearance(const CamModel *m)
+double cam_vf_clearance(const CamModel *m)
 {
     return m->closure == CAM_CHOICE_CLOSURE_FORM ? m->c : 0.0;
 }
@@ -103,7 +95,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0] - contact * clearance(m));
+    F = closing(m, d[0] - contact * cam_vf_clearance(m));
     if (m->mu == 0.0) {
         *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
@@ -131,7 +123,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 {
     if (y[Y_DIR] == 0.0) {
         cam_profile_eval(&m->profile, y[0], d);
-        *P = closing(m, d[0] - contact * clearance(m));
+        *P = closing(m, d[0] - contact * cam_vf_clearance(m));
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -174,21 +166,21 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
 static double free_acceleration(const CamModel *m, double s, double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * friction0(m)) / m->m;
+    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * cam_vf_friction0(m)) / m->m;
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
  * the guide's static friction (0: held). */
-static double flight_direction(const CamModel *m, const double y[NY])
+double cam_vf_flight_direction(const CamModel *m, const double y[NY])
 {
     double net;
     if (y[4] != 0.0)
         return sgn(y[4]);
     net = -closing(m, y[3]);
-    return fabs(net) > friction0(m) ? sgn(net) : 0.0;
+    return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
 }
 
-static void rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -218,7 +210,7 @@ static void set_on_flank(const CamModel *m, double y[NY], int contact)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - contact * clearance(m);
+    y[3] = d[0] - contact * cam_vf_clearance(m);
     y[4] = d[1] * y[1];
 }
 
@@ -227,16 +219,16 @@ static void rk4(const CamModel *m, double u, int contact, const double y[NY], do
 {
     double k1[NY], k2[NY], k3[NY], k4[NY], t[NY];
     int j;
-    rates(m, u, contact, y, k1);
+    cam_vf_rates(m, u, contact, y, k1);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + 0.5 * h * k1[j];
-    rates(m, u, contact, t, k2);
+    cam_vf_rates(m, u, contact, t, k2);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + 0.5 * h * k2[j];
-    rates(m, u, contact, t, k3);
+    cam_vf_rates(m, u, contact, t, k3);
     for (j = 0; j < NY; j++)
         t[j] = y[j] + h * k3[j];
-    rates(m, u, contact, t, k4);
+    cam_vf_rates(m, u, contact, t, k4);
     for (j = 0; j < NY; j++)
         out[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
     if (contact)
@@ -244,7 +236,7 @@ static void rk4(const CamModel *m, double u, int contact, const double y[NY], do
 }
 
 /* The event function `code` at y on or off the flank `contact` (> 0: nothing happens). */
-static double event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
+double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
 {
     double d[4], omega_dot, P;
     if (code == EV_STOP)
@@ -258,7 +250,7 @@ static double event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - clearance(m)) + TOUCH : (d[0] + clearance(m)) - y[3] + TOUCH;
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + TOUCH;
 }
 
 /* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
@@ -269,7 +261,7 @@ static double event_at(const CamModel *m, double u, int code, int contact, const
         return at[0] - y[0];
     if (code == EV_SIDE)
         return at[1] * side_force(m, y, u, contact) + CAM_SIDE_HYSTERESIS;
-    return event_value(m, u, code, contact, y);
+    return cam_vf_event_value(m, u, code, contact, y);
 }
 
 static int crossed(double before, double after)
@@ -298,7 +290,7 @@ static double acceleration_scale(const CamModel *m, const double y[NY], double u
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return fabs(closing(m, d[0]) / m->m) + friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+    return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -326,7 +318,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     double d[4], before[NY], w, omega_dot, P, scale = acceleration_scale(m, y, u);
     memcpy(before, y, sizeof before);
     cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - flank * clearance(m);
+    y[3] = d[0] - flank * cam_vf_clearance(m);
     impact(m, y, d[1], m->restitution);
     unstick(y);
     w = y[4] - d[1] * y[1];
@@ -335,7 +327,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
         return 0;
     }
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0] - flank * clearance(m);
+    y[3] = d[0] - flank * cam_vf_clearance(m);
     impact(m, y, d[1], 0.0);
     unstick(y);
     y[4] = d[1] * y[1];
@@ -343,7 +335,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     return flank * P >= 0.0 ? flank : 0;
 }
 
-static void load_y(const CamDrive *d, double y[NY])
+void cam_vf_load_y(const CamDrive *d, double y[NY])
 {
     y[0] = d->x[CAM_THETA];
     y[1] = d->x[CAM_OMEGA];
@@ -352,11 +344,11 @@ static void load_y(const CamDrive *d, double y[NY])
     y[4] = d->speed.v;
     y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
     y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
-    y[Y_SIGMA] = flight_direction(&d->model, y);
+    y[Y_SIGMA] = cam_vf_flight_direction(&d->model, y);
     y[Y_DIR] = d->mode.stuck ? 0.0 : d->mode.direction;
 }
 
-static void store_y(CamDrive *d, const double y[NY])
+void cam_vf_store_y(CamDrive *d, const double y[NY])
 {
     d->x[CAM_THETA] = y[0];
     d->x[CAM_OMEGA] = y[1];
@@ -386,20 +378,60 @@ static int settle(const CamModel *m, double y[NY], double u, int contact)
     return contact * P >= 0.0 ? contact : 0;
 }
 
+/* settle, and *left the flank the follower lets go of where it does. */
+int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
+{
+    int after = settle(m, y, u, contact);
+    if (contact && !after)
+        *left = contact;
+    return after;
+}
+
+/* The lift-off or touch-down `code` from the contact `contact` at y at time [s] (a touch-down: the impact and the
+ * rebound guard of land, *rebound its guard), for co-simulation's step and Model Exchange's event update alike: the
+ * contact after, *left the flank the follower leaves (its gap's origin in Model Exchange); its line appended to
+ * d->step_events. */
+int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
+                      int *left, long *dropped)
+{
+    const CamModel *m = &d->model;
+    double dd[4], w_before, w_after;
+    int flank = code == EV_TOUCH_UP ? 1 : -1;
+    if (code == EV_LIFT_OFF) {
+        set_on_flank(m, y, contact);
+        cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: lift-off from flank %+d at "
+                          "t = %.9g s (theta = %.6g rad); ", contact, time, y[0]);
+        *left = contact;
+        return 0;
+    }
+    cam_profile_eval(&m->profile, y[0], dd);
+    w_before = y[4] - dd[1] * y[1];
+    *rebound = 0.0;
+    contact = land(m, y, u, flank, rebound);
+    w_after = y[4] - dd[1] * y[1];
+    d->speed.impacts += 1.0;
+    if (!contact)
+        *left = flank;
+    cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: touch-down on flank %+d at "
+                      "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank, time, y[0],
+                      w_before, w_after);
+    return contact;
+}
+
 /* At rest (omega = 0: the start, a new input, a stop, a located break-away): the shaft stays stuck, the follower at
  * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
  * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
  * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
-static void at_rest(const CamModel *m, double y[NY], double u, int *contact, int at_threshold)
+void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
 {
     double dir, margin;
     y[1] = 0.0;
     y[Y_DIR] = 0.0;
-    *contact = settle(m, y, u, *contact);
+    *contact = cam_vf_settle_from(m, y, u, *contact, left);
     margin = breakaway(m, y, u, *contact, &dir);
     if (margin > 0.0 || at_threshold) {
         y[Y_DIR] = dir;
-        *contact = settle(m, y, u, *contact);
+        *contact = cam_vf_settle_from(m, y, u, *contact, left);
     }
 }
 
@@ -407,7 +439,7 @@ static int vf_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
     double y[NY], other[NY];
-    int contact;
+    int contact, left = 1;
     (void)err;
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
     d->mode.contact = 1;   /* the kinematic backlash's mode is not this follower's (d->speed.contact is): held engaged */
@@ -415,7 +447,7 @@ static int vf_init(CamDrive *d, CamError *err)
     d->form_u = d->u;
     memset(&d->speed, 0, sizeof d->speed);
     d->speed.contact = 1.0;
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     contact = settle(&d->model, y, d->u, 1);
     if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
         memcpy(other, y, sizeof other);
@@ -423,9 +455,11 @@ static int vf_init(CamDrive *d, CamError *err)
             memcpy(y, other, sizeof other);
     }
     if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-        at_rest(&d->model, y, d->u, &contact, 0);
+        cam_vf_at_rest(&d->model, y, d->u, &contact, &left, 0);
     d->speed.contact = contact;
-    store_y(d, y);
+    d->speed.left = contact != 0 ? contact : left;   /* in flight from the start: it was set on flank +1 */
+    d->speed.sigma = cam_vf_flight_direction(&d->model, y);
+    cam_vf_store_y(d, y);
     return CAM_OK;
 }
 
@@ -446,13 +480,13 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     double ws = m->compliant ? sqrt(m->k_shaft * (1.0 / m->J_m + 1.0 / m->J_0)) + m->d_shaft * (1.0 / m->J_m
                                                                                                   + 1.0 / m->J_0)
                 : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
-    int contact = (int)d->speed.contact, events = 0;
+    int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
     long dropped = 0, taken = 0;
     d->step_events[0] = '\0';
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
-        at_rest(m, y, u, &contact, 0);
-    if (contact && !(contact = settle(m, y, u, contact)))
+        cam_vf_at_rest(m, y, u, &contact, &left, 0);
+    if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     while (tau < h) {
@@ -462,14 +496,14 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
         if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {   /* from rest: STEP_ANGLE at the acceleration */
             double rate[NY];
-            rates(m, u, contact, y, rate);
+            cam_vf_rates(m, u, contact, y, rate);
             if (rate[1] != 0.0)
                 dt = fmin(dt, sqrt(2.0 * STEP_ANGLE / fabs(rate[1])));
         }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
-        if (!contact && y[Y_DIR] == 0.0 && clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
-            double c = clearance(m), A = acceleration_scale(m, y, u);
+        if (!contact && y[Y_DIR] == 0.0 && cam_vf_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
+            double c = cam_vf_clearance(m), A = acceleration_scale(m, y, u);
             dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
             if (y[4] != 0.0)
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
@@ -479,7 +513,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
-            y[Y_SIGMA] = flight_direction(m, y);
+            y[Y_SIGMA] = cam_vf_flight_direction(m, y);
         if (rebound > 0.0)
             dt = fmin(dt, rebound);   /* a bounce lasts about 4 rebound: the first step cannot hold it */
         if (++taken > MAX_STEPS)
@@ -495,7 +529,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
-            if (y[Y_SIGMA] != 0.0 && friction0(m) > 0.0)
+            if (y[Y_SIGMA] != 0.0 && cam_vf_friction0(m) > 0.0)
                 codes[n++] = EV_HALT;
         }
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
@@ -528,7 +562,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (code == EV_SIDE)
             continue;
         if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
-            if (contact && !(contact = settle(m, y, u, contact)))
+            if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
                 cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                                   "(theta = %.6g rad); ", time + tau, y[0]);
             continue;
@@ -538,7 +572,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
         if (code == EV_STOP || code == EV_BREAK_AWAY) {
             int was = contact;
-            at_rest(m, y, u, &contact, code == EV_BREAK_AWAY);
+            cam_vf_at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
             cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
                               "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
                               time + tau, y[0]);
@@ -547,31 +581,18 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                                   "%+d at t = %.9g s (theta = %.6g rad); ", was, time + tau, y[0]);
         } else if (code == EV_HALT) {
             y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
-        } else if (code == EV_LIFT_OFF) {
-            set_on_flank(m, y, contact);
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank %+d at "
-                              "t = %.9g s (theta = %.6g rad); ", contact, time + tau, y[0]);
-            contact = 0;
         } else {
-            double dd[4], w_before, w_after;
-            int flank = code == EV_TOUCH_UP ? 1 : -1;
-            cam_profile_eval(&m->profile, y[0], dd);
-            w_before = y[4] - dd[1] * y[1];
-            rebound = 0.0;
-            contact = land(m, y, u, flank, &rebound);
-            w_after = y[4] - dd[1] * y[1];
-            d->speed.impacts += 1.0;
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: touch-down on flank %+d at "
-                              "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank,
-                              time + tau, y[0], w_before, w_after);
+            contact = cam_vf_transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
         }
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more", dropped);
-    store_y(d, y);
+    cam_vf_store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
+    d->speed.left = left;
+    d->speed.sigma = cam_vf_flight_direction(m, y);   /* Model Exchange's (co-simulation decides it at each step) */
     *steps = taken;
     return CAM_OK;
 }
@@ -582,7 +603,7 @@ static void vf_outputs(CamDrive *d, double out[])
     const CamModel *m = &d->model;
     double y[NY], dd[4], omega_dot, P, i;
     CamLoad load;
-    load_y(d, y);
+    cam_vf_load_y(d, y);
     cam_profile_eval(&m->profile, y[0], dd);
     i = current(m, y, d->form_u);
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
@@ -599,7 +620,7 @@ static void vf_outputs(CamDrive *d, double out[])
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
-        y[3] = dd[0] - contact * clearance(m);
+        y[3] = dd[0] - contact * cam_vf_clearance(m);
     } else {
         load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;

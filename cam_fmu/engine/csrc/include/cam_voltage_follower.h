@@ -1,0 +1,42 @@
+/* The voltage drive's follower of its own (docs/model.md 13.6): what voltage_follower.c (its equations and
+ * co-simulation's step) shares with voltage_follower_me.c (Model Exchange's entry points, cam_drive.h cam_vf_me_*).
+ * Internal to the engine, not for bindings. y = (theta, omega, i, s, v, phi, omega_m, sigma, dir): see
+ * voltage_follower.c. */
+#ifndef CAM_VOLTAGE_FOLLOWER_H
+#define CAM_VOLTAGE_FOLLOWER_H
+
+#include "cam_drive.h"
+
+#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
+#define NY 9
+#define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
+#define Y_ROTOR 6
+#define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
+#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
+
+/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
+enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK, EV_SIDE };
+
+/* m: a groove's clearance (closure 'form'), 0 for a spring's one flank. */
+double cam_vf_clearance(const CamModel *m);
+/* N: the guide's friction at no contact force. */
+double cam_vf_friction0(const CamModel *m);
+/* The flying follower's direction sgn(v), or at a halt where the net force pushes it (0: held by friction). */
+double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
+/* The rates of y on the flank `contact` (0: in flight) under the input u [V]. */
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY]);
+/* The event function `code` at y (> 0: nothing happens). */
+double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY]);
+/* y from the drive's state, and back (the follower's s, v in d->speed, the shaft's mode in d->mode). */
+void cam_vf_load_y(const CamDrive *d, double y[NY]);
+void cam_vf_store_y(CamDrive *d, const double y[NY]);
+/* On the flank `contact`: the follower set on it, or let go where the flank would pull (*left: the flank it lets
+ * go of); the contact after. */
+int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left);
+/* A lift-off or touch-down `code` from `contact` at y at time [s]: the contact after (see voltage_follower.c). */
+int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
+                      int *left, long *dropped);
+/* At rest (omega = 0): stuck, or moving off where it accelerates (at once at a located break-away). */
+void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold);
+
+#endif
