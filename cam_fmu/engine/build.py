@@ -32,7 +32,7 @@ import tempfile
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from . import codegen, targets
+from . import codegen, reproducible, targets
 from .targets import Target
 
 HERE = Path(__file__).resolve().parent
@@ -138,12 +138,15 @@ def compile_shared(dest: Path, sources: Sequence[Path], include: Sequence[Path] 
     dest = Path(dest).resolve()
     dest.parent.mkdir(parents=True, exist_ok=True)
     # a private folder beside dest: zig writes an import library and a .pdb beside a .dll; the move is atomic
-    # (a concurrent loader never sees half a library)
+    # (a concurrent loader never sees half a library). Reproducible (reproducible.py): the output is named
+    # relative to it (a macOS library records its path as its install name) and every folder is mapped away.
     with tempfile.TemporaryDirectory(prefix=f".{dest.name}.", dir=dest.parent) as tmp:
         out = Path(tmp) / dest.name
-        cmd = [*head, *CFLAGS, *extra_flags, *(f"-I{Path(p).resolve()}" for p in include),  # absolute: cwd is tmp
+        folders = [Path(tmp), *include, *(Path(p).parent for p in sources)]
+        cmd = [*head, *CFLAGS, *extra_flags, *reproducible.prefix_map_flags(folders),
+               *(f"-I{Path(p).resolve()}" for p in include),  # absolute: cwd is tmp
                *(f"-D{k}={v}" for k, v in (defines or {}).items()), *(str(Path(p).resolve()) for p in sources),
-               "-o", str(out), *LDFLAGS]
+               "-o", out.name, *LDFLAGS]
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp)
         if proc.returncode != 0:
             raise EngineBuildError(f"compiling {dest.name} failed ({' '.join(cmd)}):\n{proc.stderr.strip()}")

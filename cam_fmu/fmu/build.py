@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Callable, List, Sequence
 from xml.etree import ElementTree as ET
 
-from ..engine import targets
+from ..engine import reproducible, targets
 from . import binaries, engine_fmu, ssp
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
@@ -192,7 +192,7 @@ def build_wheels(folder: Path, names: Sequence[str] | None = None) -> list[Path]
         row = targets.get(name)
         proc = subprocess.run([sys.executable, "-m", "pip", "wheel", ".", "--no-deps", "--no-build-isolation", "-q",
                                "-w", str(folder)], cwd=PACKAGE_DIR.parent, capture_output=True, text=True,
-                              env={**os.environ, "CAM_FMU_ENGINE_TARGET": name}, timeout=1800)
+                              env={**reproducible.build_env(), "CAM_FMU_ENGINE_TARGET": name}, timeout=1800)
         wheels = sorted(folder.glob(f"cam_fmu-*-py3-none-{row.wheel}.whl"))
         if proc.returncode != 0 or not wheels:
             raise BuildError(f"the {name} wheel: pip wheel failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import build as engine_build
-from ..engine import codegen, targets
+from ..engine import codegen, reproducible, targets
 from . import binaries, macho, model_description, model_description3, pi_codegen, scene_data
 
 PACKAGE_DIR = engine_build.HERE.parent  # cam_fmu/
@@ -222,11 +222,7 @@ def build(dest: Path, fmi_version: int = 2, platforms: Sequence[str] | None = No
         if fmi_version == 3:
             (folder / "buildDescription.xml").write_bytes(binaries.build_description(m.identifier, files))
         (root / "fmu" / "modelDescription.xml").write_bytes(model_description_xml(m, guid, fmi_version, files))
-        out = root / f"{m.identifier}.fmu"
-        with zipfile.ZipFile(out, "w", compression=zipfile.ZIP_DEFLATED) as z:
-            for path in sorted((root / "fmu").rglob("*")):
-                if path.is_file():
-                    z.write(path, path.relative_to(root / "fmu").as_posix())
+        out = reproducible.write_zip(root / f"{m.identifier}.fmu", reproducible.tree_entries(root / "fmu"))
         dest.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(out, dest)
     return dest

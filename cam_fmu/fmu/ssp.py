@@ -41,6 +41,7 @@ from typing import Any, Mapping, Sequence
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
+from ..engine import reproducible
 from . import scene_data
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -200,13 +201,10 @@ def write_ssp(system: System, fmus: Mapping[str, str | Path], dest: str | Path) 
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.with_name(dest.name + ".tmp")
     defaults = {comp.name: fmu_defaults(fmus[comp.name]) for comp in system.components.values()}
-    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", system_xml(without_defaults(system, defaults)))
-        written: set[str] = set()
-        for comp in system.components.values():
-            if comp.source not in written:
-                z.write(fmus[comp.name], comp.source)
-                written.add(comp.source)
+    entries: dict[str, bytes | Path] = {"SystemStructure.ssd": system_xml(without_defaults(system, defaults))}
+    for comp in system.components.values():
+        entries.setdefault(comp.source, Path(fmus[comp.name]))
+    reproducible.write_zip(tmp, entries)  # sorted, the build's time: two builds give the same bytes
     tmp.replace(dest)
     return dest
 
