@@ -19,6 +19,12 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+# The environment pytest runs in comes first on PATH: `.venv/bin/python -m pytest` from a shell whose PATH
+# lacks .venv/bin still runs that environment's console scripts (cam-fmu, fmpy), here and in every child.
+# sys.executable unresolved: a venv's python is a symlink out of its bin folder.
+_ENV_BIN = Path(sys.executable).parent
+if (_ENV_BIN / "cam-fmu").is_file() and os.environ.get("PATH", "").split(os.pathsep)[0] != str(_ENV_BIN):
+    os.environ["PATH"] = os.pathsep.join([str(_ENV_BIN), os.environ.get("PATH", "")])
 # the shared helpers, and the layers' modules that others import (a test of one layer may reuse another's
 # closed forms or hosts), whichever folders a session collects
 for _folder in (Path(__file__).resolve().parent, *sorted(p for p in Path(__file__).resolve().parent.iterdir()
