@@ -113,3 +113,25 @@ def test_an_older_python3_is_refused(tmp_path):
     assert run.returncode != 0, run.stdout[-2000:]
     assert "Python 3.9" in run.stderr and "3.10 or newer" in run.stderr, run.stderr
     assert not (checkout / ".venv").exists()
+
+
+def test_a_python3_without_venv_gets_python3_venv_from_apt(tmp_path):
+    """Debian's python3 without python3-venv: `python3 -m venv` fails, setup.sh installs python3-venv with apt
+    and tries again. Here both are stand-ins (first on PATH): a python3 whose venv always fails and an apt-get
+    that records its arguments, so setup.sh ends with its error after the one apt call and leaves no .venv."""
+    if not SYSTEM_PYTHON.is_file():
+        pytest.fail(f"{SYSTEM_PYTHON} is missing: this test needs the system's python3")
+    shim, log = tmp_path / "bin", tmp_path / "apt.log"
+    shim.mkdir()
+    (shim / "python3").write_text('#!/bin/sh\nif [ "$1" = -m ] && [ "$2" = venv ]; then\n'
+                                  '  echo "ensurepip is not available" >&2; exit 1\nfi\n'
+                                  f'exec {SYSTEM_PYTHON} "$@"\n')
+    (shim / "apt-get").write_text(f'#!/bin/sh\necho "$@" >> {log}\n')
+    for tool in ("python3", "apt-get"):
+        (shim / tool).chmod(0o755)
+    checkout = _clone(tmp_path / "cam_fmu")
+    run = _setup(checkout, f"{shim}:{SYSTEM_PATH}")
+    assert run.returncode != 0, run.stdout[-2000:]
+    assert log.read_text().splitlines() == ["update", "install -y python3-venv"], log.read_text()
+    assert "failed even with python3-venv installed" in run.stderr, run.stderr
+    assert not (checkout / ".venv").exists()
