@@ -76,10 +76,8 @@ def entries(folder: Path) -> list[Path]:
     return sorted(p for p in folder.iterdir() if not p.name.startswith((".", "_")) and p.name != LEGACY_SPEC)
 
 
-def parts(folder: str | Path, cases: int | None = None) -> list[tuple[int, int, Path]]:
-    """(first case, end, file) of every finished batch, in case order; SweepError for a file that is not a part,
-    a part beyond ``cases`` and parts that hold a case twice (naming the files and the cases)."""
-    folder = Path(folder)
+def _listing(folder: Path) -> list[tuple[int, int, Path]]:
+    """(first, end, file) of every part by its name, in case order; SweepError for a file that is not a part."""
     found = []
     for path in entries(folder):
         match = PART.fullmatch(path.name)
@@ -87,15 +85,31 @@ def parts(folder: str | Path, cases: int | None = None) -> list[tuple[int, int, 
             raise SweepError(f"{folder} holds {path.name}, not a part file (part-<first>-<end>.parquet, first < "
                              "end): a sweep's folder holds its part files only; move it away")
         found.append((int(match[1]), int(match[2]), path))
-    found.sort()
-    if cases is not None and found and found[-1][1] > cases:
+    return sorted(found)
+
+
+def _check_range(found: Sequence[tuple[int, int, Path]], cases: int | None) -> None:
+    if cases is not None and found:
         first, end, path = max(found, key=lambda p: p[1])
-        raise SweepError(f"{path} holds cases {first + 1} to {end}, beyond this sweep's {cases}: not a part of it")
+        if end > cases:
+            raise SweepError(f"{path} holds cases {first + 1} to {end}, beyond this sweep's {cases}: not a part of it")
+
+
+def _check_disjoint(folder: Path, found: Sequence[tuple[int, int, Path]]) -> None:
     for (f1, e1, p1), (f2, e2, p2) in zip(found, found[1:]):
         if f2 < e1:
             raise SweepError(f"{folder} holds cases {f2 + 1} to {min(e1, e2)} twice, in {p1.name} and {p2.name}: "
                              "--resume removes a part whose rows another holds with the same bits; otherwise "
                              "remove one of them")
+
+
+def parts(folder: str | Path, cases: int | None = None) -> list[tuple[int, int, Path]]:
+    """(first case, end, file) of every finished batch, in case order; SweepError for a file that is not a part,
+    a part beyond ``cases`` and parts that hold a case twice (naming the files and the cases)."""
+    folder = Path(folder)
+    found = _listing(folder)
+    _check_range(found, cases)
+    _check_disjoint(folder, found)
     return found
 
 
@@ -133,20 +147,14 @@ def _same_bits(a, b) -> bool:
 
 def repair(folder: str | Path, cases: int) -> tuple[list[tuple[int, int, Path]], list[str]]:
     """The parts after removing each one whose every row a larger part holds with the same bits, and a line per
-    file removed; SweepError for a part whose name and rows disagree, and for any other overlap (parts that
-    cross, or that disagree on a case): which copy is right is then unknown, so nothing is removed."""
+    file removed; SweepError, with nothing removed, for a file that is not a part, a part beyond ``cases`` or
+    whose rows are not the cases its name says, and any other overlap (parts that cross, or that disagree on a
+    case: which copy is right is then unknown)."""
     import pyarrow.parquet as pq
 
     folder = Path(folder)
-    try:
-        return parts(folder, cases), []
-    except SweepError:
-        pass
-    found = []
-    for path in entries(folder):
-        match = PART.fullmatch(path.name)
-        if match and path.is_file() and int(match[1]) < int(match[2]):
-            found.append((int(match[1]), int(match[2]), path))
+    found = _listing(folder)
+    _check_range(found, cases)
     found.sort(key=lambda p: (p[0], -p[1]))  # a larger part before the ones it holds
     kept: list[tuple[int, int, Path]] = []
     redundant, notes = [], []
@@ -155,7 +163,6 @@ def repair(folder: str | Path, cases: int) -> tuple[list[tuple[int, int, Path]],
             f0, e0, p0 = kept[-1]
             mine, theirs = pq.read_table(path), pq.read_table(p0)
             _check_cases(mine, first, end, path)
-            _check_cases(theirs, f0, e0, p0)
             if not _same_bits(mine, theirs.slice(first - f0, end - first)):
                 raise SweepError(f"{folder} holds cases {first + 1} to {end} twice, in {p0.name} and {path.name}, "
                                  "with different values: which is right is unknown; remove the wrong one (or "
@@ -164,9 +171,12 @@ def repair(folder: str | Path, cases: int) -> tuple[list[tuple[int, int, Path]],
             notes.append(f"removed {path.name}: its cases {first + 1} to {end} are in {p0.name} with the same bits")
         else:
             kept.append((first, end, path))
+    _check_disjoint(folder, kept)
+    for first, end, path in kept:
+        _check_cases(pq.read_table(path, columns=["case"]), first, end, path)
     for path in redundant:
         path.unlink()
-    return parts(folder, cases), notes  # what is left must be disjoint, or it is refused
+    return kept, notes
 
 
 # ------------------------------------------------------------------ reading and writing

@@ -207,7 +207,8 @@ def _bump(table):
                             pa.array(values, pa.float64()))
 
 
-@pytest.mark.parametrize("kind", ["different bits", "crossing", "beyond the cases", "renamed", "not a part"])
+@pytest.mark.parametrize("kind", ["different bits", "crossing", "beyond the cases", "renamed", "swapped",
+                                  "not a part"])
 def test_overlapping_or_foreign_files_are_refused_and_nothing_is_removed(small, tmp_path, kind):
     """A copy that differs in one bit, a part crossing two others, a part past the case count, a part whose rows
     are not the cases its name says, and a file that is no part: --resume refuses on one line (exit 2), names the
@@ -227,6 +228,11 @@ def test_overlapping_or_foreign_files_are_refused_and_nothing_is_removed(small, 
     elif kind == "renamed":  # cases 9..12 under the name of 5..6, which part 4-8 holds
         (folder / "part-0000000008-0000000012.parquet").rename(folder / "part-0000000004-0000000006.parquet")
         words = "part-0000000004-0000000006.parquet is named for cases 5 to 6 but holds 4 rows of cases 9 to 12"
+    elif kind == "swapped":  # two parts' names exchanged: no overlap by name, but not the cases they say
+        (folder / "part-0000000000-0000000004.parquet").rename(folder / "x")
+        (folder / "part-0000000008-0000000012.parquet").rename(folder / "part-0000000000-0000000004.parquet")
+        (folder / "x").rename(folder / "part-0000000008-0000000012.parquet")
+        words = "part-0000000000-0000000004.parquet is named for cases 1 to 4 but holds 4 rows of cases 9 to 12"
     else:
         (folder / "notes.txt").write_text("mine\n")
         words = "holds notes.txt, not a part file"
