@@ -1,6 +1,6 @@
 """Parameter sweeps of a scene: one case on the C engine or an FMU, its metrics, the tables.
 
-The cases: sweep_cases.py; running them in batches, streamed to Parquet: sweep_run.py.
+The cases: sweep_cases.py; running them in batches, streamed to Parquet: sweep_run.py; the files: sweep_store.py.
 
 A case runs on the C engine in this process (``engine``: a new DriveSimulator from the scene's start values,
 its input table in one ``run`` call: the communication steps fmpy takes on cam.fmu, ``fmpy_schedule``) or on
