@@ -6,8 +6,9 @@ Runs the scene's primary run once per case (a full grid of the --vary values, a 
 Saltelli design for Sobol indices) on the C engine in-process (default) or an FMU through fmpy, in batches on
 dask.distributed (by default a local cluster with one worker process per core; --scheduler ADDRESS uses a
 running cluster; --serial runs in this process). Each finished batch is written at once to
-DIR/<scene>_sweep.parquet/ (one file per batch; --resume continues a sweep from what is there). Sweeps of at
-most CSV_MAX_CASES cases also get DIR/<scene>_sweep.csv (unit headers, case order) and DIR/<scene>_sweep.png;
+DIR/<scene>_sweep.parquet/ (one file per batch, the specification beside it in DIR/<scene>_sweep.json;
+--resume continues a sweep from what is there; one sweep writes a folder at a time). Sweeps of at
+most CSV_MAX_CASES cases also get DIR/<scene>_sweep.csv (column case, unit headers, case order) and DIR/<scene>_sweep.png;
 --sensitivity adds DIR/<scene>_sensitivity.csv, a table on stdout and DIR/<scene>_sensitivity.png.
 
 Every case is checked before any runs, as `simulate` checks a scene (exit 2 on the first bad one; above
@@ -77,7 +78,9 @@ def run(args) -> int:
     from ..experiments.progress import ProgressBar
     from ..experiments.scenes import find_scene
     from ..experiments.sweep import Design, SweepError, check_design, check_metrics, parse_sample, parse_vary
-    from ..experiments.sweep_run import Plan, failed_on_disk, iter_rows, run_sweep
+    from ..experiments.sweep_lock import hold
+    from ..experiments.sweep_run import Plan, run_sweep
+    from ..experiments.sweep_store import dataset_path, failed_on_disk, iter_rows, lock_path
 
     scene = find_scene(args.scene)  # checked here: a bad scene fails before any worker starts
     if args.stop_time is not None:
@@ -117,53 +120,53 @@ def run(args) -> int:
         bar.start = time.monotonic()  # the rate and the time left from here: the cluster is up
         bar(n_cases - to_run, n_cases, 0)
 
-    summary = run_sweep(plan, out, args.workers, args.scheduler, args.serial, args.resume, args.overwrite,
-                        args.batch_size, progress=bar, started=started)
-    bar.close()
-    from ..experiments.sweep_run import dataset_path
-
     folder = dataset_path(out, scene.name)
-    names = [v.name for v in varies]
-    small = n_cases <= CSV_MAX_CASES
-    table = None
-    if small:
-        from ..experiments.sweep import write_table
+    with hold(lock_path(folder), folder):  # one writer, from the first check of the folder to its last read
+        summary = run_sweep(plan, out, args.workers, args.scheduler, args.serial, args.resume, args.overwrite,
+                            args.batch_size, progress=bar, started=started,
+                            notes=lambda line: print(f"# {scene.name}: {line}", file=sys.stderr), locked=True)
+        bar.close()
+        names = [v.name for v in varies]
+        small = n_cases <= CSV_MAX_CASES
+        table = None
+        if small:
+            from ..experiments.sweep import write_table
 
-        rows = list(iter_rows(folder))
-        table = write_table(rows, names, metrics, out / f"{scene.name}_sweep.csv")
-    if summary.interrupted:
-        print(f"cam-fmu sweep: interrupted: {summary.done} of {n_cases} cases finished, kept in {table or folder}",
-              file=sys.stderr)
-        return 130
-    print(folder)
-    if table:
-        print(table)
-        if not args.no_plot:
-            from ..experiments.sweep import plot_table
+            rows = list(iter_rows(folder))
+            table = write_table(rows, names, metrics, out / f"{scene.name}_sweep.csv")
+        if summary.interrupted:
+            print(f"cam-fmu sweep: interrupted: {summary.done} of {n_cases} cases finished, kept in "
+                  f"{table or folder}", file=sys.stderr)
+            return 130
+        print(folder)
+        if table:
+            print(table)
+            if not args.no_plot:
+                from ..experiments.sweep import plot_table
 
-            print(plot_table(rows, varies, metrics, out / f"{scene.name}_sweep.png",
-                             title=f"{scene.name}: sweep of {', '.join(names)} ({engine})"))
-    if args.sensitivity is not None:
-        from ..experiments.sensitivity import report
+                print(plot_table(rows, varies, metrics, out / f"{scene.name}_sweep.png",
+                                 title=f"{scene.name}: sweep of {', '.join(names)} ({engine})"))
+        if args.sensitivity is not None:
+            from ..experiments.sensitivity import report
 
-        report(plan, folder, out, plot=not args.no_plot)
-    rate = summary.ran / summary.seconds if summary.seconds > 0 else 0.0
-    print(f"# {scene.name}: {summary.ran} cases in {summary.seconds:.1f} s ({rate:,.0f} cases/s, "
-          f"{summary.workers} worker{'s' * (summary.workers != 1)}), {summary.failed} failed; "
-          f"{summary.done} of {n_cases} on disk", file=sys.stderr)
-    failures = failed_on_disk(folder) if summary.failed or args.resume else 0
-    if failures:
-        shown = 0
-        for row in iter_rows(folder, ["case", *names, "status", "message"]):
-            if row["status"] != "failed":
-                continue
-            if shown == NAMED_FAILURES:
-                print(f"# ... and more (status 'failed' in {folder})", file=sys.stderr)
-                break
-            values = ", ".join(f"{v}={row[v]}" for v in names)
-            print(f"# case {row['case']} ({values}) failed: {row['message']}", file=sys.stderr)
-            shown += 1
-        print(f"cam-fmu sweep: {failures} of {n_cases} cases failed (rows kept, status 'failed')",
-              file=sys.stderr)
-        return 1
-    return 0
+            report(plan, folder, out, plot=not args.no_plot)
+        failures = failed_on_disk(folder) if summary.failed or args.resume else 0
+        rate = summary.ran / summary.seconds if summary.seconds > 0 else 0.0
+        print(f"# {scene.name}: {summary.ran} cases in {summary.seconds:.1f} s ({rate:,.0f} cases/s, "
+              f"{summary.workers} worker{'s' * (summary.workers != 1)}), {summary.failed} failed; "
+              f"{summary.done} of {n_cases} on disk", file=sys.stderr)
+        if failures:
+            shown = 0
+            for row in iter_rows(folder, ["case", *names, "status", "message"]):
+                if row["status"] != "failed":
+                    continue
+                if shown == NAMED_FAILURES:
+                    print(f"# ... and more (status 'failed' in {folder})", file=sys.stderr)
+                    break
+                values = ", ".join(f"{v}={row[v]}" for v in names)
+                print(f"# case {row['case']} ({values}) failed: {row['message']}", file=sys.stderr)
+                shown += 1
+            print(f"cam-fmu sweep: {failures} of {n_cases} cases failed (rows kept, status 'failed')",
+                  file=sys.stderr)
+            return 1
+        return 0

@@ -38,7 +38,7 @@ def sobol_indices(problem: dict, y: np.ndarray, seed: int = 0) -> dict[str, np.n
 def indices(plan: Any, folder: str | Path) -> list[dict[str, Any]]:
     """One row (COLUMNS) per (metric, parameter) of the sweep ``plan`` (sweep_run.Plan with a Saltelli design)
     whose table is ``folder``."""
-    from .sweep_run import iter_rows
+    from .sweep_store import iter_rows
 
     metrics = list(plan.metrics)
     y = {m: [] for m in metrics}

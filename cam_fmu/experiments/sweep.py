@@ -1,6 +1,6 @@
 """Parameter sweeps of a scene: one case on the C engine or an FMU, its metrics, the tables.
 
-The cases: sweep_cases.py; running them in batches, streamed to Parquet: sweep_run.py.
+The cases: sweep_cases.py; running them in batches, streamed to Parquet: sweep_run.py; the files: sweep_store.py.
 
 A case runs on the C engine in this process (``engine``: a new DriveSimulator from the scene's start values,
 its input table in one ``run`` call: the communication steps fmpy takes on cam.fmu, ``fmpy_schedule``) or on
@@ -234,15 +234,17 @@ def run_batch(job: Mapping[str, Any]) -> dict[str, list]:
 # ------------------------------------------------------------------ tables
 def write_table(rows: Iterable[Mapping[str, Any]], names: Sequence[str], metrics: Sequence[str],
                 path: str | Path) -> Path:
-    """CSV: one row per case, headers with units ('m [kg]', 'peak_i [A]'); numbers with 17 digits (exact);
-    then each case's status ('ok', 'failed') and message (the reason of a failed case, quoted)."""
+    """CSV: one row per case, first its number ``case`` (from 1, as in the Parquet table), then the varied values
+    and the metrics with units in the headers ('m [kg]', 'peak_i [A]'), numbers with 17 digits (exact), then
+    the case's status ('ok', 'failed') and message (the reason of a failed case, quoted)."""
     columns = list(names) + list(metrics)
     path = Path(path)
     with open(path, "w", encoding="utf-8", newline="") as fh:
         out = csv.writer(fh, lineterminator="\n")
-        out.writerow([header(n) for n in columns] + ["status", "message"])
+        out.writerow(["case"] + [header(n) for n in columns] + ["status", "message"])
         for row in rows:
-            out.writerow([repr(row[n]) if isinstance(row[n], float) else str(row[n]) for n in columns]
+            out.writerow([str(row["case"])]
+                         + [repr(row[n]) if isinstance(row[n], float) else str(row[n]) for n in columns]
                          + [row.get("status", "ok"), row.get("message", "")])
     return path
 

@@ -1,13 +1,14 @@
 """A sweep's cases in batches, serial or on dask.distributed, each finished batch written at once to Parquet.
 
-The table is a Parquet dataset, ``DIR/<scene>_sweep.parquet/``: one file per finished batch,
-``part-<first>-<end>.parquet`` holding the cases of index first..end-1 (column ``case``: index + 1), the
-varied values, the metrics (headers with units), ``status`` and ``message``; ``sweep.json`` beside them holds
-the sweep's specification (scene, options, the engine's build, the batch size). A file appears whole or not at
-all (written under a temporary name, then renamed), so whatever stops the driver (Ctrl-C, kill -9, a lost
-machine) leaves only finished cases on disk; ``resume=True`` runs the cases no file holds, with the stored batch
-size, and refuses a folder whose specification differs. Every case's row depends on the case alone, so the
-table (sorted by case) equals an uninterrupted run's bit for bit.
+The table is a Parquet dataset, ``DIR/<scene>_sweep.parquet/``, of part files only, its specification beside it
+in ``DIR/<scene>_sweep.json`` (scene, options, the engine's build, the batch size): sweep_store.py. One file
+per finished batch, ``part-<first>-<end>.parquet`` holding the cases of index first..end-1 (column ``case``:
+index + 1), the varied values, the metrics (headers with units), ``status`` and ``message``. A file appears
+whole or not at all (written under a temporary name, then renamed), so whatever stops the driver (Ctrl-C,
+kill -9, a lost machine) leaves only finished cases on disk; ``resume=True`` runs the cases no file holds, with
+the stored batch size, and refuses a folder whose specification differs. Every case's row depends on the case
+alone, so the table (sorted by case) equals an uninterrupted run's bit for bit. One sweep writes a folder at a
+time (sweep_lock.py), and a resume repairs or refuses parts that hold a case twice (sweep_store.repair).
 
 Memory stays bounded: the driver holds at most ``2 x workers + 1`` batches in flight (their values and rows),
 never the case list or the table; dask's message logs keep LOG_LENGTH messages a stream, not 1000. The batch
@@ -30,6 +31,9 @@ from typing import Any, Callable, Iterator, Sequence
 
 from .interrupts import InterruptFlag, environment, quiet, sigint_ignored
 from .sweep import Design, SweepError, header, run_batch, run_case
+from .sweep_lock import hold
+from .sweep_store import (cases_on_disk, dataset_path, entries, lock_path, read_spec, repair, spec_path, write_part,
+                          write_spec)
 
 BATCH_SECONDS = 1.0  # s of work per batch
 MAX_BATCH = 50_000
@@ -38,8 +42,7 @@ MAX_BATCH = 50_000
 # batches' tasks (their values), the client's to the scheduler the same, so the driver (the local scheduler's
 # process) grew by a batch's values per batch until 1000 a stream. A short log bounds that to a few batches.
 LOG_LENGTH = 8
-SPEC_FILE = "sweep.json"
-FORMAT = 1  # of the dataset's files and sweep.json
+FORMAT = 1  # of the part files and the specification (sweep_store.py)
 
 
 @dataclass
@@ -88,10 +91,6 @@ class Summary:
     interrupted: bool = False
 
 
-def dataset_path(out: str | Path, scene_name: str) -> Path:
-    return Path(out) / f"{scene_name}_sweep.parquet"
-
-
 # ------------------------------------------------------------------ the files
 def _schema(plan: Plan, spec: dict):
     import pyarrow as pa
@@ -104,30 +103,46 @@ def _schema(plan: Plan, spec: dict):
     return pa.schema(fields, metadata={"cam_fmu.sweep": json.dumps(spec, sort_keys=True)})
 
 
-def _write_part(folder: Path, schema, columns: dict[str, list]) -> None:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
+def prepare(plan: Plan, out: str | Path, resume: bool, overwrite: bool) -> tuple[Path, dict, list, list[str]]:
+    """The dataset's folder, the stored specification, the parts on disk and a line per repair (run under the
+    folder's lock); refuses before any case runs (SweepError naming the option) a resume of a folder made by
+    another command, scene or options, a resume of a folder whose parts hold a case twice other than as
+    identical copies (sweep_store.repair), and a fresh run over an earlier sweep."""
+    folder = dataset_path(out, plan.scene.name)
+    spec = plan.spec()
+    if resume:
+        stored = read_spec(folder)
+        if stored is None:
+            what = f"holds no sweep (no {spec_path(folder).name} beside it)" if folder.is_dir() else "does not exist"
+            raise SweepError(f"--resume: {folder} {what}: nothing to continue")
+        if stored.get("command") != "sweep":
+            raise SweepError(f"--resume: {folder} was made by the command {stored.get('command')!r}, not sweep")
+        for key, value in spec.items():
+            if stored.get(key) != value:
+                raise SweepError(f"--resume: {folder} was made with {key} = {stored.get(key)!r}, this sweep has "
+                                 f"{key} = {value!r}: a resume continues the same sweep only")
+        for tmp in folder.glob(".part-*.tmp"):  # a write cut short: that batch runs again
+            tmp.unlink()
+        try:
+            done, notes = repair(folder, len(plan.design))
+        except SweepError as exc:
+            raise SweepError(f"--resume: {exc}") from None
+        return folder, stored, done, notes
+    held = entries(folder)
+    if held or read_spec(folder) is not None:
+        if not overwrite:
+            raise SweepError(f"--out: {folder} holds an earlier sweep ({len(held)} part files): --resume continues "
+                             "it, --overwrite starts again")
+    if folder.exists():
+        import shutil
 
-    first, count = columns["case"][0] - 1, len(columns["case"])
-    data = {("case" if name == "case" else name if name in ("status", "message") else header(name)): values
-            for name, values in columns.items()}
-    table = pa.table({f.name: pa.array(data[f.name], type=f.type) for f in schema}, schema=schema)
-    tmp = folder / f".part-{first:010d}-{uuid.uuid4().hex}.tmp"
-    pq.write_table(table, tmp)
-    os.replace(tmp, folder / f"part-{first:010d}-{first + count:010d}.parquet")
-
-
-def parts(folder: Path) -> list[tuple[int, int, Path]]:
-    """(first case, end, file) of every finished batch, in case order."""
-    out = []
-    for path in folder.glob("part-*.parquet"):
-        _, first, end = path.stem.split("-")
-        out.append((int(first), int(end), path))
-    return sorted(out)
+        shutil.rmtree(folder)
+    spec_path(folder).unlink(missing_ok=True)
+    return folder, spec, [], []
 
 
 def _todo(n: int, batch: int, done: list[tuple[int, int, Path]]) -> Iterator[tuple[int, int]]:
-    """The ranges (start, stop) to run: each batch's cases that no file holds."""
+    """The ranges (start, stop) to run: each batch's cases that no file holds (``done``: disjoint, in order)."""
     k = 0
     for start in range(0, n, batch):
         stop = min(n, start + batch)
@@ -142,63 +157,6 @@ def _todo(n: int, batch: int, done: list[tuple[int, int, Path]]) -> Iterator[tup
             j += 1
         if cursor < stop:
             yield cursor, stop
-
-
-def iter_rows(folder: str | Path, columns: Sequence[str] | None = None) -> Iterator[dict[str, Any]]:
-    """The table's rows in case order, one file at a time, keyed by name without unit ('m', 'peak_i', 'case',
-    'status', 'message'); ``columns``: only those (by name)."""
-    import pyarrow.parquet as pq
-
-    for _, _, path in parts(Path(folder)):
-        table = pq.read_table(path)
-        names = [f.split(" [")[0] for f in table.column_names]
-        table = table.rename_columns(names)
-        if columns is not None:
-            table = table.select(list(columns))
-        yield from table.to_pylist()
-
-
-def failed_on_disk(folder: str | Path) -> int:
-    """Failed cases in the dataset (column status, file by file)."""
-    import pyarrow.compute as pc
-    import pyarrow.parquet as pq
-
-    return sum(int(pc.sum(pc.equal(pq.read_table(path, columns=["status"])["status"], "failed")).as_py() or 0)
-               for _, _, path in parts(Path(folder)))
-
-
-def read_spec(folder: str | Path) -> dict | None:
-    path = Path(folder) / SPEC_FILE
-    return json.loads(path.read_text()) if path.is_file() else None
-
-
-def prepare(plan: Plan, out: str | Path, resume: bool, overwrite: bool) -> tuple[Path, dict, list]:
-    """The dataset's folder and stored specification; refuses before any case runs (SweepError naming the option)
-    a resume of a folder made by another command, scene or options, and a fresh run over finished cases."""
-    folder = dataset_path(out, plan.scene.name)
-    spec = plan.spec()
-    if resume:
-        stored = read_spec(folder)
-        if stored is None:
-            what = "holds no sweep (no sweep.json)" if folder.is_dir() else "does not exist"
-            raise SweepError(f"--resume: {folder} {what}: nothing to continue")
-        if stored.get("command") != "sweep":
-            raise SweepError(f"--resume: {folder} was made by the command {stored.get('command')!r}, not sweep")
-        for key, value in spec.items():
-            if stored.get(key) != value:
-                raise SweepError(f"--resume: {folder} was made with {key} = {stored.get(key)!r}, this sweep has "
-                                 f"{key} = {value!r}: a resume continues the same sweep only")
-        for tmp in folder.glob(".part-*.tmp"):  # a write cut short: that batch runs again
-            tmp.unlink()
-        return folder, stored, parts(folder)
-    if folder.exists():
-        if not overwrite and (parts(folder) or read_spec(folder)):
-            raise SweepError(f"--out: {folder} holds an earlier sweep ({sum(e - f for f, e, _ in parts(folder))} "
-                             "finished cases): --resume continues it, --overwrite starts again")
-        import shutil
-
-        shutil.rmtree(folder)
-    return folder, spec, []
 
 
 # ------------------------------------------------------------------ the run
@@ -222,16 +180,32 @@ def pilot_seconds(plan: Plan) -> float:
 def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler: str | None = None,
               serial: bool = False, resume: bool = False, overwrite: bool = False, batch_size: int | None = None,
               progress: Callable[[int, int, int], None] | None = None,
-              started: Callable[[str, int, int], None] | None = None) -> Summary:
+              started: Callable[[str, int, int], None] | None = None,
+              notes: Callable[[str], None] | None = None, locked: bool = False) -> Summary:
     """Run every case not on disk yet; ``progress(done, total, failed)`` after each case (serial) or batch;
-    ``started(where, batch size, cases to run)`` once the engine is up. An interrupt (SIGINT) stops the run
-    with every finished batch written (serial: the cases finished in the current batch too)."""
-    folder, spec, done = prepare(plan, out, resume, overwrite)
-    n = len(plan.design)
+    ``started(where, batch size, cases to run)`` once the engine is up; ``notes(line)`` for each repair of the
+    folder (sweep_store.repair). An interrupt (SIGINT) stops the run with every finished batch written (serial:
+    the cases finished in the current batch too). The folder's lock (sweep_lock.hold) is held for the run;
+    ``locked``: the caller holds it already."""
     if batch_size is not None and batch_size < 1:
         raise SweepError(f"--batch-size {batch_size}: allowed >= 1")
+    folder = dataset_path(out, plan.scene.name)
+    with contextlib.ExitStack() as lock:
+        if not locked:
+            lock.enter_context(hold(lock_path(folder), folder))
+        return _run_locked(plan, out, workers, scheduler, serial, resume, overwrite, batch_size, progress, started,
+                           notes)
+
+
+def _run_locked(plan: Plan, out, workers, scheduler, serial, resume, overwrite, batch_size, progress, started,
+                notes) -> Summary:
+    folder, spec, done, repaired = prepare(plan, out, resume, overwrite)
+    for line in repaired:
+        if notes:
+            notes(line)
+    n = len(plan.design)
     t0 = time.perf_counter()
-    on_disk = sum(e - f for f, e, _ in done)
+    on_disk = cases_on_disk(done)  # disjoint parts within the n cases (sweep_store.parts): 0 <= on_disk <= n
     logs = contextlib.ExitStack()
     if serial:
         n_workers, client, cluster = 1, None, None
@@ -249,7 +223,7 @@ def run_sweep(plan: Plan, out: str | Path, workers: int | None = None, scheduler
         if "batch_size" not in spec:
             spec["batch_size"] = batch_size or choose_batch_size(pilot_seconds(plan), n, n_workers)
         folder.mkdir(parents=True, exist_ok=True)
-        (folder / SPEC_FILE).write_text(json.dumps(spec, indent=1, sort_keys=True) + "\n")
+        write_spec(folder, spec)
         schema = _schema(plan, {k: v for k, v in spec.items() if k != "batch_size"})
         todo = _todo(n, spec["batch_size"], done)
         where = "serial" if serial else (scheduler or f"local cluster of {n_workers} workers")
@@ -298,7 +272,7 @@ def _serial(plan: Plan, folder: Path, schema, todo, counts: list, n: int, progre
         flag = InterruptFlag()
         try:
             if columns["case"]:
-                _write_part(folder, schema, columns)
+                write_part(folder, schema, columns)
                 counts[0] += len(columns["case"])
         finally:
             flag.restore()
@@ -353,7 +327,7 @@ def _distributed(plan: Plan, client, n_workers: int, folder: Path, schema, todo,
             for future in batch:
                 columns = future.result()
                 in_flight -= 1
-                _write_part(folder, schema, columns)
+                write_part(folder, schema, columns)
                 counts[0] += len(columns["case"])
                 counts[1] += sum(s == "failed" for s in columns["status"])
                 counts[2] += len(columns["case"])

@@ -56,9 +56,11 @@ def serial(cam_fmu_path, tmp_path_factory) -> str:
 
 def test_serial_table(serial):
     lines = serial.strip().splitlines()
-    assert lines[0] == "m [kg],rise_law,peak_i [A],peak_M [N.m],ripple [rad/s],final_omega [rad/s],status,message"
+    assert lines[0] == ("case,m [kg],rise_law,peak_i [A],peak_M [N.m],ripple [rad/s],final_omega [rad/s],status,"
+                        "message")
     assert len(lines) == 1 + 6
-    rows = [line.split(",") for line in lines[1:]]
+    rows = [line.split(",")[1:] for line in lines[1:]]
+    assert [line.split(",")[0] for line in lines[1:]] == ["1", "2", "3", "4", "5", "6"]
     # a heavier follower slows the spin-up: final omega falls with m for each law
     for law in ("paper", "cycloidal"):
         finals = [float(r[5]) for r in rows if r[1] == law]
@@ -80,7 +82,9 @@ def test_a_failing_case_keeps_every_row_and_is_named(cam_fmu_path, tmp_path, whe
     assert proc.returncode == 1, proc.stderr[-3000:]
     with open(out / "paper_fig6_sweep.csv", newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["max_steps [1]", "final_omega [rad/s]", "status", "message"]
+    assert rows[0] == ["case", "max_steps [1]", "final_omega [rad/s]", "status", "message"]
+    assert [r[0] for r in rows[1:]] == ["1", "2", "3"]  # the case numbers
+    rows = [r[1:] for r in rows]
     assert [float(r[0]) for r in rows[1:]] == [10000, 1, 5000]
     assert [r[2] for r in rows[1:]] == ["ok", "failed", "ok"]
     assert "max_steps = 1 internal steps" in rows[2][3] and rows[2][1] == "nan"
@@ -105,7 +109,7 @@ def test_the_fmi3_fmu_sweeps_as_cam_fmu(serial, tmp_path):
     assert proc.returncode == 1, proc.stderr[-3000:]
     with open(out / "paper_fig6_sweep.csv", newline="") as fh:
         rows = list(csv.reader(fh))
-    assert [r[2] for r in rows[1:]] == ["ok", "failed", "ok"] and "max_steps = 1 internal steps" in rows[2][3]
+    assert [r[3] for r in rows[1:]] == ["ok", "failed", "ok"] and "max_steps = 1 internal steps" in rows[2][4]
 
 
 def _rewritten(fmu: Path, dest: Path, change) -> Path:
@@ -160,19 +164,21 @@ def test_an_interrupt_keeps_the_finished_cases_and_says_so_on_one_line(cam_fmu_p
     assert 3 <= kept < 400
     with open(out / "paper_fig6_sweep.csv", newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0] == ["m [kg]", "final_omega [rad/s]", "status", "message"] and len(rows) == 1 + kept
-    masses = [float(r[0]) for r in rows[1:]]
-    assert masses == sorted(masses) and all(r[2] == "ok" for r in rows[1:])
+    assert rows[0] == ["case", "m [kg]", "final_omega [rad/s]", "status", "message"] and len(rows) == 1 + kept
+    masses = [float(r[1]) for r in rows[1:]]
+    assert masses == sorted(masses) and all(r[3] == "ok" for r in rows[1:])
+    cases = [int(r[0]) for r in rows[1:]]
+    assert cases == sorted(set(cases)) and all(1 <= c <= 400 for c in cases)  # each case once
     if where == ["--serial"]:  # serial: the first cases, in order
         assert masses == [float(v) for v in parse_vary("m=0.2:0.6:400").values[:kept]]
     again = tmp_path / "again"  # two of the kept cases, run on their own
-    picked = f"m={rows[1][0]},{rows[-1][0]}"
+    picked = f"m={rows[1][1]},{rows[-1][1]}"
     subprocess.run([sys.executable, "-m", "cam_fmu.cli", *LONG[:2], "--vary", picked, *LONG[4:], "--fmu",
                     str(cam_fmu_path), "--out", str(again), "--serial"], check=True, capture_output=True,
                    env=_env(), cwd=tmp_path, timeout=600)
     with open(again / "paper_fig6_sweep.csv", newline="") as fh:
         alone = list(csv.reader(fh))[1:]
-    assert alone == [rows[1], rows[-1]]
+    assert alone == [["1", *rows[1][1:]], ["2", *rows[-1][1:]]]  # cases 1 and 2 of that sweep
 
 
 def test_a_local_cluster_says_nothing_when_the_dashboard_port_is_taken(cam_fmu_path, tmp_path):

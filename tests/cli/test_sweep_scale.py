@@ -40,7 +40,7 @@ def _rows(path: Path) -> list[list[str]]:
 
 
 def _parquet_rows(folder: Path) -> list[dict]:
-    from cam_fmu.experiments.sweep_run import iter_rows
+    from cam_fmu.experiments.sweep_store import iter_rows
 
     return list(iter_rows(folder))
 
@@ -63,8 +63,8 @@ def test_the_engine_in_process_and_cam_fmu_give_the_same_bits(cam_fmu_path, tmp_
     _cli("sweep", *failing, "--out", str(tmp_path / "fe"), cwd=tmp_path, check=1)
     _cli("sweep", *failing, "--fmu", str(cam_fmu_path), "--out", str(tmp_path / "ff"), cwd=tmp_path, check=1)
     fa, fb = _rows(tmp_path / "fe" / "paper_fig6_sweep.csv"), _rows(tmp_path / "ff" / "paper_fig6_sweep.csv")
-    assert [r[:3] for r in fa] == [r[:3] for r in fb] and [r[2] for r in fa[1:]] == ["ok", "failed"]
-    assert "max_steps = 1 internal steps" in fa[2][3] and fa[2][3] in fb[2][3]
+    assert [r[:4] for r in fa] == [r[:4] for r in fb] and [r[3] for r in fa[1:]] == ["ok", "failed"]
+    assert "max_steps = 1 internal steps" in fa[2][4] and fa[2][4] in fb[2][4]
 
 
 def test_sizing_metrics_equal_numpy_on_a_simulate_run(tmp_path):
@@ -88,8 +88,8 @@ def test_sizing_metrics_equal_numpy_on_a_simulate_run(tmp_path):
     _cli("sweep", "paper_fig6", "--vary", f"m={mass}:{mass}:1", "--metric", ",".join(expected), "--stop-time", "1",
          "--serial", "--no-plot", "--out", str(tmp_path / "sw"), cwd=tmp_path)
     rows = _rows(tmp_path / "sw" / "paper_fig6_sweep.csv")
-    assert rows[0][1:5] == ["rms_M [N.m]", "rms_i [A]", "peak_accel [rad/s2]", "energy_per_turn [J]"]
-    for name, value in zip(expected, rows[1][1:5]):
+    assert rows[0][2:6] == ["rms_M [N.m]", "rms_i [A]", "peak_accel [rad/s2]", "energy_per_turn [J]"]
+    for name, value in zip(expected, rows[1][2:6]):
         assert float(value) == pytest.approx(expected[name], rel=1e-6), name
     assert expected["energy_per_turn"] > 0 and expected["peak_accel"] > 0
 
@@ -114,7 +114,10 @@ def test_a_driver_killed_by_sigkill_resumes_to_the_same_table(tmp_path):
     assert proc.returncode == -signal.SIGKILL
     kept = len(list(folder.glob("part-*.parquet")))
     assert 2 <= kept < 10 and not (out / "paper_fig6_sweep.csv").exists()
+    lock = out / "paper_fig6_sweep.lock"  # left behind by the killed driver, naming it: no longer held
+    assert json.loads(lock.read_text())["pid"] == proc.pid
     again = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
+    assert not lock.exists()
     assert f"({30 - 3 * kept} to run)" in again.stderr or f"({30 - 3 * kept - 3} to run)" in again.stderr
     assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "whole" / "paper_fig6_sweep.csv").read_text()
     rows = _parquet_rows(folder)
@@ -134,9 +137,11 @@ def test_resume_refuses_another_sweep_and_a_fresh_run_keeps_an_earlier_one(tmp_p
     fresh = _cli(*args, cwd=tmp_path, check=2)
     assert "--resume continues it, --overwrite starts again" in fresh.stderr
     _cli(*args, "--overwrite", cwd=tmp_path)
-    spec = json.loads((folder / "sweep.json").read_text())
+    spec_file = tmp_path / "out" / "paper_fig6_sweep.json"  # beside the dataset, which holds part files only
+    assert all(p.name.startswith("part-") and p.suffix == ".parquet" for p in folder.iterdir())
+    spec = json.loads(spec_file.read_text())
     spec["command"] = "cosim"
-    (folder / "sweep.json").write_text(json.dumps(spec))
+    spec_file.write_text(json.dumps(spec))
     command = _cli(*args, "--resume", cwd=tmp_path, check=2)
     assert "made by the command 'cosim'" in command.stderr
     nothing = _cli(*args[:-1], str(tmp_path / "empty"), "--resume", cwd=tmp_path, check=2)
@@ -184,7 +189,8 @@ def test_sobol_indices_of_an_additive_function_match_the_closed_form(tmp_path):
     var_i = (h_i - l_i)^2 / 12; estimated through the code that analyses a sweep's Parquet table."""
     from cam_fmu.experiments import sensitivity
     from cam_fmu.experiments.scenes import find_scene
-    from cam_fmu.experiments.sweep_run import Plan, _schema, _write_part
+    from cam_fmu.experiments.sweep_run import Plan, _schema
+    from cam_fmu.experiments.sweep_store import write_part
 
     varies = (parse_vary("m=0.2:0.8"), parse_vary("mu=0:0.3"), parse_vary("lift=0.01:0.02"))
     design = Design(varies, ("saltelli", 4096), seed=2)
@@ -200,7 +206,7 @@ def test_sobol_indices_of_an_additive_function_match_the_closed_form(tmp_path):
     for start in range(0, n, 5000):
         values = design.values(start, min(n, start + 5000))
         x = np.column_stack([values[v.name] for v in varies])
-        _write_part(folder, schema, {"case": list(range(start + 1, start + len(x) + 1)), **values,
+        write_part(folder, schema, {"case": list(range(start + 1, start + len(x) + 1)), **values,
                                      "peak_M": list(x @ a), "status": ["ok"] * len(x), "message": [""] * len(x)})
     rows = sensitivity.indices(plan, folder)
     assert [r["parameter"] for r in rows] == ["m", "mu", "lift"] and rows == sensitivity.indices(plan, folder)
@@ -229,7 +235,7 @@ def test_sensitivity_on_the_drive_ranks_as_a_one_at_a_time_sweep(tmp_path):
         others = [x for o, (l2, h2) in ranges.items() if o != name for x in ("--vary", f"{o}={(l2 + h2) / 2}:{(l2 + h2) / 2}:1")]
         _cli("sweep", "paper_fig6", "--vary", f"{name}={lo}:{hi}:5", *others, "--metric", "peak_M", "--stop-time",
              "0.5", "--serial", "--no-plot", "--out", str(tmp_path / name), cwd=tmp_path)
-        values = [float(r[3]) for r in _rows(tmp_path / name / "paper_fig6_sweep.csv")[1:]]
+        values = [float(r[4]) for r in _rows(tmp_path / name / "paper_fig6_sweep.csv")[1:]]
         spread[name] = max(values) - min(values)
     assert by_st == sorted(ranges, key=lambda n: -spread[n]), (table, spread)
 
