@@ -13,8 +13,9 @@ cd "$(dirname "$0")"
 # - wine64:   runs the x86_64-windows binaries in the Windows test hosts (tests/hosts/test_engine_fmu_win64.py);
 # - qemu-user-static, libc6-arm64-cross: run the aarch64-linux binaries in an aarch64 test host
 #             (qemu-aarch64-static -L /usr/aarch64-linux-gnu; tests/hosts/test_fmu_platforms.py).
+# - clang:    the second C compiler every C file must compile under warning-free (tests/hosts/test_c_compilers.py).
 missing=()
-for pkg in gcc valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
+for pkg in gcc clang valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed"; then
         missing+=("$pkg")
     fi
