@@ -12,6 +12,8 @@ engine by golden-section search to 1e-3 relative in f (control.frequency.locate_
 at a frozen angle, on the analytic curve beside it. Writes DIR/<scene>_bode.csv and
 DIR/<scene>_bode.png (the extrema marked); ``--json`` prints the summary (operating point, the
 extrema with their kind, the largest difference to the analytic response) as one JSON object.
+Progress: a bar on stderr over the grid's frequencies, then one over the extrema located
+(experiments.progress.ProgressBar: on a terminal or with CAM_FMU_PROGRESS=1, never with 0).
 
 Frequencies out of reach are refused before anything runs, naming the reachable range
 (experiments.frequency.OperatingPoint.reachable: the work of one run is bounded); so is a speed
@@ -50,6 +52,7 @@ def run(args) -> int:
 
     from ..control.frequency import EXTREMUM_TOLERANCE, analytic_response, locate_extrema, refine_extremum
     from ..experiments.frequency import measured_response, operating_point
+    from ..experiments.progress import ProgressBar
     from ..experiments.scenes import find_scene
     from .simulate import apply_sets
 
@@ -75,10 +78,18 @@ def run(args) -> int:
     except ValueError as exc:
         raise ValueError(f"scene {scene.name}: {exc}") from None
     point.check(f, names=("--fmin", "--fmax"))  # before anything runs or is allocated
-    measured = measured_response(params, f, amplitude=args.amplitude, point=point)
+    grid = ProgressBar(f"bode {scene.name} (frequencies)")
+    try:
+        measured = measured_response(params, f, amplitude=args.amplitude, point=point, progress=grid)
+    finally:
+        grid.close()
     analytic = analytic_response(params, theta0, f) if theta0 is not None else None
-    extrema = locate_extrema(measured, lambda fk: measured_response(params, [fk], amplitude=args.amplitude,
-                                                                    point=point))
+    search = ProgressBar(f"bode {scene.name} (extrema located)")
+    try:
+        extrema = locate_extrema(measured, lambda fk: measured_response(params, [fk], amplitude=args.amplitude,
+                                                                        point=point), progress=search)
+    finally:
+        search.close()
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {args.out!r} exists and is not a directory")

@@ -165,19 +165,25 @@ def refine_extremum(gain_at, lo: float, hi: float, kind: str,
     return math.exp(x), seen[x], math.expm1(b - a)
 
 
-def locate_extrema(response: Response, response_at, tolerance: float = EXTREMUM_TOLERANCE) -> list[Extremum]:
+def locate_extrema(response: Response, response_at, tolerance: float = EXTREMUM_TOLERANCE,
+                   progress=None) -> list[Extremum]:
     """Every resonance and anti-resonance of the motor's and the cam's |H| sampled in ``response``, each refined by
-    ``response_at(f) -> Response`` at single frequencies [Hz] (grid_extrema, refine_extremum)."""
+    ``response_at(f) -> Response`` at single frequencies [Hz] (grid_extrema, refine_extremum). ``progress(done,
+    total)``: called before the first search and after each (one search an extremum)."""
     f = np.asarray(response.f, dtype=float)
+    todo = [(output, k, kind) for output in ("motor", "cam")
+            for k, kind in grid_extrema(np.abs(getattr(response, output)))]
     found = []
-    for output in ("motor", "cam"):
-        gain = np.abs(getattr(response, output))
-        for k, kind in grid_extrema(gain):
-            def gain_at(fk: float, output: str = output) -> float:
-                return abs(getattr(response_at(fk), output)[0])
+    if progress is not None and todo:
+        progress(0, len(todo))
+    for output, k, kind in todo:
+        def gain_at(fk: float, output: str = output) -> float:
+            return abs(getattr(response_at(fk), output)[0])
 
-            fk, gk, width = refine_extremum(gain_at, f[k - 1], f[k + 1], kind, tolerance)
-            found.append(Extremum(output, kind, fk, gk, width))
+        fk, gk, width = refine_extremum(gain_at, f[k - 1], f[k + 1], kind, tolerance)
+        found.append(Extremum(output, kind, fk, gk, width))
+        if progress is not None:
+            progress(len(found), len(todo))
     return found
 
 

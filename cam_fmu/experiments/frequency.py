@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -174,14 +174,16 @@ def _measured_run(p: Mapping[str, Any], u: np.ndarray, hold: float, settle_holds
 
 
 def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], theta0: float | None = None,
-                      u0: float | None = None, amplitude: float = 1e-3, point: OperatingPoint | None = None) -> Response:
+                      u0: float | None = None, amplitude: float = 1e-3, point: OperatingPoint | None = None,
+                      progress: Callable[[int, int], None] | None = None) -> Response:
     """H(j 2 pi f) measured on the C engine by small-signal simulation (module docstring).
 
     ``theta0`` [rad]: the frozen-angle operating point (friction and backlash off, u0 from gravity); else the
     drive turning under ``u0`` [V] with everything its parameters model (or ``point``, from operating_point).
     ``amplitude`` [V] of the sine. Each frequency runs the drive twice from the same start, with and without the
     sine, and fits the difference: the operating point's own motion (the cam's turning, a settling transient)
-    cancels exactly. A frequency out of reach (OperatingPoint.reachable) is refused before anything runs."""
+    cancels exactly. A frequency out of reach (OperatingPoint.reachable) is refused before anything runs.
+    ``progress(done, total)``: called before the first frequency and after each (e.g. progress.ProgressBar)."""
     if not (math.isfinite(amplitude) and amplitude > 0.0):
         raise ValueError(f"amplitude = {amplitude!r} V: allowed > 0")
     f = np.asarray(f, dtype=float)
@@ -193,7 +195,9 @@ def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], thet
     p, u0 = point.params, point.u0
     columns = [OUTPUT_NAMES.index("omega_m"), OUTPUT_NAMES.index("omega")]
     motor, cam = [], []
-    for fk in f:
+    if progress is not None:
+        progress(0, len(f))
+    for k, fk in enumerate(f):
         period = 1.0 / fk
         hold = period / HOLDS_PER_PERIOD
         h = hold / OUTPUTS_PER_HOLD
@@ -209,6 +213,8 @@ def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], thet
         difference = excited - base
         motor.append(_harmonic(t_end, difference[:, 0], w) / U)
         cam.append(_harmonic(t_end, difference[:, 1], w) / U)
+        if progress is not None:
+            progress(k + 1, len(f))
     return Response(f, np.array(motor), np.array(cam), float(u0), point.note)
 
 
