@@ -48,18 +48,24 @@ CHUNK_HOLDS = 1 << 16
 @dataclass(frozen=True)
 class OperatingPoint:
     """What a measurement around one operating point needs: the engine's parameters, u0 [V], the settling time
-    [s], the measurement window's floor [s] (two turns while turning) and a note saying what it is."""
+    [s], the measurement window's floor [s] (two turns while turning), a note saying what it is and, while
+    turning, the cam's turning frequency f_turn [Hz] (turns per second; None at a frozen angle)."""
 
     params: dict
     u0: float
     settle: float
     window: float
     note: str
+    f_turn: float | None = None
 
     def holds(self, f: float) -> tuple[int, int]:
         """(held values before the measurement, periods measured) at f [Hz] (the settling rule)."""
         return (HOLDS_PER_PERIOD * max(SETTLE_PERIODS, math.ceil(self.settle * f)),
                 max(MEASURE_PERIODS, math.ceil(self.window * f)))
+
+    def span(self, f: float) -> float:
+        """The measured window [s] at f [Hz]: the periods of the fit (the settling rule)."""
+        return self.holds(f)[1] / f
 
     def work(self, f: float) -> tuple[int, float]:
         """(held values of one run, the engine's internal steps at least: simulated time / h_max) at f [Hz]."""
@@ -158,8 +164,23 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
     turn_rate = abs(theta[-1] - theta[half]) / ((len(theta) - half) * h) / (2.0 * math.pi)  # turns per second
     if not turn_rate > 1e-3:
         raise ValueError(f"u0 = {u0!r} V: the cam does not turn (it comes to rest); give a frozen angle instead")
+    turn_rate = _turn_rate(theta[half:], h) or turn_rate
     return OperatingPoint(p, u0, settle, 2.0 / turn_rate, f"turning under u0 = {u0:.6g} V at "
-                          f"{60.0 * turn_rate:.4g} 1/min (the first harmonic at f, averaged over at least two turns)")
+                          f"{60.0 * turn_rate:.6g} 1/min, {turn_rate:.6g} turns/s (the first harmonic at f, averaged "
+                          "over at least two turns)", turn_rate)
+
+
+def _turn_rate(theta: np.ndarray, h: float) -> float | None:
+    """Turns per second [1/s] between the first and the last whole turn completed in ``theta`` [rad], sampled
+    every h [s] (each crossing of a multiple of 2 pi interpolated linearly): exact for a periodic turning, while
+    theta's mean slope over a part of a turn is off by the speed's ripple. None under two crossings."""
+    turns = np.floor(theta / (2.0 * math.pi))
+    k = np.nonzero(np.diff(turns))[0]
+    if len(k) < 2:
+        return None
+    level = 2.0 * math.pi * np.maximum(turns[k], turns[k + 1])
+    t = (k + (level - theta[k]) / (theta[k + 1] - theta[k])) * h
+    return (len(k) - 1) / abs(t[-1] - t[0])
 
 
 def _measured_run(p: Mapping[str, Any], u: np.ndarray, hold: float, settle_holds: int) -> np.ndarray:
