@@ -125,16 +125,6 @@ def run(args) -> int:
         handle.write(",".join(columns) + "\n")
         for k in range(len(f)):
             handle.write(",".join(repr(float(column[k])) for column in columns.values()) + "\n")
-    written = [csv]
-    if not args.no_plot:
-        from ..plots.bode import plot_bode
-
-        curve = None  # the linearised drive's curve drawn densely, through its resonances' peaks
-        if analytic is not None:
-            dense = np.union1d(np.geomspace(args.fmin, args.fmax, 2000), [ex.f for ex in extrema])
-            curve = analytic_response(params, theta0, dense)
-        written.append(plot_bode(measured, curve, f"{scene.name}: {measured.note}", out / f"{scene.name}_bode.png",
-                                 extrema))
     summary = {"operating_point": measured.note, "u0": measured.u0, "amplitude": args.amplitude,
                "extremum_tolerance": EXTREMUM_TOLERANCE, "f_turn": point.f_turn, "shaft_bands": None, "extrema": []}
     if point.f_turn is not None:
@@ -155,6 +145,20 @@ def run(args) -> int:
             entry["f_analytic"], entry["gain_analytic"], _ = refine_extremum(
                 exact, ex.f / (1.0 + 8 * EXTREMUM_TOLERANCE), ex.f * (1.0 + 8 * EXTREMUM_TOLERANCE), ex.kind, 1e-7)
         summary["extrema"].append(entry)
+    causes = None  # what each extremum of a turning drive is, in the figure's labels
+    if point.f_turn is not None:
+        causes = [{"turning harmonic": f"harmonic {e['harmonic']}", "shaft": "shaft", "neither": ""}[e["cause"]]
+                  for e in summary["extrema"]]
+    written = [csv]
+    if not args.no_plot:
+        from ..plots.bode import plot_bode
+
+        curve = None  # the linearised drive's curve drawn densely, through its resonances' peaks
+        if analytic is not None:
+            dense = np.union1d(np.geomspace(args.fmin, args.fmax, 2000), [ex.f for ex in extrema])
+            curve = analytic_response(params, theta0, dense)
+        written.append(plot_bode(measured, curve, f"{scene.name}: {measured.note}", out / f"{scene.name}_bode.png",
+                                 extrema, causes))
     if analytic is not None:
         for name in ("motor", "cam"):
             exact, seen = getattr(analytic, name), getattr(measured, name)
