@@ -9,7 +9,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # this checkout's cam_fmu, installed or not
 
+from cam_fmu.experiments.progress import ProgressBar  # noqa: E402
 from cam_fmu.fmu.build import main  # noqa: E402
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # a bar on stderr per FMU naming the platform being built (a first build takes minutes: every platform's
+    # zig cache is cold), drawn on a terminal or with CAM_FMU_PROGRESS=1 (0: never), as `cam-fmu simulate` draws
+    sys.exit(main(progress=ProgressBar))

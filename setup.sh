@@ -17,6 +17,7 @@ die() { echo "setup.sh: error: $*" >&2; exit 1; }
 # - wine64:   runs the x86_64-windows binaries in the Windows test hosts (tests/hosts/test_engine_fmu_win64.py);
 # - qemu-user-static, libc6-arm64-cross: run the aarch64-linux binaries in an aarch64 test host
 #             (qemu-aarch64-static -L /usr/aarch64-linux-gnu; tests/hosts/test_fmu_platforms.py);
+# - clang:    the second C compiler every C file must compile under warning-free (tests/hosts/test_c_compilers.py);
 # - python3, python3-venv: only when there is no python3 on PATH, or when `python3 -m venv` cannot work
 #             (Debian's and Ubuntu's python3 leave venv's pip bootstrap to python3-venv).
 apt_install() {
@@ -33,7 +34,7 @@ apt_install() {
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 
 missing=()
-for pkg in gcc valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
+for pkg in gcc clang valgrind libtbb12 wine64 qemu-user-static libc6-arm64-cross; do
     installed "$pkg" || missing+=("$pkg")
 done
 command -v python3 >/dev/null || missing+=(python3 python3-venv)

@@ -178,7 +178,7 @@ def zig_host(target: str, dest: Path, source: Path, *flags: str) -> Path:
     from cam_fmu.engine import build, targets
 
     row = targets.get(target)
-    libs = ["-D_POSIX_C_SOURCE=200809L", "-ldl", "-lm"] if row.system == "Linux" else []  # strdup, dlopen
+    libs = ["-D_POSIX_C_SOURCE=200809L", "-ldl", "-lm"] if row.system == "Linux" else []  # dlopen (POSIX)
     cmd = [*build.zig_cc(), "-target", row.zig, "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-Wno-strict-prototypes",
            f"-I{build.fmi_headers(2)}", f"-I{build.fmi_headers(3)}", *flags, str(source), "-o", str(dest), *libs]
     proc = subprocess.run(cmd, capture_output=True, text=True, cwd=dest.parent)

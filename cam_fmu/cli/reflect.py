@@ -10,9 +10,11 @@ they occur; ``--json`` prints them as one JSON object instead (keys J_min, J_max
 theta_<key> [rad]; the resonance keys are null when the drive-train is rigid,
 k_shaft = 0; and assumes, what the map assumes of the follower). It holds the follower on the cam at
 every angle (closure 'kinematic', a clearance ignored; 'form' where it cannot fly: c = 0, no follower mass or the
-paper's formulation) and refuses closure 'spring' and 'form' with a clearance, whose follower can leave the cam
-(`cam-fmu jump`; for 'form', `--set closure=kinematic` gives the map with the follower held on the cam). With a compliant shaft the CSV adds the columns f_r and f_a [Hz] and the
-figure a third panel.
+paper's formulation) and refuses closure 'spring' and 'form' with a clearance, whose follower can leave the cam,
+advising only commands that run on that scene (``advice``): for 'spring', `cam-fmu jump` (where and at what speed
+it leaves the cam); for 'form', whose groove holds the follower on both flanks (`jump` refuses it), the map with
+`--set closure=kinematic` (the clearance ignored) and `cam-fmu simulate` (its flights, N_contact = 0). With a
+compliant shaft the CSV adds the columns f_r and f_a [Hz] and the figure a third panel.
 """
 from __future__ import annotations
 
@@ -36,14 +38,33 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
+def advice(closure: str, scene: str, sets: list[str]) -> str:
+    """What to run instead of the map for a follower of ``closure`` that can leave the cam: whole command lines on
+    the same scene and overrides (``sets``: the --set values), each one the scene accepts."""
+    import shlex
+
+    def command(*words: str) -> str:
+        return "`" + shlex.join(["cam-fmu", *words[:1], scene, *(w for s in sets for w in ("--set", s)),
+                                 *words[1:]]) + "`"
+
+    if closure == "spring":
+        return f"where and at what cam speed it leaves the cam: {command('jump')}"
+    return (f"a groove's follower flies across its clearance between the flanks; the map with the follower held on "
+            f"the cam, the clearance ignored: "
+            f"{command('reflect', '--set', 'closure=kinematic')}; its flights over time (N_contact = 0 in "
+            f"flight): {command('simulate')}")
+
+
 def run(args) -> int:
-    from ..control.reflect import UNITS, reflected_map, summary
+    from ..control.reflect import UNITS, FreeFollowerError, reflected_map, summary
     from ..experiments.scenes import find_scene
     from .simulate import apply_sets
 
     scene = apply_sets(find_scene(args.scene), args.set)
     try:
         result = reflected_map(scene.primary.params, args.rpm, args.points)
+    except FreeFollowerError as exc:
+        raise ValueError(f"scene {scene.name}: {exc}; {advice(exc.closure, args.scene, args.set)}") from None
     except ValueError as exc:
         raise ValueError(f"scene {scene.name}: {exc}") from None
     columns = list(result)

@@ -165,20 +165,60 @@ def refine_extremum(gain_at, lo: float, hi: float, kind: str,
     return math.exp(x), seen[x], math.expm1(b - a)
 
 
-def locate_extrema(response: Response, response_at, tolerance: float = EXTREMUM_TOLERANCE) -> list[Extremum]:
+def locate_extrema(response: Response, response_at, tolerance: float = EXTREMUM_TOLERANCE,
+                   progress=None) -> list[Extremum]:
     """Every resonance and anti-resonance of the motor's and the cam's |H| sampled in ``response``, each refined by
-    ``response_at(f) -> Response`` at single frequencies [Hz] (grid_extrema, refine_extremum)."""
+    ``response_at(f) -> Response`` at single frequencies [Hz] (grid_extrema, refine_extremum). ``progress(done,
+    total)``: called before the first search and after each (one search an extremum)."""
     f = np.asarray(response.f, dtype=float)
+    todo = [(output, k, kind) for output in ("motor", "cam")
+            for k, kind in grid_extrema(np.abs(getattr(response, output)))]
     found = []
-    for output in ("motor", "cam"):
-        gain = np.abs(getattr(response, output))
-        for k, kind in grid_extrema(gain):
-            def gain_at(fk: float, output: str = output) -> float:
-                return abs(getattr(response_at(fk), output)[0])
+    if progress is not None and todo:
+        progress(0, len(todo))
+    for output, k, kind in todo:
+        def gain_at(fk: float, output: str = output) -> float:
+            return abs(getattr(response_at(fk), output)[0])
 
-            fk, gk, width = refine_extremum(gain_at, f[k - 1], f[k + 1], kind, tolerance)
-            found.append(Extremum(output, kind, fk, gk, width))
+        fk, gk, width = refine_extremum(gain_at, f[k - 1], f[k + 1], kind, tolerance)
+        found.append(Extremum(output, kind, fk, gk, width))
+        if progress is not None:
+            progress(len(found), len(todo))
     return found
+
+
+# What an extremum of a turning drive's response is (docs/control.md section 5). The turning is a periodic motion
+# whose phase nothing holds (shifted in time it is a motion of the drive too), and its load repeats every turn: a
+# sine at k f_turn, in step with the load's k-th harmonic, does net work on the turning every turn and drives its
+# phase over the whole settling; the speed difference the measurement fits is then the turning's own speed
+# shifted, whose harmonic k sits at f (measured: 97 % of the 168 (rad/s)/V at 6 f_turn on the paper drive
+# remains when the sine stops as the window opens). The fit over a window of W seconds sees a harmonic within
+# the half width of its main lobe, 1 / (2 W): a peak there is the turning's harmonic k, not a resonance. A mechanical
+# resonance of a compliant shaft lies in the band its two-mass resonance f_r(theta) (anti-resonance f_a(theta))
+# spans over a turn (control.reflect), widened by SHAFT_BAND_MARGIN for the damping and the turning's averaging;
+# it is checked first. Anything else is neither: a maximum or minimum of the fit between the harmonics, no
+# resonance of the drive.
+SHAFT_BAND_MARGIN = 0.05
+CAUSES = ("shaft", "turning harmonic", "neither")
+
+
+def turning_cause(f: float, kind: str, f_turn: float, span: float,
+                  bands: Mapping[str, Sequence[float] | None] | None = None) -> tuple[str, int | None]:
+    """(cause, k) of a turning drive's extremum at f [Hz] of ``kind`` ('resonance': a local maximum of |H|,
+    'anti-resonance': a minimum), measured over ``span`` [s]: ('shaft', None) inside the compliant shaft's band of
+    that kind (``bands``: {'resonance': (f_r_min, f_r_max), 'anti-resonance': (f_a_min, f_a_max)} [Hz] for the
+    rotor's speed; the cam's speed has no anti-resonance there, its 'anti-resonance' None; None for a rigid
+    shaft), else ('turning harmonic', k) for a maximum within 1 / (2 span) of k f_turn [Hz], else ('neither',
+    None). See CAUSES' comment."""
+    if not (f_turn > 0.0 and math.isfinite(f_turn)) or not (span > 0.0 and math.isfinite(span)):
+        raise ValueError(f"f_turn = {f_turn!r} Hz, span = {span!r} s: allowed > 0")
+    band = None if bands is None else bands.get(kind)
+    if band is not None and band[0] * (1.0 - SHAFT_BAND_MARGIN) <= f <= band[1] * (1.0 + SHAFT_BAND_MARGIN):
+        return "shaft", None
+    k = round(f / f_turn)
+    if kind == "resonance" and k >= 1 and abs(f - k * f_turn) <= 0.5 / span:
+        return "turning harmonic", int(k)
+    return "neither", None
 
 
 def settle_time(params: Mapping[str, Any] | None, theta0: float) -> float:
@@ -187,5 +227,5 @@ def settle_time(params: Mapping[str, Any] | None, theta0: float) -> float:
     return SETTLE_TIME_CONSTANTS / min(rates) if rates else 0.0
 
 
-__all__ = ["EXTREMUM_PROMINENCE", "EXTREMUM_TOLERANCE", "Extremum", "FROZEN_OFF", "Response", "analytic_response",
+__all__ = ["CAUSES", "SHAFT_BAND_MARGIN", "turning_cause", "EXTREMUM_PROMINENCE", "EXTREMUM_TOLERANCE", "Extremum", "FROZEN_OFF", "Response", "analytic_response",
            "frozen_parameters", "grid_extrema", "linear_model", "locate_extrema", "refine_extremum", "settle_time"]

@@ -35,6 +35,15 @@ ASSUMES = ("the follower on the cam at every angle: a groove's two flanks push a
 RESONANCE_KEYS = ("f_r_min", "f_r_max", "f_a_min", "f_a_max")  # Hz: None with a rigid shaft
 
 
+class FreeFollowerError(ValueError):
+    """The map refuses a follower that can leave the cam; ``closure`` says which ('spring' or 'form')."""
+
+    def __init__(self, closure: str) -> None:
+        self.closure = closure
+        super().__init__(f"closure {closure!r}: the map holds the follower on the cam at every angle (the kinematic "
+                         "rule), while this follower can leave it (docs/model.md section 13)")
+
+
 def two_mass_frequencies(k: float, J_m: float, J_c: float) -> tuple[float, float]:
     """(f_r, f_a) [Hz]: the undamped resonance and anti-resonance that the rotor J_m [kg m^2] sees on a shaft of
     stiffness k [N m/rad] carrying J_c [kg m^2] (docs/model.md 12.3)."""
@@ -49,11 +58,7 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
         raise ValueError(f"points = {points}: at least 8 angles over a turn")
     model = DriveModel(params)
     if model.free_follower:
-        raise ValueError(f"closure {model.closure!r}: the map holds the follower on the cam at every angle (the "
-                         "kinematic rule), while this follower can leave it (docs/model.md section 13); for where "
-                         "and at what speed it does, use cam-fmu jump"
-                         + ("; for the map with the follower held on the cam (the clearance ignored), --set "
-                            "closure=kinematic" if model.closure == "form" else ""))
+        raise FreeFollowerError(model.closure)
     omega = rpm * 2.0 * math.pi / 60.0
     direction = 1.0 if omega > 0.0 else -1.0
     thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
@@ -95,5 +100,5 @@ def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
     return out
 
 
-__all__ = ["COLUMNS", "FREQUENCIES", "PARTS", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary",
+__all__ = ["COLUMNS", "FREQUENCIES", "PARTS", "FreeFollowerError", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary",
            "two_mass_frequencies"]

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
@@ -48,18 +48,24 @@ CHUNK_HOLDS = 1 << 16
 @dataclass(frozen=True)
 class OperatingPoint:
     """What a measurement around one operating point needs: the engine's parameters, u0 [V], the settling time
-    [s], the measurement window's floor [s] (two turns while turning) and a note saying what it is."""
+    [s], the measurement window's floor [s] (two turns while turning), a note saying what it is and, while
+    turning, the cam's turning frequency f_turn [Hz] (turns per second; None at a frozen angle)."""
 
     params: dict
     u0: float
     settle: float
     window: float
     note: str
+    f_turn: float | None = None
 
     def holds(self, f: float) -> tuple[int, int]:
         """(held values before the measurement, periods measured) at f [Hz] (the settling rule)."""
         return (HOLDS_PER_PERIOD * max(SETTLE_PERIODS, math.ceil(self.settle * f)),
                 max(MEASURE_PERIODS, math.ceil(self.window * f)))
+
+    def span(self, f: float) -> float:
+        """The measured window [s] at f [Hz]: the periods of the fit (the settling rule)."""
+        return self.holds(f)[1] / f
 
     def work(self, f: float) -> tuple[int, float]:
         """(held values of one run, the engine's internal steps at least: simulated time / h_max) at f [Hz]."""
@@ -158,8 +164,23 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
     turn_rate = abs(theta[-1] - theta[half]) / ((len(theta) - half) * h) / (2.0 * math.pi)  # turns per second
     if not turn_rate > 1e-3:
         raise ValueError(f"u0 = {u0!r} V: the cam does not turn (it comes to rest); give a frozen angle instead")
+    turn_rate = _turn_rate(theta[half:], h) or turn_rate
     return OperatingPoint(p, u0, settle, 2.0 / turn_rate, f"turning under u0 = {u0:.6g} V at "
-                          f"{60.0 * turn_rate:.4g} 1/min (the first harmonic at f, averaged over at least two turns)")
+                          f"{60.0 * turn_rate:.6g} 1/min, {turn_rate:.6g} turns/s (the first harmonic at f, averaged "
+                          "over at least two turns)", turn_rate)
+
+
+def _turn_rate(theta: np.ndarray, h: float) -> float | None:
+    """Turns per second [1/s] between the first and the last whole turn completed in ``theta`` [rad], sampled
+    every h [s] (each crossing of a multiple of 2 pi interpolated linearly): exact for a periodic turning, while
+    theta's mean slope over a part of a turn is off by the speed's ripple. None under two crossings."""
+    turns = np.floor(theta / (2.0 * math.pi))
+    k = np.nonzero(np.diff(turns))[0]
+    if len(k) < 2:
+        return None
+    level = 2.0 * math.pi * np.maximum(turns[k], turns[k + 1])
+    t = (k + (level - theta[k]) / (theta[k + 1] - theta[k])) * h
+    return (len(k) - 1) / abs(t[-1] - t[0])
 
 
 def _measured_run(p: Mapping[str, Any], u: np.ndarray, hold: float, settle_holds: int) -> np.ndarray:
@@ -174,14 +195,16 @@ def _measured_run(p: Mapping[str, Any], u: np.ndarray, hold: float, settle_holds
 
 
 def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], theta0: float | None = None,
-                      u0: float | None = None, amplitude: float = 1e-3, point: OperatingPoint | None = None) -> Response:
+                      u0: float | None = None, amplitude: float = 1e-3, point: OperatingPoint | None = None,
+                      progress: Callable[[int, int], None] | None = None) -> Response:
     """H(j 2 pi f) measured on the C engine by small-signal simulation (module docstring).
 
     ``theta0`` [rad]: the frozen-angle operating point (friction and backlash off, u0 from gravity); else the
     drive turning under ``u0`` [V] with everything its parameters model (or ``point``, from operating_point).
     ``amplitude`` [V] of the sine. Each frequency runs the drive twice from the same start, with and without the
     sine, and fits the difference: the operating point's own motion (the cam's turning, a settling transient)
-    cancels exactly. A frequency out of reach (OperatingPoint.reachable) is refused before anything runs."""
+    cancels exactly. A frequency out of reach (OperatingPoint.reachable) is refused before anything runs.
+    ``progress(done, total)``: called before the first frequency and after each (e.g. progress.ProgressBar)."""
     if not (math.isfinite(amplitude) and amplitude > 0.0):
         raise ValueError(f"amplitude = {amplitude!r} V: allowed > 0")
     f = np.asarray(f, dtype=float)
@@ -193,7 +216,9 @@ def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], thet
     p, u0 = point.params, point.u0
     columns = [OUTPUT_NAMES.index("omega_m"), OUTPUT_NAMES.index("omega")]
     motor, cam = [], []
-    for fk in f:
+    if progress is not None:
+        progress(0, len(f))
+    for k, fk in enumerate(f):
         period = 1.0 / fk
         hold = period / HOLDS_PER_PERIOD
         h = hold / OUTPUTS_PER_HOLD
@@ -209,6 +234,8 @@ def measured_response(params: Mapping[str, Any] | None, f: Sequence[float], thet
         difference = excited - base
         motor.append(_harmonic(t_end, difference[:, 0], w) / U)
         cam.append(_harmonic(t_end, difference[:, 1], w) / U)
+        if progress is not None:
+            progress(k + 1, len(f))
     return Response(f, np.array(motor), np.array(cam), float(u0), point.note)
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
@@ -24,6 +24,9 @@ from ..engine import targets
 from . import macho
 
 HOST = "host"  # this machine with the system C compiler, not zig (an installed package without the build extra)
+# progress(done, total, note): called before each target (note: "building <target>") and once all are built (note
+# ""), e.g. experiments.progress.ProgressBar (build_fmu.py passes one: a first build takes minutes)
+Progress = Callable[..., None]
 
 
 class BinaryBuildError(RuntimeError):
@@ -42,25 +45,33 @@ def resolve(names: Sequence[str] | None) -> list[str]:
     return names
 
 
-def compile_all(folder: Path, identifier: str, names: Sequence[str], compile_one) -> dict[str, Path]:
+def compile_all(folder: Path, identifier: str, names: Sequence[str], compile_one,
+                progress: Progress | None = None) -> dict[str, Path]:
     """``compile_one(dest, target)`` for each of ``names`` (``target``: a row of the table, or None for ``host``),
-    ``dest`` = ``folder/<name>/<identifier><suffix>``; returns {name: library}."""
+    ``dest`` = ``folder/<name>/<identifier><suffix>``; returns {name: library}. ``progress``: see Progress."""
     def one(name: str) -> Path:
         row = targets.host() if name == HOST else targets.get(name)
         return compile_one(folder / name / f"{identifier}{row.suffix}", None if name == HOST else row)
 
-    return {name: one(name) for name in names}
+    built = {}
+    for k, name in enumerate(names):
+        if progress is not None:
+            progress(k, len(names), note=f"building {name}")
+        built[name] = one(name)
+    if progress is not None:
+        progress(len(names), len(names), note="")
+    return built
 
 
 def compile_sources(folder: Path, identifier: str, sources: Sequence[Path], include: Sequence[Path] = (),
                     defines: Mapping[str, str] | None = None, names: Sequence[str] | None = None,
-                    extra_flags: Sequence[str] = ()) -> dict[str, Path]:
+                    extra_flags: Sequence[str] = (), progress: Progress | None = None) -> dict[str, Path]:
     """The C ``sources`` (with ``include``, ``defines``, ``extra_flags``) compiled for ``names`` (default: every
-    target) into ``folder``; returns {name: library}."""
+    target) into ``folder``; returns {name: library}. ``progress``: see Progress."""
     def one(dest: Path, row):
         return engine_build.compile_shared(dest, sources, include, defines, row, extra_flags)
 
-    return compile_all(folder, identifier, resolve(names), one)
+    return compile_all(folder, identifier, resolve(names), one, progress)
 
 
 def place(root: Path, identifier: str, fmi_version: int, built: Mapping[str, Path]) -> list[Path]:
@@ -94,4 +105,4 @@ def build_description(identifier: str, files: Sequence[str], language: str = "C9
     return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
 
 
-__all__ = ["HOST", "BinaryBuildError", "build_description", "compile_all", "compile_sources", "place", "resolve"]
+__all__ = ["HOST", "BinaryBuildError", "Progress", "build_description", "compile_all", "compile_sources", "place", "resolve"]

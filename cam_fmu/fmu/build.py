@@ -176,19 +176,25 @@ def fmi_version(path: str | Path) -> str:
         return "?"
 
 
-def shipped_files() -> list[Path]:
-    """The FMUs and SSPs a distribution wheel carries (``models/`` of this checkout, built first where stale)."""
-    return [*(ensure_fmu(None, model=name) for name in MODELS), *(ensure_ssp(name) for name in SSP_NAMES)]
+def shipped_files(log: Callable[[str], None] | None = None) -> list[Path]:
+    """The FMUs and SSPs a distribution wheel carries (``models/`` of this checkout, built first where stale;
+    ``log``: told what is built)."""
+    return [*(ensure_fmu(None, log, model=name) for name in MODELS), *(ensure_ssp(name, log) for name in SSP_NAMES)]
 
 
-def build_wheels(folder: Path, names: Sequence[str] | None = None) -> list[Path]:
+def build_wheels(folder: Path, names: Sequence[str] | None = None,
+                 progress: binaries.Progress | None = None) -> list[Path]:
     """One wheel per target of engine/targets.py (``names``; default all) into ``folder``: py3-none-<platform>,
-    the engine library compiled by zig for it and the shipped FMUs and SSPs (setup.py). Returns the wheels."""
+    the engine library compiled by zig for it and the shipped FMUs and SSPs (setup.py). Returns the wheels.
+    ``progress(done, total, note=...)``: told which wheel is being built (binaries.Progress)."""
     folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
-    shipped_files()  # built once here, not once per wheel
+    shipped_files(None if progress is None else lambda m: print(m, file=sys.stderr))  # once here, not per wheel
     made = []
-    for name in names or targets.NAMES:
+    names = list(names or targets.NAMES)
+    for k, name in enumerate(names):
+        if progress is not None:
+            progress(k, len(names), note=f"building {name}")
         row = targets.get(name)
         proc = subprocess.run([sys.executable, "-m", "pip", "wheel", ".", "--no-deps", "--no-build-isolation", "-q",
                                "-w", str(folder)], cwd=PACKAGE_DIR.parent, capture_output=True, text=True,
@@ -197,17 +203,21 @@ def build_wheels(folder: Path, names: Sequence[str] | None = None) -> list[Path]
         if proc.returncode != 0 or not wheels:
             raise BuildError(f"the {name} wheel: pip wheel failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
         made.append(wheels[0])
+    if progress is not None:
+        progress(len(names), len(names), note="")
     return made
 
 
-def build(dest: Path, model: str = "cam", platforms: Sequence[str] | None = None) -> Path:
+def build(dest: Path, model: str = "cam", platforms: Sequence[str] | None = None,
+          progress: binaries.Progress | None = None) -> Path:
     """Build the FMU of ``model`` (one of MODELS) at ``dest`` (a path ending in .fmu) and return it.
-    ``platforms``: its binaries' targets (engine/targets.py; default all, ``["host"]``: this machine only)."""
+    ``platforms``: its binaries' targets (engine/targets.py; default all, ``["host"]``: this machine only);
+    ``progress(done, total, note=...)``: told which platform is being built (binaries.Progress)."""
     if model not in MODELS:
         raise BuildError(f"model {model!r}: allowed {', '.join(map(repr, MODELS))}")
     c_model, fmi_version = ENGINE_MODELS[model]
     try:
-        return engine_fmu.build(dest, fmi_version=fmi_version, model=c_model, platforms=platforms)
+        return engine_fmu.build(dest, fmi_version=fmi_version, model=c_model, platforms=platforms, progress=progress)
     except (engine_fmu.FmuBuildError, targets.TargetError) as exc:
         raise BuildError(str(exc)) from None
 
@@ -221,7 +231,17 @@ def build_ssp(dest: Path, cam: Path, pi_speed: Path, name: str = SSP_NAME) -> Pa
     return ssp.write_ssp(system, {"cam": cam, "controller": pi_speed}, dest)
 
 
-def main(argv: List[str] | None = None) -> int:
+def main(argv: List[str] | None = None, progress: Callable[[str], binaries.Progress] | None = None) -> int:
+    """The build's command line. ``progress(label)``: a progress callback for one FMU or the wheels, with
+    ``close()`` (build_fmu.py passes experiments.progress.ProgressBar: a bar on stderr naming the FMU and the
+    platform being built; without it, nothing but the paths built, on stdout)."""
+    def bar(label: str):
+        return progress(label) if progress is not None else None
+
+    def done(one) -> None:
+        if one is not None:
+            one.close()
+
     parser = argparse.ArgumentParser(prog="build_fmu.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--dest", type=Path, default=None,
                         help="build one FMU (--model, default cam) into this file; without --dest: "
@@ -238,13 +258,25 @@ def main(argv: List[str] | None = None) -> int:
     platforms = None if args.platforms == "all" else args.platforms.split(",")
     try:
         if args.wheels is not None:
-            for wheel in build_wheels(args.wheels, platforms):
+            one = bar("build wheels")
+            try:
+                wheels = build_wheels(args.wheels, platforms, one)
+            finally:
+                done(one)
+            for wheel in wheels:
                 print(wheel)
             return 0
+        todo = {args.model: args.dest} if args.dest is not None else {name: default_model_path(name) for name in MODELS}
+        built = {}
+        for name, dest in todo.items():
+            one = bar(f"build {name}.fmu (FMI {ENGINE_MODELS[name][1]}.0)")
+            try:
+                built[name] = build(dest, name, platforms, one)
+            finally:
+                done(one)
         if args.dest is not None:
-            print(build(args.dest, args.model, platforms))
+            print(built[args.model])
             return 0
-        built = {name: build(default_model_path(name), name, platforms) for name in MODELS}
         for path in built.values():
             print(path)
         for name in SSP_NAMES:

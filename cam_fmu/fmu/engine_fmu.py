@@ -197,11 +197,12 @@ def model_description_xml(m: CModel, guid: str, fmi_version: int, files: Sequenc
 
 
 def build(dest: Path, fmi_version: int = 2, platforms: Sequence[str] | None = None,
-          model: str | CModel = "cam") -> Path:
+          model: str | CModel = "cam", progress: binaries.Progress | None = None) -> Path:
     """Build the FMU of ``model`` for ``fmi_version`` (2 or 3) at ``dest`` (a path ending in .fmu) and return it.
 
     ``platforms``: target names of ``engine.targets`` (default: all, with zig), or ``["host"]``: this machine
-    only, with the system C compiler."""
+    only, with the system C compiler. ``progress(done, total, note=...)``: told which platform is being built
+    (binaries.Progress)."""
     if fmi_version not in GLUE:
         raise FmuBuildError(f"fmi_version {fmi_version!r}: allowed 2 or 3")
     m = _model(model)
@@ -215,7 +216,7 @@ def build(dest: Path, fmi_version: int = 2, platforms: Sequence[str] | None = No
         files = write_sources(folder, m, guid, fmi_version)
         try:
             built = binaries.compile_sources(root / "built", m.identifier, [folder / f for f in files], (folder,),
-                                             names=platforms, extra_flags=BINARY_FLAGS)
+                                             names=platforms, extra_flags=BINARY_FLAGS, progress=progress)
         except (engine_build.EngineBuildError, binaries.BinaryBuildError, targets.TargetError) as exc:
             raise FmuBuildError(f"{m.identifier} (FMI {fmi_version}.0)'s binaries: {exc}") from None
         binaries.place(root / "fmu", m.identifier, fmi_version, built)

@@ -28,7 +28,8 @@ import numpy as np
 from .disc_cam import DiscCam, Program
 from .motion_law import golden_max
 
-__all__ = ["Limits", "CheckReport", "DesignWarning", "check_design", "smallest_base_radius"]
+__all__ = ["Limits", "CheckReport", "DesignWarning", "PressureAngleAdvice", "check_design", "pressure_angle_advice",
+           "smallest_base_radius"]
 
 TWO_PI = 2.0 * math.pi
 GRID = 7200
@@ -57,10 +58,31 @@ class DesignWarning:
     check: str                      # "pressure_angle", "radius_of_curvature", "undercut", "groove_undercut"
     message: str
     at: tuple[float, ...] = ()      # angles [rad] where it occurs (range ends for undercut)
+    advice: "PressureAngleAdvice | None" = None  # the pressure angle's: what lowers it, computed
 
     def to_json_dict(self) -> dict:
-        return {"check": self.check, "message": self.message,
-                "at_deg": [math.degrees(a) for a in self.at]}
+        out = {"check": self.check, "message": self.message, "at_deg": [math.degrees(a) for a in self.at]}
+        if self.advice is not None:
+            out["advice"] = self.advice.to_json_dict()
+        return out
+
+
+@dataclass(frozen=True)
+class PressureAngleAdvice:
+    """What lowers a cam's max pressure angle, each change computed on the cam (m, rad): the in-line follower's
+    (e = 0), the offset that gives the least (|e| < r_b) and that least, and the smallest prime-circle radius
+    at which the max pressure angle meets the limit at the cam's own offset."""
+
+    inline: float                   # max |alpha| at e = 0, the same r_b [rad]
+    best_offset: float              # e [m] of the least max |alpha| at this r_b
+    best: float                     # that least [rad]
+    base_radius: float              # smallest r_b [m] with max |alpha| <= the limit at the cam's offset
+
+    def to_json_dict(self) -> dict:
+        return {"inline_max_pressure_angle_deg": math.degrees(self.inline),
+                "best_offset_mm": self.best_offset * 1e3,
+                "best_offset_max_pressure_angle_deg": math.degrees(self.best),
+                "base_radius_mm": self.base_radius * 1e3}
 
 
 @dataclass(frozen=True)
@@ -202,11 +224,12 @@ def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
 
     warnings = []
     if a_max > limits.max_pressure_angle:
+        advice = pressure_angle_advice(cam, limits.max_pressure_angle)
         warnings.append(DesignWarning(
             "pressure_angle",
             f"max pressure angle {math.degrees(a_max):.4g} deg at theta = {math.degrees(a_at):.5g} deg "
             f"exceeds the limit {math.degrees(limits.max_pressure_angle):.4g} deg "
-            f"(raise the base radius or offset the follower)", (a_at,)))
+            f"({_pressure_angle_text(cam, a_max, a_at, advice, limits.max_pressure_angle)})", (a_at,), advice))
     rho_c = rho_min - r_r
     rho_lim = _min_radius(limits, r_r)
     if under:
@@ -238,6 +261,83 @@ def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
         undercut=bool(under), undercut_ranges=under,
         groove_undercut=bool(groove), groove_undercut_ranges=groove,
         limits=limits, warnings=tuple(warnings))
+
+
+def _max_pressure_angle(s: np.ndarray, s1: np.ndarray, r_b: float, e: float) -> float:
+    """max |alpha| [rad] on the grid's s, s' of a prime circle r_b [m] and offset e [m]."""
+    return float(np.max(np.abs(np.arctan2(s1 - e, math.sqrt(r_b * r_b - e * e) + s))))
+
+
+def _golden_min(f, a: float, b: float, tol: float) -> float:
+    """The argument of the least f between a and b (golden-section search to ``tol``)."""
+    g = (math.sqrt(5.0) - 1.0) / 2.0
+    c, d = b - g * (b - a), a + g * (b - a)
+    fc, fd = f(c), f(d)
+    while b - a > tol:
+        if fc < fd:
+            b, d, fd = d, c, fc
+            c = b - g * (b - a)
+            fc = f(c)
+        else:
+            a, c, fc = c, d, fd
+            d = a + g * (b - a)
+            fd = f(d)
+    return 0.5 * (a + b)
+
+
+def pressure_angle_advice(cam: DiscCam, limit: float) -> PressureAngleAdvice:
+    """What lowers the max pressure angle of ``cam`` (module of the offset's effect: tan alpha = (s' - e) /
+    (sqrt(r_b^2 - e^2) + s), an offset e > 0 lowers it on the rise, s' > 0, and raises it on the return):
+    the in-line follower's, the best offset at this prime circle (a scan of |e| < r_b refined by golden section
+    to 1e-6 r_b) and the smallest prime circle meeting ``limit`` [rad] at the cam's offset (bisection to 1e-6
+    m; the pressure angle falls as r_b grows). Values refined as ``check_design`` refines them."""
+    grid = _grid(cam.program)
+    s, s1, _, _ = cam._derivs(grid)
+    r_b, e, r_r = cam.base_radius, cam.offset, cam.roller_radius
+
+    def exact(r: float, off: float) -> float:
+        other = DiscCam(cam.program, r, r_r, off)
+        return _refined_max(lambda t: abs(other.pressure_angle(t)), grid, np.abs(other.pressure_angle(grid)))[0]
+
+    span = 0.98 * r_b
+    scan = np.linspace(-span, span, 197)
+    k = int(np.argmin([_max_pressure_angle(s, s1, r_b, x) for x in scan]))
+    lo, hi = scan[max(k - 1, 0)], scan[min(k + 1, len(scan) - 1)]
+    best_offset = _golden_min(lambda x: _max_pressure_angle(s, s1, r_b, x), float(lo), float(hi), 1e-6 * r_b)
+    if abs(best_offset) < 1e-6 * r_b:  # within the search's resolution of in line (a symmetric program)
+        best_offset = 0.0
+    lo, hi = max(r_r, abs(e)) * (1.0 + 1e-9) + 1e-12, r_b
+    while _max_pressure_angle(s, s1, hi, e) > limit:
+        lo, hi = hi, 2.0 * hi
+        if hi > 1000.0:
+            break
+    while hi - lo > 1e-6:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if _max_pressure_angle(s, s1, mid, e) <= limit else (mid, hi)
+    while exact(hi, e) > limit and hi < 1000.0:  # the refined maximum, a hair above the grid's
+        hi *= 1.0 + 1e-6
+    return PressureAngleAdvice(inline=exact(r_b, 0.0), best_offset=best_offset, best=exact(r_b, best_offset),
+                               base_radius=hi)
+
+
+def _pressure_angle_text(cam: DiscCam, a_max: float, a_at: float, advice: PressureAngleAdvice, limit: float) -> str:
+    """The warning's advice in words: the offset's part in the excess, what to change, the numbers computed."""
+    deg, e, best = math.degrees, cam.offset, advice.best_offset
+    side = "rise" if cam._derivs(a_at)[1] > 0.0 else "return"
+    parts = []
+    if e != 0.0 and advice.inline < a_max:
+        parts.append(f"the offset e = {e * 1e3:.4g} mm raises it on the {side}")
+    if advice.best < a_max * (1.0 - 1e-6):
+        meets = "meets the limit" if advice.best <= limit else "still above the limit"
+        if best == 0.0:
+            parts.append(f"remove the offset: in line, e = 0, it is {deg(advice.best):.4g} deg, the least ({meets})")
+        else:
+            verb = ("offset the follower by" if e == 0.0 else "reverse the offset to" if best * e < 0.0
+                    else "reduce the offset to" if abs(best) < abs(e) else "increase the offset to")
+            parts.append(f"{verb} e = {best * 1e3:.4g} mm: {deg(advice.best):.4g} deg, the least ({meets})")
+    parts.append(f"{'or ' if parts else ''}raise the base radius: r_b = {advice.base_radius * 1e3:.5g} mm meets the "
+                 f"limit at e = {e * 1e3:.4g} mm")
+    return "; ".join(parts)
 
 
 def smallest_base_radius(program: Program, roller_radius: float, offset: float = 0.0,

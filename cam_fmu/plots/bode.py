@@ -5,9 +5,12 @@ from pathlib import Path
 from typing import Any, Sequence
 
 
-def plot_bode(measured: Any, analytic: Any, title: str, path: Path, extrema: Sequence[Any] = ()) -> Path:
+def plot_bode(measured: Any, analytic: Any, title: str, path: Path, extrema: Sequence[Any] = (),
+              causes: Sequence[str] | None = None) -> Path:
     """A Bode plot of control.frequency Responses: measured as markers, the analytic response as lines, each located
-    resonance (a triangle up) and anti-resonance (a triangle down) marked and labelled with its frequency."""
+    resonance (a triangle up) and anti-resonance (a triangle down) marked and labelled with its frequency.
+    ``causes``: what each extremum is, added to its label (a turning drive's: 'harmonic 6', 'shaft', ...); then the
+    legend calls the triangles maxima and minima, since not every one is a resonance."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -25,15 +28,17 @@ def plot_bode(measured: Any, analytic: Any, title: str, path: Path, extrema: Seq
             gain.loglog(analytic.f, np.abs(exact), "-", color=color, linewidth=1.0, label=f"{label} (linearised)")
             phase.semilogx(analytic.f, np.degrees(np.unwrap(np.angle(exact))), "-", color=color, linewidth=1.0)
     colors = {"motor": "tab:blue", "cam": "tab:orange"}
-    for ex in extrema:
+    for k, ex in enumerate(extrema):
         up = ex.kind == "resonance"
         gain.plot([ex.f], [ex.gain], "^" if up else "v", color=colors[ex.output], markersize=9,
                   markeredgecolor="black", zorder=5)
-        gain.annotate(f"{ex.f:.4g} Hz", (ex.f, ex.gain), textcoords="offset points", xytext=(6, 8 if up else -14),
+        note = f"{ex.f:.4g} Hz" + (f", {causes[k]}" if causes is not None and causes[k] else "")
+        gain.annotate(note, (ex.f, ex.gain), textcoords="offset points", xytext=(6, 8 if up else -14),
                       fontsize=7, color=colors[ex.output])
     if extrema:
-        gain.plot([], [], "^", color="grey", markeredgecolor="black", label="resonance (located)")
-        gain.plot([], [], "v", color="grey", markeredgecolor="black", label="anti-resonance (located)")
+        up, down = (("resonance", "anti-resonance") if causes is None else ("maximum", "minimum"))
+        gain.plot([], [], "^", color="grey", markeredgecolor="black", label=f"{up} (located)")
+        gain.plot([], [], "v", color="grey", markeredgecolor="black", label=f"{down} (located)")
     gain.set_ylabel("|H| [(rad/s)/V]")
     gain.grid(True, which="both", alpha=0.3)
     gain.legend(fontsize=8)

@@ -119,3 +119,46 @@ def test_bad_table_is_an_error(tmp_path, capsys):
     t.write_text("angle_deg,lift_mm\n0,0\n90,5\n90,6\n")
     rc, _, err = run(capsys, "--roller-radius-mm", "10", "--table", str(t))
     assert rc == 2 and "angles must increase strictly" in err
+
+
+def _max_alpha(prog, r_b: float, e: float) -> float:
+    """max |pressure angle| [deg] by the closed form tan alpha = (s' - e) / (sqrt(r_b^2 - e^2) + s) on a dense grid."""
+    th = np.linspace(0, 2 * math.pi, 200001)
+    s, s1, _, _ = prog.evaluate(th)
+    return float(np.degrees(np.abs(np.arctan((s1 - e) / (math.sqrt(r_b ** 2 - e ** 2) + s)))).max())
+
+
+@pytest.mark.parametrize("argv, prog, cause", [
+    # the paper's symmetric cam, 10 mm offset: the offset is the cause (in line it passes, 29.24 deg)
+    (["--offset-mm", "10"], paper_program(), "the offset e = 10 mm raises it on the return"),
+    (["--offset-mm", "-10"], paper_program(), "the offset e = -10 mm raises it on the rise"),
+    # a steep rise (120 deg) and a gentle return: the offset that lowers it is positive, -5 mm must be reversed
+    (["--rise-deg", "120", "--return-deg", "240", "--offset-mm", "-5"],
+     CamProgram("paper", "paper", lift=1.5 * math.pi * 0.035, rise_angle=math.radians(120), upper_dwell=0.0,
+                return_angle=math.radians(240), lower_dwell=0.0), "reverse the offset to e = "),
+])
+def test_pressure_angle_advice_lowers_it(capsys, argv, prog, cause):
+    """`contour --offset-mm 10` said "offset the follower" when the offset was the cause. Every change advised
+    lowers the max pressure angle, by the closed form on a dense grid: the offset advised (the least: 0.5 mm
+    either side is no lower), the in-line follower where it is the cure, and the base radius (the smallest that
+    meets the limit at the cam's own offset)."""
+    rc, out, _ = run(capsys, "--roller-radius-mm", "5", *argv, "--json")
+    assert rc == 0
+    d = json.loads(out)
+    (warning,) = [w for w in d["warnings"] if w["check"] == "pressure_angle"]
+    message, advice = warning["message"], warning["advice"]
+    assert cause in message and "offset the follower" not in message, message
+    r_b, e, limit = 0.1, d["offset_mm"] * 1e-3, d["limits"]["max_pressure_angle_deg"]
+    now = _max_alpha(prog, r_b, e)
+    assert d["max_pressure_angle_deg"] == pytest.approx(now, abs=1e-5) and now > limit
+    best = advice["best_offset_mm"] * 1e-3
+    assert f"e = {advice['best_offset_mm']:.4g} mm" in message or (best == 0.0 and "in line, e = 0" in message)
+    at_best = _max_alpha(prog, r_b, best)
+    assert at_best < now - 0.1 and at_best == pytest.approx(advice["best_offset_max_pressure_angle_deg"], abs=1e-5)
+    assert _max_alpha(prog, r_b, best - 5e-4) > at_best and _max_alpha(prog, r_b, best + 5e-4) > at_best
+    assert advice["inline_max_pressure_angle_deg"] == pytest.approx(_max_alpha(prog, r_b, 0.0), abs=1e-5)
+    if "raises it" in message:
+        assert advice["inline_max_pressure_angle_deg"] < now
+    r_min = advice["base_radius_mm"] * 1e-3
+    assert f"r_b = {advice['base_radius_mm']:.5g} mm" in message
+    assert _max_alpha(prog, r_min, e) <= limit + 1e-6 and _max_alpha(prog, r_min * (1 - 1e-4), e) > limit

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -61,7 +62,7 @@ def test_jump_prints_its_results(tmp_path):
     (["jump", "groove_crossover"], "it does not jump"),
     (["jump", "spring_jump", "--safety", "0.5"], "--safety 0.5"),
     (["jump", "spring_jump", "--rpm", "-3"], "--rpm -3"),
-    (["reflect", "spring_jump"], "use cam-fmu jump"),
+    (["reflect", "spring_jump"], "`cam-fmu jump spring_jump`"),
     (["bode", "paper_fig6", "--set", "closure=spring"], "no small-signal model"),
     # a groove with a clearance (closure 'form', the default): the follower can fly; the paper's rule on request
     (["reflect", "backlash"], "closure 'form'"), (["reflect", "backlash"], "--set closure=kinematic"),
@@ -70,6 +71,30 @@ def test_jump_prints_its_results(tmp_path):
 def test_refusals_say_why(args, message, tmp_path):
     done = cli(*args, "--out", str(tmp_path), cwd=tmp_path)
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("scene, sets", [
+    ("backlash", []),  # closure 'form' with a clearance: `jump` refuses a groove, so reflect must not advise it
+    ("backlash", ["--set", "c=1e-3", "--set", "m=0.5"]),
+    ("spring_jump", []),
+    ("paper_fig6", ["--set", "closure=spring", "--set", "F_spring0=30"]),
+])
+def test_reflect_advises_only_commands_that_run_on_the_scene(scene, sets, tmp_path):
+    """Every command the refusal advises is run as written (with --out and --no-plot added) and succeeds; for a
+    groove (closure 'form') that is not `cam-fmu jump`, which refuses it."""
+    import shlex
+
+    done = cli("reflect", scene, *sets, "--out", str(tmp_path / "refused"), cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    advised = re.findall(r"`(cam-fmu [^`]+)`", done.stderr)
+    closure = "spring" if "closure=spring" in sets or scene == "spring_jump" else "form"
+    assert [shlex.split(c)[1] for c in advised] == (["jump"] if closure == "spring" else ["reflect", "simulate"])
+    for k, command in enumerate(advised):
+        words = shlex.split(command)
+        assert words[2] == scene and " ".join(sets) in command
+        ran = cli(*words[1:], "--out", str(tmp_path / str(k)), "--no-plot", cwd=tmp_path)
+        assert ran.returncode == 0, (command, ran.stderr)
+        assert ran.stdout.strip()
 
 
 def test_reflect_says_what_it_assumes(tmp_path):

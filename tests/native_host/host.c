@@ -48,6 +48,19 @@
 
 #include "fmi2FunctionTypes.h"
 
+/* A copy of text in memory of its own (free() it): what strdup does, which C99 lacks (POSIX declares it, and
+ * under -std=c99 neither glibc nor clang does without _POSIX_C_SOURCE; an undeclared strdup returns int). */
+static char *copy_text(const char *text)
+{
+    size_t n = strlen(text) + 1;
+    char *copy = malloc(n);
+    if (!copy) {
+        fprintf(stderr, "host: out of memory\n");
+        exit(1);
+    }
+    return memcpy(copy, text, n);
+}
+
 static void json_string(const char *s)
 {
     putchar('"');
@@ -221,7 +234,7 @@ int main(int argc, char **argv)
             fmi2ValueReference vrs[64];
             const char *values[64];
             size_t n = 0;
-            char *list = strdup(argv[++k]);
+            char *list = copy_text(argv[++k]);
             for (int i = 0; i < 64; i++) values[i] = "junk";
             for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
             free(list);
@@ -243,7 +256,7 @@ int main(int argc, char **argv)
             fmi2ValueReference vrs[64];
             double values[64];
             size_t n = 0;
-            char *list = strdup(argv[++k]);
+            char *list = copy_text(argv[++k]);
             for (int i = 0; i < 64; i++) values[i] = -1.5;
             for (char *t = strtok(list, ","); t && n < 64; t = strtok(NULL, ",")) vrs[n++] = (fmi2ValueReference)atoi(t);
             free(list);

@@ -263,3 +263,83 @@ def test_every_numeric_option_of_every_command_takes_a_negative_number_in_any_no
                 assert (value if isinstance(action.nargs, int) else [value]) == [action.type(text)] * count, name
                 checked += 1
     assert checked >= 10
+
+
+# ------------------------------------------------------------------ a turning drive: what each extremum is
+def _turning_frequency(params, u0: float, stop: float = 12.0) -> float:
+    """Turns per second of the drive turning under u0 [V], from the scipy reference (independent of the engine
+    and of bode's operating point): the last whole turn between two crossings of a multiple of 2 pi."""
+    from cam_fmu.physics.signals import constant
+    from cam_fmu.reference.integrate import simulate_reference
+
+    run = simulate_reference(params, stop, 1e-3, u=constant(u0))
+    t, theta = run["time"], run["theta"]
+    turns = np.floor(theta / (2 * math.pi))
+    k = np.nonzero(np.diff(turns))[0]
+    crossings = [np.interp(2 * math.pi * turns[j + 1], theta[j:j + 2], t[j:j + 2]) for j in k[-2:]]
+    return 1.0 / (crossings[1] - crossings[0])
+
+
+def test_a_turning_drives_peaks_are_the_turnings_harmonics_not_resonances(tmp_path):
+    """`bode --u0 3.5` called a peak of 174 (rad/s)/V at 8.23 Hz a resonance. On the rigid paper drive turning
+    under 3.5 V (no mechanical resonance at all) every peak between 5 and 12 Hz is a multiple of the turning
+    frequency: the 4th, 6th and 8th harmonics, hundreds of times the response between them, and even, as the
+    paper's cam repeats its load every half turn (rise and return mirror images of a symmetric law). None is
+    called a resonance, in the text or the JSON."""
+    args = [sys.executable, "-m", "cam_fmu", "bode", "paper_fig6", "--u0", "3.5", "--fmin", "5", "--fmax", "12",
+            "--points", "8", "--no-plot", "--out", str(tmp_path)]
+    summary = json.loads(subprocess.run([*args, "--json"], capture_output=True, text=True, check=True).stdout)
+    f_turn = _turning_frequency(dict(find_scene("paper_fig6").primary.params), 3.5)
+    assert summary["f_turn"] == pytest.approx(f_turn, rel=1e-4) and summary["shaft_bands"] is None
+    peaks = [e for e in summary["extrema"] if e["kind"] == "peak"]
+    assert {e["kind"] for e in summary["extrema"]} <= {"peak", "dip"}  # a rigid shaft: nothing mechanical
+    for e in summary["extrema"]:
+        k = round(e["f"] / f_turn)
+        if e["cause"] == "turning harmonic":
+            assert e["kind"] == "peak" and e["harmonic"] == k and abs(e["f"] / (k * f_turn) - 1) < 5e-3, e
+        else:
+            assert e["cause"] == "neither" and e["harmonic"] is None, e
+    harmonics = sorted({e["harmonic"] for e in peaks if e["cause"] == "turning harmonic"})
+    assert harmonics == [4, 6, 8], summary["extrema"]
+    dips = [e["gain"] for e in summary["extrema"] if e["kind"] == "dip"]
+    assert min(e["gain"] for e in peaks) > 100 * max(dips)
+    text = subprocess.run([*args[:7], "--fmin", "7.5", "--fmax", "9", "--points", "3", *args[-3:]],
+                          capture_output=True, text=True, check=True).stdout  # the 6th harmonic alone, in words
+    assert "resonance" not in text.replace("not a resonance", "").replace("no mechanical resonance", ""), text
+    assert text.count(" speed: peak at ") == 2 and text.count(": the turning's harmonic 6 (6 x 1.3758") == 2, text
+
+
+def test_what_an_extremum_of_a_turning_drive_is():
+    """turning_cause: the shaft's band first (of the extremum's kind), then a maximum within half the fit's main
+    lobe, 1 / (2 span), of a multiple of f_turn; a minimum is never a harmonic; anything else is neither."""
+    from cam_fmu.control.frequency import turning_cause
+
+    bands = {"resonance": (207.0, 363.0), "anti-resonance": (25.3, 300.0)}
+    assert turning_cause(8.2242, "resonance", 1.37139, 1.46) == ("turning harmonic", 6)
+    assert turning_cause(8.2242, "resonance", 1.37139, 1.46, bands) == ("turning harmonic", 6)
+    assert turning_cause(8.2283 + 0.5 / 1.46 * 1.01, "resonance", 1.37139, 1.46) == ("neither", None)
+    assert turning_cause(8.2283, "anti-resonance", 1.37139, 1.46) == ("neither", None)
+    assert turning_cause(205.6, "resonance", 1.37139, 1.46, bands) == ("shaft", None)  # 0.7 % below f_r_min
+    assert turning_cause(48.0, "anti-resonance", 1.37139, 1.46, bands) == ("shaft", None)
+    assert turning_cause(48.0, "resonance", 1.37139, 1.46, bands) == ("turning harmonic", 35)
+    assert turning_cause(400.0, "resonance", 1.37139, 1.46, bands) == ("neither", None)  # 10 % above the band
+    cam = {"resonance": bands["resonance"], "anti-resonance": None}  # the cam's speed has no anti-resonance
+    assert turning_cause(48.0, "anti-resonance", 1.37139, 1.46, cam) == ("neither", None)
+    with pytest.raises(ValueError, match="f_turn"):
+        turning_cause(8.0, "resonance", 0.0, 1.0)
+
+
+def test_the_shaft_band_of_a_turning_drive_is_the_two_mass_closed_form():
+    """bode's shaft bands are f_r and f_a of the rotor against the cam side J_cam + m s'^2 at the lightest and the
+    heaviest angle (docs/model.md 12.3)."""
+    from cam_fmu.cli.bode import shaft_bands
+
+    model = DriveModel(SHAFT)
+    s1 = np.array([model.program.derivatives(t)[1] for t in np.linspace(0, 2 * math.pi, 7201)])
+    light, heavy = model.J_0 + model.m * (s1 ** 2).min(), model.J_0 + model.m * (s1 ** 2).max()
+    bands = shaft_bands(SHAFT, 1.37)
+    f_r_heavy, f_a_heavy = two_mass_frequencies(model.k_shaft, model.J_m, heavy)
+    f_r_light, f_a_light = two_mass_frequencies(model.k_shaft, model.J_m, light)
+    assert bands["resonance"] == pytest.approx([f_r_heavy, f_r_light], rel=1e-5)
+    assert bands["anti-resonance"] == pytest.approx([f_a_heavy, f_a_light], rel=1e-5)
+    assert shaft_bands(dict(SHAFT, k_shaft=0.0), 1.37) is None

@@ -63,15 +63,19 @@ def fmi2_include_dir() -> Path:
     return fmi_headers(2)
 
 
+def defines() -> dict[str, object]:
+    """The macros c_floor/floor.c is compiled with: its variable counts, value references and u's start [V]."""
+    vrs = value_references()
+    return {"N_INPUTS": len(INPUTS), "N_OUTPUTS": len(OUTPUTS), "VR_U": vrs["u"], "VR_THETA": vrs["theta"],
+            "VR_OMEGA": vrs["omega"], "START_U": repr(float(dict((n, s) for n, _u, s, _d in INPUTS)["u"]))}
+
+
 def compile_binary(dest_so: Path, compiler: str | None = None) -> Path:
     from ...engine.build import find_compiler
 
-    vrs = value_references()
     cc = compiler or find_compiler()
-    defines = {"N_INPUTS": len(INPUTS), "N_OUTPUTS": len(OUTPUTS), "VR_U": vrs["u"], "VR_THETA": vrs["theta"],
-               "VR_OMEGA": vrs["omega"], "START_U": repr(float(dict((n, s) for n, _u, s, _d in INPUTS)["u"]))}
     cmd = [cc, "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", f"-I{fmi2_include_dir()}",
-           *(f"-D{k}={v}" for k, v in defines.items()), str(C_SOURCE), "-o", str(dest_so)]
+           *(f"-D{k}={v}" for k, v in defines().items()), str(C_SOURCE), "-o", str(dest_so)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         raise CFloorError(f"compiling {C_SOURCE.name} failed:\n{' '.join(cmd)}\n{proc.stderr}")
