@@ -29,7 +29,7 @@ from ..physics.formulations.consistent import HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
-from .flight import follower_speed_reference, next_breakpoint, speed_motion
+from .flight import follower_speed_reference, next_breakpoint, piece_input, speed_motion
 from .voltage_flight import follower_voltage_reference
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
@@ -120,6 +120,7 @@ class _Consistent:
             if t >= stop - 1e-12:
                 break
             t_end = next(b for b in breaks if b > t + 1e-12)
+            self.piece_end = t_end   # the piece's input up to t_end is its own (flight.piece_input)
             # theta is integrated relative to the last whole turn: rtol then acts on
             # an angle below 4 pi, not on the unbounded theta (long runs keep their accuracy).
             base = 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
@@ -203,11 +204,11 @@ class _Consistent:
         return tol
 
     def _rhs(self, mode, base: float):
-        hybrid, model, u, n = self.hybrid, self.model, self.u, self.hybrid.size
-        energy = self.energy
+        hybrid, model, n = self.hybrid, self.model, self.hybrid.size
+        energy, u_at = self.energy, piece_input(self.u, self.piece_end)
 
         def rhs(t, y):
-            u_t = u.value(t)
+            u_t = u_at(t)[0]
             state = [y[0] + base, *y[1:n]]
             dy = list(hybrid.derivative(state, u_t, mode))
             if energy:
@@ -222,8 +223,8 @@ class _Consistent:
         return rhs
 
     def _event(self, k: int, mode, base: float):
-        hybrid, u, n = self.hybrid, self.u, self.hybrid.size
-        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u.value(t), mode)[k]
+        hybrid, n, u_at = self.hybrid, self.hybrid.size, piece_input(self.u, self.piece_end)
+        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u_at(t)[0], mode)[k]
 
     @staticmethod
     def _breakpoint_event(target: float, direction: float):
