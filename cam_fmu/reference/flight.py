@@ -11,6 +11,7 @@ many so far).
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -107,7 +108,7 @@ def speed_motion(omega: float, omega_dot: float, t: float) -> float:
     return omega if abs(omega) > 1e-12 * max(1.0, abs(t)) * abs(omega_dot) else -omega_dot
 
 
-def piece_input(signal: Signal, end: float):
+def piece_input(signal: Signal, end: float) -> Callable[[float], tuple[float, float]]:
     """(value, slope) of ``signal`` as a function of t within a piece that ends at ``end`` [s]: at the end, an input's
     break, the piece's own (the left limit). solve_ivp evaluates the right-hand side and the events at the end point;
     with the value after the break there, an event that the break itself makes (a break-away at a step of u) was
