@@ -40,7 +40,7 @@ SLOW = {  # measured: a full run's --durations
     "test_sweep", "test_bench", "test_cross_check", "test_docs", "test_engine_fmu_me", "test_compliant_shaft",
     "test_frequency", "test_reflect", "test_fmi_formulations", "test_plots", "test_cli_errors", "test_ssp_file",
     "test_fmi_wrong_answers", "test_saved_states", "test_reference", "test_motion_table", "test_mounting",
-    "test_fmu_build", "test_engine_profile", "test_fmi_pole", "test_symbolic_route",
+    "test_fmu_build", "test_engine_profile", "test_fmi_pole", "test_symbolic_route", "test_input_discontinuities",
 }
 
 

@@ -14,7 +14,10 @@ k_spring (at the scene's F_spring0) that hold the follower at that speed with th
 sqrt(S) x target). Writes DIR/<scene>_jump.png (no --no-plot): the available and the needed force over a turn at
 the speeds given (or at omega_jump). ``--json`` prints one JSON object (keys omega_jump [rad/s], rpm_jump,
 theta_jump [rad], s_jump [m]; margin_N, theta_margin, speed_ratio with --rpm; preload_N, theta_preload,
-k_spring_N_per_m, theta_k_spring, safety with --target-rpm; null where not asked).
+k_spring_N_per_m, theta_k_spring, safety with --target-rpm; null where not asked). A spring answer beyond its
+parameter's range (physics/parameters.py: F_spring0, k_spring) is null, with the reason in beyond_range (the value
+needed and the range); where neither is in range the command fails (exit 2) naming both, and says whether a spring
+with both changed does it or no spring in range does.
 """
 from __future__ import annotations
 
@@ -72,7 +75,7 @@ def report(params, omega: float | None, target: float | None, safety: float) -> 
     out = {"omega_jump": jump.omega_jump, "rpm_jump": jump.omega_jump / RPM, "theta_jump": jump.theta,
            "s_jump": jump.s, "reason": jump.reason, "margin_N": None, "theta_margin": None, "speed_ratio": None,
            "preload_N": None, "theta_preload": None, "k_spring_N_per_m": None, "theta_k_spring": None,
-           "safety": None}
+           "safety": None, "beyond_range": None}
     if omega is not None:
         out["margin_N"], out["theta_margin"] = contact_margin(model.program, omega, *args)
         out["speed_ratio"] = jump.omega_jump / omega
@@ -82,7 +85,42 @@ def report(params, omega: float | None, target: float | None, safety: float) -> 
                                                              model.k_spring, model.F_gx, f0)
         out["k_spring_N_per_m"], out["theta_k_spring"] = rate_for(model.program, target, safety, model.m,
                                                                   model.F_spring0, model.F_gx, f0)
+        _within_range(out, model, target, safety, f0)
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+
+
+def _within_range(out: dict, model, target: float, safety: float, f0: float) -> None:
+    """Keep only the spring answers within the parameters' ranges (physics/parameters.py): an answer beyond its
+    range becomes None with the reason in out["beyond_range"]; where neither is in range, raise ValueError naming
+    each parameter, the value needed and the range, and whether a spring with both changed (the largest rate in
+    range and the preload it needs) does it."""
+    from ..physics.follower import preload_for
+    from ..physics.parameters import BY_NAME
+
+    F0_spec, k_spec = BY_NAME["F_spring0"], BY_NAME["k_spring"]
+    beyond = []
+    if out["preload_N"] > F0_spec.high:
+        beyond.append(f"the preload F_spring0 would have to be {out['preload_N']:.6g} N at k_spring = "
+                      f"{model.k_spring:g} N/m, allowed {F0_spec.allowed()}")
+        out["preload_N"] = out["theta_preload"] = None
+    if out["k_spring_N_per_m"] is not None and math.isfinite(out["k_spring_N_per_m"]) \
+            and out["k_spring_N_per_m"] > k_spec.high:
+        beyond.append(f"the spring rate k_spring would have to be {out['k_spring_N_per_m']:.6g} N/m at F_spring0 = "
+                      f"{model.F_spring0:g} N, allowed {k_spec.allowed()}")
+        out["k_spring_N_per_m"] = out["theta_k_spring"] = None
+    out["beyond_range"] = "; ".join(beyond) or None
+    if out["preload_N"] is not None or (out["k_spring_N_per_m"] is not None
+                                        and math.isfinite(out["k_spring_N_per_m"])):
+        return
+    stiffest, _ = preload_for(model.program, target, safety, model.m, k_spec.high, model.F_gx, f0)
+    if stiffest <= F0_spec.high:
+        both = (f"only a spring with both changed: k_spring = {k_spec.high:g} N/m with F_spring0 >= "
+                f"{max(stiffest, 0.0):.6g} N")
+    else:
+        both = (f"no spring in range does it: even k_spring = {k_spec.high:g} N/m needs F_spring0 = {stiffest:.6g} N "
+                f"(allowed {F0_spec.allowed()})")
+    reasons = "; ".join(beyond) if beyond else "no rate can (a lift of 0 needs more than the preload)"
+    raise ValueError(f"--target-rpm {target / RPM:g} with --safety {safety:g}: {reasons}; {both}")
 
 
 def curves(params, speeds: dict[str, float], points: int = 1440) -> dict:
@@ -143,10 +181,18 @@ def run(args) -> int:
               f"rad ({'held' if out['margin_N'] > 0 else 'the follower leaves the cam'}); omega_jump / omega = "
               + ("inf" if out["speed_ratio"] is None else f"{out['speed_ratio']:.6g}"))
     if target is not None:
-        k_text = "none can (a lift of 0 needs more than the preload)" if out["k_spring_N_per_m"] is None \
-            else f"{out['k_spring_N_per_m']:.6g} N/m at the preload F_spring0 (set by theta = {out['theta_k_spring']:.6g} rad)"
-        print(f"to hold {args.target_rpm:g} 1/min with safety {args.safety:g}: preload {out['preload_N']:.6g} N at the "
-              f"rate k_spring (set by theta = {out['theta_preload']:.6g} rad); spring rate {k_text}")
+        beyond = out["beyond_range"] or ""
+        if out["k_spring_N_per_m"] is not None:
+            k_text = (f"{out['k_spring_N_per_m']:.6g} N/m at the preload F_spring0 (set by theta = "
+                      f"{out['theta_k_spring']:.6g} rad)")
+        elif "k_spring" in beyond:
+            k_text = "none in range (" + next(part for part in beyond.split("; ") if "k_spring would" in part) + ")"
+        else:
+            k_text = "none can (a lift of 0 needs more than the preload)"
+        F0_text = (f"{out['preload_N']:.6g} N at the rate k_spring (set by theta = {out['theta_preload']:.6g} rad)"
+                   if out["preload_N"] is not None else
+                   "none in range (" + next(part for part in beyond.split("; ") if "F_spring0 would" in part) + ")")
+        print(f"to hold {args.target_rpm:g} 1/min with safety {args.safety:g}: preload {F0_text}; spring rate {k_text}")
     for path in written:
         print(path)
     sys.stdout.flush()

@@ -10,6 +10,10 @@ One sample per communication step h (the sample period is the step size)::
     I     += ki h e   unless v > u_max and e > 0, or v < u_min and e < 0   (anti-windup:
                                                                conditional integration)
 
+Finite inputs can overflow a double (e = 1e308 - (-1e308); ki h e with h = 1e300 s): where e, the
+setpoint's rate, u_ff, v or the new I is not finite the sample raises SimulationError naming it and
+changes nothing (pi_speed.fmu: fmi2Error with that message), never an output that is NaN or infinite.
+
 The feedforward is the armature voltage that holds the speed w against the
 load torque M and the inertia J that cam.fmu reports (its outputs ``M`` and
 ``J``): R i + c_e w with c_m i = M + J dw/dt (L and the current's dynamics
@@ -28,6 +32,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
+from ..errors import SimulationError
 from ..physics.parameters import KGF, ParameterError, ParameterSpec
 
 _P = ParameterSpec
@@ -96,16 +101,30 @@ class PiSpeedController:
 
     def _law(self, omega_meas: float, omega_setpoint: float, M_load: float, J_load: float,
              h: float | None) -> tuple[float, float, float, float, float]:
+        """(w, e, u_ff, v, u) on the inputs; raises SimulationError where one is not finite (an overflow of finite
+        inputs: e = 1e308 - -1e308), naming it, before anything changes."""
         p = self.params
         w = self.setpoint(omega_setpoint)
         e = w - float(omega_meas)
+        self._finite(e, "the speed error 'error' = w - omega_meas", w, omega_meas)
         u_ff = 0.0
         if p["feedforward"] > 0.0:
             w_dot = 0.0 if (h is None or self.w_prev is None) else (w - self.w_prev) / h
+            self._finite(w_dot, "the setpoint's rate (w - w_prev) / h", w, omega_meas)
             u_ff = p["feedforward"] * (p["R"] / p["c_m"] * (float(M_load) + float(J_load) * w_dot) + p["c_e"] * w)
+            self._finite(u_ff, "the feedforward 'u_ff'", w, omega_meas)
         v = u_ff + p["kp"] * e + self.integral
+        self._finite(v, "the unclamped command u_ff + kp error + integral", w, omega_meas)
         u = min(max(v, p["u_min"]), p["u_max"])
         return w, e, u_ff, v, u
+
+    def _finite(self, value: float, what: str, w: float, omega_meas: float) -> None:
+        """Raise SimulationError naming ``what`` where ``value`` is not finite (pi_speed.fmu's fmi2Error)."""
+        if not math.isfinite(value):
+            raise SimulationError(f"{what} is not finite (an overflow): setpoint w = {w!r} rad/s, omega_meas = "
+                                  f"{float(omega_meas)!r} rad/s, integral = {self.integral!r} V, kp = "
+                                  f"{self.params['kp']!r} V/(rad/s), ki = {self.params['ki']!r} V/rad "
+                                  "(the state is as before)")
 
     def initialize(self, omega_meas: float, omega_setpoint: float = 0.0, M_load: float = 0.0,
                    J_load: float = 0.0) -> float:
@@ -125,9 +144,11 @@ class PiSpeedController:
                 raise ParameterError(f"input {name!r} = {value!r} [{UNITS[name]}] is not finite: allowed any finite value")
         p = self.params
         w, e, u_ff, v, u = self._law(omega_meas, omega_setpoint, M_load, J_load, h)
+        integral = self.integral
         if not ((v > p["u_max"] and e > 0.0) or (v < p["u_min"] and e < 0.0)):
-            self.integral += p["ki"] * h * e
-        self.w_prev, self.error, self.u_ff, self.u = w, e, u_ff, u
+            integral += p["ki"] * h * e
+        self._finite(integral, "the integral 'integral' + ki h error", w, omega_meas)
+        self.integral, self.w_prev, self.error, self.u_ff, self.u = integral, w, e, u_ff, u
         return u
 
     def outputs(self) -> dict[str, float]:

@@ -7,6 +7,11 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Sequence
 
 
+# Relative distance [1] within which a time stamp counts as the time asked (left_value, left_slope): the rounding of
+# a grid time k h (a few ulps), far below any input's own time scale.
+LEFT_TOLERANCE = 1e-12
+
+
 @dataclass(frozen=True)
 class Signal:
     """Piecewise-linear signal through (times, values); ``hold`` makes it a staircase.
@@ -38,6 +43,37 @@ class Signal:
             return values[k - 1]
         t0, t1 = times[k - 1], times[k]
         return values[k - 1] + (values[k] - values[k - 1]) * (t - t0) / (t1 - t0)
+
+    def left_value(self, t: float) -> float:
+        """The limit from the left at t: the value held up to t (at a jump the value before it; at a kink, or
+        anywhere the signal is continuous, ``value(t)``; at or before the first time stamp the first value). A time
+        stamp within LEFT_TOLERANCE of t counts as t (a grid time 3 * 0.1 s is 0.30000000000000004 s, and a
+        co-simulation master steps to it with the input before the stamp 0.3 s). The outputs at an input's
+        discontinuity are this side's (docs/model.md 8.1)."""
+        times, values = self.times, self.values
+        tol = LEFT_TOLERANCE * max(1.0, abs(t))
+        k = bisect.bisect_left(times, t - tol)
+        if k == 0:
+            return values[0]
+        if self.hold:
+            return values[k - 1]
+        if k == len(times):
+            return values[-1]
+        if times[k] <= t + tol:   # a knot at t: its first value (a repeated stamp's is the one before the jump)
+            return values[k]
+        t0, t1 = times[k - 1], times[k]
+        return values[k - 1] + (values[k] - values[k - 1]) * (t - t0) / (t1 - t0)
+
+    def left_slope(self, t: float) -> float:
+        """d(value)/dt on the piece that ends at t or runs through it (the limit from the left, stamps within
+        LEFT_TOLERANCE of t counting as t; at or before the first stamp ``slope(t)``; 0 for a staircase)."""
+        times, values = self.times, self.values
+        k = bisect.bisect_left(times, t - LEFT_TOLERANCE * max(1.0, abs(t)))
+        if k == 0:
+            return self.slope(t)
+        if self.hold or k == len(times):
+            return 0.0
+        return (values[k] - values[k - 1]) / (times[k] - times[k - 1])
 
     def slope(self, t: float) -> float:
         """d(value)/dt on the piece that starts at or before t (0 for a staircase)."""

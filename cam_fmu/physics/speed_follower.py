@@ -92,19 +92,21 @@ class SpeedFollower:
         stay = contact if self.held(theta, omega, omega_dot, contact) >= 0.0 else 0.0  # a tie: the events decide
         return stay, s1 * omega, impact(math.inf, self.m, s1, omega, v, 0.0)
 
-    def outputs(self, theta: float, omega: float, omega_dot: float, s: float, v: float, contact: float) -> dict:
-        """Every output of the speed drive with the follower's own s, v, a and the contact force N_contact [N]."""
+    def outputs(self, theta: float, omega: float, omega_dot: float, s: float, v: float, contact: float,
+                direction: float | None = None) -> dict:
+        """Every output of the speed drive with the follower's own s, v, a and the contact force N_contact [N];
+        ``direction`` the way the cam moves, sgn(omega) unless given (at a stop, the way it moved into it)."""
         model = self.model
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
-        direction = self._sign(omega)
+        direction = self._sign(omega) if direction is None else direction
         shaft = model.M_f * direction
 
         def load(angle: float) -> tuple[float, float, float]:  # (M, J, force along X) with the follower on the flank
             sf, d1, d2, _ = self.flank(angle, contact)
             push = required_force(self.m, d2, omega, d1, omega_dot) + closing_force(sf, self.k, self.F0, model.F_gx)
             t_a = d1 / (model.r_b + self.program.derivatives(angle)[0])
-            sigma = self._sign(d1 * omega)
+            sigma = self._sign(d1 * direction)
             f = self._solve(push * t_a + model.G_y, t_a, sigma, model.mu, model.N_g, 0.0)
             force = push + sigma * f
             return shaft + force * d1, model.J_0 + self.m * d1 * d1, force

@@ -242,7 +242,7 @@ class VoltageFollower:
         shaft = self.M_f * self.moving(omega)
         if contact and self.heading == 0.0:  # stuck: the shaft's static friction takes the drive's torque
             P, a, M, J = self.static_force(theta, contact), 0.0, drive, self.J_0 + self.m * s1 * s1
-            N = abs(P) * math.sqrt(1.0 + tan_a * tan_a)
+            N = P * math.sqrt(1.0 + tan_a * tan_a)  # signed as the flank: < 0 on the upper flank (contact -1)
             s, v = s_cam - contact * self.c, 0.0
         elif contact:
             omega_dot, P, _ = self.on_flank(theta, omega, drive, contact)

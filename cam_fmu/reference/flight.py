@@ -11,6 +11,7 @@ many so far).
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -72,6 +73,7 @@ class PieceRun:
                 break
             contact, y = self._settle(t, y, contact)
             t_end = next(b for b in breaks if b > t + 1e-15 * max(1.0, t))
+            self.piece_end = t_end   # the piece's input up to t_end is its own (piece_input)
             events, rhs, options = self._piece(t, y, contact)
             if self.rebound > 0.0:  # the first piece after a rebound is shorter than the bounce it starts
                 t_end = min(t_end, t + self.rebound)
@@ -97,6 +99,25 @@ class PieceRun:
         for name in rows[0]:
             result[name] = np.array([row[name] for row in rows])
         return result
+
+
+def speed_motion(omega: float, omega_dot: float, t: float) -> float:
+    """The way the cam moves just before t [s] at the speed omega [rad/s] and acceleration omega_dot [rad/s2] of the
+    interval ending there: omega, and where omega is 0 (to within omega_dot times the rounding of t, 1e-12 max(1, t),
+    as the C engine's speed.c) -omega_dot, the way it came into the stop (the left limit, docs/model.md 8.1)."""
+    return omega if abs(omega) > 1e-12 * max(1.0, abs(t)) * abs(omega_dot) else -omega_dot
+
+
+def piece_input(signal: Signal, end: float) -> Callable[[float], tuple[float, float]]:
+    """(value, slope) of ``signal`` as a function of t within a piece that ends at ``end`` [s]: at the end, an input's
+    break, the piece's own (the left limit). solve_ivp evaluates the right-hand side and the events at the end point;
+    with the value after the break there, an event that the break itself makes (a break-away at a step of u) was
+    located a rounding before the break and applied there with the input before it, 1000 times over."""
+    def at(t: float) -> tuple[float, float]:
+        if t < end:
+            return signal.value(t), signal.slope(t)
+        return signal.left_value(end), signal.left_slope(end)
+    return at
 
 
 class FollowerRun(PieceRun):
@@ -151,20 +172,20 @@ class FollowerRun(PieceRun):
         return 1.0 if a > 0.0 else (-1.0 if a < 0.0 else 0.0)
 
     def _rhs(self, contact: float, sigma: float):
-        body, omega_ref = self.body, self.omega_ref
+        body, speed = self.body, piece_input(self.omega_ref, self.piece_end)
         if contact != 0.0:
             def follow(t, y):  # (s, v) ride on the flank; only theta matters, s and v are reset from the cam
-                omega, omega_dot = omega_ref.value(t), omega_ref.slope(t)
+                omega, omega_dot = speed(t)
                 _, s1, s2, _ = body.program.derivatives(y[0])
                 return [omega, s1 * omega, s2 * omega * omega + s1 * omega_dot]
             return follow
 
         def fly(t, y):
-            return [omega_ref.value(t), y[2], body.free_acceleration(y[1], sigma)]
+            return [speed(t)[0], y[2], body.free_acceleration(y[1], sigma)]
         return fly
 
     def _events(self, contact: float, sigma: float) -> list:
-        body, omega_ref = self.body, self.omega_ref
+        body, speed = self.body, piece_input(self.omega_ref, self.piece_end)
         events = []
 
         def add(kind: str, fn) -> None:
@@ -172,7 +193,7 @@ class FollowerRun(PieceRun):
             events.append(fn)
 
         if contact != 0.0:
-            add("lift-off", lambda t, y: body.held(y[0], omega_ref.value(t), omega_ref.slope(t), contact))
+            add("lift-off", lambda t, y: body.held(y[0], *speed(t), contact))
             return events
         add("touch-down +1", lambda t, y: body.gaps(y[0], y[1])[0] + TOUCH)
         if body.two_sided:
@@ -210,10 +231,12 @@ class FollowerRun(PieceRun):
         return contact, y
 
     def _row(self, t: float, y, contact: float) -> dict[str, float]:
-        omega = self.omega_ref.value(t)
-        t_left = t - 1e-12 * max(1.0, t) if t > 0.0 else 0.0  # at a kink the interval ending at t counts
-        omega_dot = self.omega_ref.slope(t_left)
-        row = self.body.outputs(float(y[0]), omega, omega_dot, float(y[1]), float(y[2]), contact)
+        # at an input's kink or jump its left limit, the interval ending at t (docs/model.md 8.1); at 0 the first piece
+        omega = self.omega_ref.left_value(t) if t > 0.0 else self.omega_ref.value(t)
+        omega_dot = self.omega_ref.left_slope(t) if t > 0.0 else self.omega_ref.slope(t)
+        motion = omega if t == 0.0 else speed_motion(omega, omega_dot, t)   # a stop at t still moves (left limit)
+        row = self.body.outputs(float(y[0]), omega, omega_dot, float(y[1]), float(y[2]), contact,
+                                1.0 if motion > 0.0 else (-1.0 if motion < 0.0 else 0.0))
         row["impacts"] = float(len(self.impacts))
         return row
 

@@ -23,13 +23,13 @@ from scipy.integrate import solve_ivp
 
 from ..physics.signals import Signal, constant
 from ..physics.contact import follower_along, rest_position, speed_engaged
-from ..physics.drive import DriveModel
+from ..physics.drive import DriveModel, sign
 from ..physics.formulations import formulation_name
 from ..physics.formulations.consistent import HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.variables import INPUT_STARTS, OUTPUTS
-from .flight import follower_speed_reference, next_breakpoint
+from .flight import follower_speed_reference, next_breakpoint, piece_input, speed_motion
 from .voltage_flight import follower_voltage_reference
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
@@ -103,6 +103,12 @@ class _Consistent:
         input_changed = True  # at the start and at each input break: decide stick/slip anew
         while True:
             u_now = u.value(t)
+            if input_changed and t in u.breaks and t > 0.0:
+                # Outputs due at an input's break: its left limit, the mode and the input before it (docs/model.md
+                # 8.1), as a co-simulation step that ends there.
+                while k_out < len(grid) and grid[k_out] <= t + 1e-12:
+                    rows.append(hybrid.outputs(y[:n], u.left_value(t), mode) | self._energy_row(y))
+                    k_out += 1
             if input_changed:
                 # Not after an event: its transition has settled the mode already, and
                 # settling again at a located break-away (margin ~ -1e-17) re-sticks it.
@@ -114,6 +120,7 @@ class _Consistent:
             if t >= stop - 1e-12:
                 break
             t_end = next(b for b in breaks if b > t + 1e-12)
+            self.piece_end = t_end   # the piece's input up to t_end is its own (flight.piece_input)
             # theta is integrated relative to the last whole turn: rtol then acts on
             # an angle below 4 pi, not on the unbounded theta (long runs keep their accuracy).
             base = 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
@@ -197,11 +204,11 @@ class _Consistent:
         return tol
 
     def _rhs(self, mode, base: float):
-        hybrid, model, u, n = self.hybrid, self.model, self.u, self.hybrid.size
-        energy = self.energy
+        hybrid, model, n = self.hybrid, self.model, self.hybrid.size
+        energy, u_at = self.energy, piece_input(self.u, self.piece_end)
 
         def rhs(t, y):
-            u_t = u.value(t)
+            u_t = u_at(t)[0]
             state = [y[0] + base, *y[1:n]]
             dy = list(hybrid.derivative(state, u_t, mode))
             if energy:
@@ -216,8 +223,8 @@ class _Consistent:
         return rhs
 
     def _event(self, k: int, mode, base: float):
-        hybrid, u, n = self.hybrid, self.u, self.hybrid.size
-        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u.value(t), mode)[k]
+        hybrid, n, u_at = self.hybrid, self.hybrid.size, piece_input(self.u, self.piece_end)
+        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u_at(t)[0], mode)[k]
 
     @staticmethod
     def _breakpoint_event(target: float, direction: float):
@@ -266,19 +273,22 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
 
     rows = []
     for k, t in enumerate(grid):
+        t = float(t)
         if k:
-            end = theta + integral(float(grid[k - 1]), float(t))
+            end = theta + integral(float(grid[k - 1]), t)
             s = follower_along(model.program, s, theta, end, model.c)  # the same play operator as the FMU
             theta = end
-        omega = omega_ref.value(float(t))
-        if omega == 0.0:  # at rest the follower lies on the cam where its weight pushes it
+        # At an input's discontinuity (a kink or a jump of omega_ref) the outputs are its left limit, the interval
+        # that ends at t, as a co-simulation step that ends there (docs/model.md 8.1); at t = 0 the first piece.
+        omega = omega_ref.left_value(t) if k else omega_ref.value(t)
+        omega_dot = omega_ref.left_slope(t) if k else omega_ref.slope(t)
+        motion = speed_motion(omega, omega_dot, t) if k else omega
+        if motion == 0.0:  # at rest the follower lies on the cam where its weight pushes it
             s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
-        # At a kink of omega(t) the acceleration of the interval that ends at t
-        # counts, as in a co-simulation step that ends there.
-        t_left = float(t) - 1e-12 * max(1.0, float(t)) if k else 0.0
-        omega_dot = omega_ref.slope(t_left)
-        engaged = speed_engaged(model.program, theta, s, omega, model.c, omega_dot, model.F_gx)
-        rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged))
+        engaged = speed_engaged(model.program, theta, s, motion, model.c, omega_dot, model.F_gx)
+        rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged, sign(motion)))
+        if omega_ref.value(t) == 0.0:  # at rest from t on (a stop): there from the next interval, as the FMU's input
+            s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
     return _collect(rows, grid)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.signals import Signal
 from ..physics.voltage_follower import VoltageFollower, sgn
-from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint
+from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint, piece_input
 
 ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
 
@@ -82,11 +82,12 @@ class VoltageFollowerRun(PieceRun):
         return events + [breakpoint], self._rhs(contact, sigma), options
 
     def _rhs(self, contact: float, sigma: float):
-        body, u, energy, n = self.body, self.u, self.energy, self.body.size
+        body, energy, n = self.body, self.energy, self.body.size
+        u_at = piece_input(self.u, self.piece_end)
         R, M_f, d_shaft = body.model.R, body.M_f, body.model.d_shaft
 
         def rhs(t, y):
-            u_t = u.value(t)
+            u_t = u_at(t)[0]
             state = y[:n]
             dy = body.rates(state, u_t, contact, sigma)
             if not energy:
@@ -99,6 +100,10 @@ class VoltageFollowerRun(PieceRun):
 
     def _events(self, contact: float, sigma: float, t0: float, y0: list) -> list:
         body, u = self.body, self.u
+        piece = piece_input(u, self.piece_end)
+
+        def u_at(t: float) -> float:   # the piece's input, at its end (an input's break) the left limit
+            return piece(t)[0]
         events = []
 
         def add(kind: str, fn) -> None:
@@ -107,16 +112,16 @@ class VoltageFollowerRun(PieceRun):
 
         heading = body.heading
         if heading == 0.0:  # stuck: until the torque on the held cam (a current, a shaft) starts it
-            add("break-away", lambda t, y: -body.start(y[:body.size], u.value(t), contact)[0])
+            add("break-away", lambda t, y: -body.start(y[:body.size], u_at(t), contact)[0])
             if contact:
                 return events
         else:
             add("stop", lambda t, y: heading * y[1])
         if contact:
-            add("lift-off", lambda t, y: body.contact_force(y[:body.size], u.value(t), contact))
+            add("lift-off", lambda t, y: body.contact_force(y[:body.size], u_at(t), contact))
             side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
             if side != 0.0:  # the piece ends just past the kink of |N_r| (by 1e-9 N, docs/model.md 10), no transition
-                add("side", lambda t, y: side * body.side_force(y[:body.size], u.value(t), contact) + SIDE_HYSTERESIS)
+                add("side", lambda t, y: side * body.side_force(y[:body.size], u_at(t), contact) + SIDE_HYSTERESIS)
             return events
         add("touch-down +1", lambda t, y: body.gap(y, 1.0) + TOUCH)
         if body.two_sided:
@@ -181,7 +186,8 @@ class VoltageFollowerRun(PieceRun):
 
     def _row(self, t: float, y, contact: float) -> dict[str, float]:
         n = self.body.size
-        row = self.body.outputs([float(x) for x in y[:n]], self.u.value(t), contact)
+        u = self.u.left_value(t) if t > 0.0 else self.u.value(t)   # at a break its left limit (docs/model.md 8.1)
+        row = self.body.outputs([float(x) for x in y[:n]], u, contact)
         row["impacts"] = float(len(self.impacts))
         if self.energy:
             row.update({name: float(value) for name, value in zip(ENERGY, y[n:])}, E_impact=self.loss)

@@ -97,6 +97,51 @@ def test_reflect_advises_only_commands_that_run_on_the_scene(scene, sets, tmp_pa
         assert ran.stdout.strip()
 
 
+def test_a_spring_beyond_the_parameters_ranges_is_refused_naming_them(tmp_path):
+    """1e6 1/min with safety 100 needs a preload S 4 A m omega^2 (k_spring = 0) far beyond F_spring0's range and a
+    rate beyond k_spring's (the answers were 6.1e10 N and 3.8e11 N/m with exit 0): exit 2, each parameter named with
+    the value needed and its range from the parameter table; even the stiffest spring in range leaves the follower at
+    sqrt(S) times the target (the contact margin, computed apart from the sizing, is < 0)."""
+    from cam_fmu.physics.follower import contact_margin
+    from cam_fmu.physics.parameters import BY_NAME
+
+    done = cli("jump", "spring_jump", *PRELOAD_ONLY, "--target-rpm", "1e6", "--safety", "100", "--no-plot",
+               cwd=tmp_path)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    omega = 1e6 * 2 * math.pi / 60
+    preload = 100 * 4 * A * MASS * omega ** 2
+    assert preload > 10 * BY_NAME["F_spring0"].high
+    assert f"F_spring0 would have to be {preload:.6g} N at k_spring = 0 N/m, allowed {BY_NAME['F_spring0'].allowed()}" \
+        in done.stderr, done.stderr
+    assert f"k_spring would have to be" in done.stderr and BY_NAME["k_spring"].allowed() in done.stderr
+    assert "no spring in range does it" in done.stderr
+    model = DriveModel(dict(find_scene("spring_jump").primary.params, mu=0.0))
+    stiffest = contact_margin(model.program, 10.0 * omega, model.m, BY_NAME["k_spring"].high,
+                              BY_NAME["F_spring0"].high, model.F_gx)[0]
+    assert stiffest < 0.0
+
+
+def test_an_answer_beyond_its_range_is_withheld_and_the_other_kept(tmp_path):
+    """At 40000 1/min (safety 1.5, k_spring = 0) the preload S 4 A m omega^2 = 1.47e6 N is beyond F_spring0's range:
+    null with the reason; the rate at the scene's preload is in range and holds (margin >= 0 at sqrt(S) omega)."""
+    from cam_fmu.physics.follower import contact_margin
+    from cam_fmu.physics.parameters import BY_NAME
+
+    done = cli("jump", "spring_jump", *PRELOAD_ONLY, "--target-rpm", "40000", "--json", "--no-plot", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    omega = 40000 * 2 * math.pi / 60
+    preload = 1.5 * 4 * A * MASS * omega ** 2
+    assert BY_NAME["F_spring0"].high < preload < 2 * BY_NAME["F_spring0"].high
+    assert out["preload_N"] is None and f"F_spring0 would have to be {preload:.6g} N" in out["beyond_range"]
+    assert BY_NAME["F_spring0"].allowed() in out["beyond_range"] and "k_spring would" not in out["beyond_range"]
+    k = out["k_spring_N_per_m"]
+    assert 0.0 < k <= BY_NAME["k_spring"].high
+    model = DriveModel(dict(find_scene("spring_jump").primary.params, mu=0.0))
+    margin = contact_margin(model.program, math.sqrt(1.5) * omega, model.m, k, F0, model.F_gx)[0]
+    assert abs(margin) < 1e-9 * k * model.program.derivatives(math.pi)[0]   # just held: the least rate (of k h)
+
+
 def test_reflect_says_what_it_assumes(tmp_path):
     done = cli("reflect", "backlash", "--set", "closure=kinematic", "--json", "--no-plot", "--out", str(tmp_path),
                cwd=tmp_path)

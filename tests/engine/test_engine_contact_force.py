@@ -7,7 +7,9 @@ formulation and drive, against what is independent of the engine's formula for i
   sgn(omega) (docs/model.md 4.3), the power the contact passes, N cos(alpha) v, is M_l omega;
 - the follower's path: N cos(alpha) = m s_dd - F_gx with s_dd the second difference of the published s;
 - the sides of the contact: 0 in flight and free in the clearance, never < 0 with a spring, < 0 exactly on a
-  groove's upper flank.
+  groove's upper flank;
+- at rest (both drives, the engine and the reference): N cos(alpha) = F_spring0 + k_spring s - F_gx on the flank
+  that force presses the follower to.
 
 The engine against the scipy reference on every shipped scene is tests/fmu_cs/test_fmu_vs_reference.py (and
 tests/engine/test_engine_follower.py, test_engine_voltage_follower.py); FMI 3.0 against FMI 2.0 bit for bit is
@@ -159,3 +161,43 @@ def test_the_kinematic_rule_reports_no_force_while_the_follower_rests_in_the_cle
         free = np.abs(np.abs(gap) - c) > 1e-12
         assert free.any() and np.all(N[free] == 0.0), extra
         assert np.count_nonzero(N[~free]) > 100, extra
+
+
+# At rest (omega = 0; the voltage drive's shaft held by its static friction M_f at u = 0, the speed drive's
+# omega_ref = 0) the follower lies on the flank the static force along X presses it to, and that flank carries the
+# spring and gravity: N cos(alpha) = F_spring0 + k_spring s - F_gx, F_gx = G sin(gamma) cos(beta) (docs/model.md
+# 4.1), at s = s_cam + c on a groove's upper flank (the force < 0) and s = s_cam - c on the lower (> 0).
+# (params, flank: -1 upper, +1 lower); the simple-harmonic cam at theta0 = 1 rad, where s' != 0 (alpha != 0).
+AT_REST = {
+    "groove-upper": (dict(closure="form", c=5e-4, gamma=math.pi / 2, beta=0.0), -1),   # gravity pulls along the rise
+    "groove-lower": (dict(closure="form", c=5e-4, **VERTICAL), +1),
+    "groove-tilted-upper": (dict(closure="form", c=5e-4, gamma=math.pi / 3, beta=math.pi / 4), -1),
+    "groove-tilted-lower": (dict(closure="form", c=5e-4, gamma=2.0, beta=2.5), +1),
+    "spring-vertical": (dict(closure="spring", k_spring=500.0, F_spring0=5.0, **VERTICAL), +1),
+    "spring-against-gravity": (dict(closure="spring", k_spring=500.0, F_spring0=5.0, gamma=math.pi / 2, beta=0.0), +1),
+}
+
+
+@pytest.mark.parametrize("drive", ["voltage", "speed"])
+@pytest.mark.parametrize("name", AT_REST)
+def test_at_rest_the_flank_carries_the_spring_and_gravity(name, drive):
+    """The engine and the scipy reference against the closed form of the static contact force: each flank's sign,
+    s on that flank, v = a = 0 and omega exactly 0, over 50 ms (the guide's friction carries nothing at rest)."""
+    from cam_fmu.physics.signals import constant
+    from cam_fmu.reference.integrate import simulate_reference
+    extra, flank = AT_REST[name]
+    theta0, c = 1.0, extra.get("c", 0.0)
+    params = dict(SHM, drive=drive, m=MASS, G=G, r_b=R_B, theta0=theta0, M_f=1.0, mu=0.05, **extra)
+    s_cam, s1 = H / 2 * (1 - math.cos(theta0)), H / 2 * math.sin(theta0)
+    s = s_cam - flank * c
+    F_gx = G * math.sin(extra["gamma"]) * math.cos(extra["beta"])
+    expected = (extra.get("F_spring0", 0.0) + extra.get("k_spring", 0.0) * s - F_gx) / math.cos(math.atan2(s1, R_B + s_cam))
+    assert abs(expected) > 1.0 and np.sign(expected) == flank and abs(F_gx) > 1.0
+    assert abs(expected * s1) < 1.0   # the shaft's static friction M_f holds the load torque: the shaft stays
+    times = np.linspace(0.0, 0.05, 51)
+    got = run(params, times)
+    ref = simulate_reference(params, 0.05, 1e-3, u=constant(0.0), omega_ref=constant(0.0))
+    for label, out in (("engine", got), ("reference", ref)):
+        assert np.all(out["omega"] == 0.0) and np.all(out["theta"] == theta0), label
+        assert np.max(np.abs(out["s"] - s)) < 1e-15 and np.all(out["v"] == 0.0) and np.all(out["a"] == 0.0), label
+        assert np.max(np.abs(out["N_contact"] - expected)) < 1e-12 * abs(expected), label

@@ -5,6 +5,7 @@ statuses, no direct feedthrough, states checked). The C FMU is loaded in this pr
 from __future__ import annotations
 
 import math
+import re
 import random
 import struct
 
@@ -263,4 +264,103 @@ def test_a_cam_state_is_not_a_pi_speed_state(unzipped, cam_fmu_path, tmp_path):
     with pytest.raises(Exception):
         slave.fmu.deserializeFMUState(blob)
     assert any("not a serialised pi_speed state" in m for m in slave.messages), slave.messages
+    slave.fmu.freeInstance()
+
+
+# Finite inputs the FMU accepts whose law overflows a double: (parameters, inputs, step h [s], the quantity named).
+OVERFLOWS = {
+    "error": (dict(kp=0.0, external_setpoint=True), dict(omega_setpoint=1e308, omega_meas=-1e308), 1e-3,
+              "the speed error 'error'"),
+    "integral": (dict(kp=0.0, ki=1e6), dict(omega_meas=1000.0), 1e300, "the integral 'integral'"),
+    "command": (dict(kp=1e4, external_setpoint=True), dict(omega_setpoint=1e305, omega_meas=-1e305), 1e-3,
+                "the unclamped command"),
+    "feedforward": (dict(feedforward=1.0, R=1e4, c_m=1e-6), dict(M_load=1e300), 1e-3, "the feedforward 'u_ff'"),
+    "setpoint rate": (dict(feedforward=1.0, external_setpoint=True), dict(omega_setpoint=1e300), 1e-310,
+                      "the setpoint's rate"),
+}
+
+
+@pytest.mark.parametrize("name", OVERFLOWS)
+def test_an_overflow_is_an_error_naming_it_never_a_nan_with_ok(unzipped, name):
+    """Finite inputs whose error, feedforward, command or integral is beyond a double (kp = 0 with e = 1e308 -
+    (-1e308) gave u = NaN with OK; ki = 1e6 and a 1e300 s step an infinite integral that u_max hid and the FMU's own
+    state check then refused): fmi2Error, the logger names the quantity, the state stays the last good one (saved,
+    serialised and set again), and control/pi.py raises SimulationError naming the same quantity, unchanged."""
+    from cam_fmu.errors import SimulationError
+    params, bad, h, what = OVERFLOWS[name]
+    slave = Logged(unzipped)
+    slave.start(params, {})
+    ctrl = pi.PiSpeedController(params)
+    ctrl.initialize(**{n: 0.0 for n in INPUTS})
+    assert status_of(lambda: slave.fmu.doStep(0.0, 1e-3)) == 0
+    ctrl.sample(1e-3, **{n: 0.0 for n in INPUTS})
+    good = slave.outputs()
+    assert good == [ctrl.outputs()[n] for n in OUTPUTS] and all(map(math.isfinite, good))
+    state = slave.fmu.getFMUState()
+    slave.set_inputs(bad)
+    assert status_of(lambda: slave.fmu.doStep(1e-3, h)) == 3   # fmi2Error
+    assert any(what in m and "is not finite (an overflow)" in m for m in slave.messages), slave.messages
+    assert slave.outputs() == good   # nothing written
+    with pytest.raises(SimulationError, match=re.escape(what)):
+        ctrl.sample(h, **dict({n: 0.0 for n in INPUTS}, **bad))
+    assert [ctrl.outputs()[n] for n in OUTPUTS] == good
+    # the state before the refused step is a state the FMU takes back, serialised too, and goes on from
+    blob = slave.fmu.serializeFMUState(state)
+    slave.fmu.setFMUState(slave.fmu.deserializeFMUState(blob))
+    slave.set_inputs({n: 0.0 for n in INPUTS})
+    assert status_of(lambda: slave.fmu.doStep(1e-3, 1e-3)) == 0
+    ctrl.sample(1e-3, **{n: 0.0 for n in INPUTS})
+    assert slave.outputs() == [ctrl.outputs()[n] for n in OUTPUTS]
+    slave.fmu.freeInstance()
+
+
+def test_an_overflow_at_initialisation_is_an_error_and_outputs_before_it_are_refused(unzipped):
+    """The law on the inputs at initialisation overflows (kp = 0, w = 1e308, omega_meas = -1e308): reading the
+    outputs before it and exitInitializationMode are fmi2Error naming the error, never u = NaN."""
+    slave = Logged(unzipped)
+    slave.fmu.setupExperiment(startTime=0.0)
+    slave.fmu.setReal([slave.vr["kp"]], [0.0])
+    slave.fmu.setBoolean([slave.vr["external_setpoint"]], [True])
+    slave.set_inputs({"omega_setpoint": 1e308, "omega_meas": -1e308})
+    slave.fmu.enterInitializationMode()
+    assert status_of(lambda: slave.fmu.getReal([slave.vr["u"]])) == 3
+    assert status_of(slave.fmu.exitInitializationMode) == 3
+    assert sum("the speed error 'error' = w - omega_meas is not finite" in m for m in slave.messages) == 2
+    slave.fmu.freeInstance()
+
+
+def test_extreme_samples_stay_finite_or_fail_together_and_every_saved_state_is_taken_back(unzipped):
+    """Random inputs up to 1e308 and steps up to 1e300 s on ki = 1e6: at every sample either the FMU and
+    control/pi.py give the same finite outputs, or both refuse (fmi2Error; SimulationError) and the state saved
+    before it goes on; every state the FMU saves, serialised, is one it sets again (before, an infinite integral
+    was saved and then refused)."""
+    from cam_fmu.errors import SimulationError
+    rng = random.Random(7)
+    params = dict(kp=rng.choice([0.0, 1e-3]), ki=1e6, external_setpoint=True, feedforward=0.5)
+    slave = Logged(unzipped)
+    slave.start(params, {})
+    ctrl = pi.PiSpeedController(params)
+    ctrl.initialize(**{n: 0.0 for n in INPUTS})
+    t, refused, accepted = 0.0, 0, 0
+    for _ in range(300):
+        inputs = {n: rng.choice([-1.0, 1.0]) * 10.0 ** rng.uniform(-3, 308) for n in INPUTS}
+        h = 10.0 ** rng.uniform(-6, 300)
+        state = slave.fmu.getFMUState()
+        slave.fmu.setFMUState(slave.fmu.deserializeFMUState(slave.fmu.serializeFMUState(state)))
+        slave.set_inputs(inputs)
+        status = status_of(lambda: slave.fmu.doStep(t, h))
+        try:
+            ctrl.sample(h, **inputs)
+        except SimulationError:
+            assert status == 3
+            refused += 1
+            slave.fmu.setFMUState(state)
+        else:
+            assert status == 0
+            accepted += 1
+            t += h
+            assert slave.outputs() == [ctrl.outputs()[n] for n in OUTPUTS]
+            assert all(map(math.isfinite, slave.outputs()))
+        slave.fmu.freeFMUState(state)
+    assert refused > 10 and accepted > 10, (refused, accepted)
     slave.fmu.freeInstance()

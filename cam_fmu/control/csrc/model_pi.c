@@ -49,6 +49,15 @@ static int refuse(Pi *c, const char *format, ...)
     return MODEL_ERROR;
 }
 
+/* MODEL_ERROR for an overflow of the law (pi_law.h names the quantity) at time t [s], with the inputs that gave it. */
+static int overflowed(Pi *c, const char *what, double t)
+{
+    return refuse(c, "%s is not finite (an overflow) at t = %.17g s: setpoint w = %.17g rad/s, omega_meas = %.17g "
+                  "rad/s, integral = %.17g V, kp = %.17g V/(rad/s), ki = %.17g V/rad (the state is as before)", what,
+                  t, c->p[PI_P_EXTERNAL_SETPOINT] != 0.0 ? c->in[PI_I_OMEGA_SETPOINT] : c->p[PI_P_OMEGA_SET],
+                  c->in[PI_I_OMEGA_MEAS], c->state.integral, c->p[PI_P_KP], c->p[PI_P_KI]);
+}
+
 static void defaults(Pi *c)
 {
     int k;
@@ -166,8 +175,11 @@ static int get_real(void *m, unsigned vr, double *value)
     }
     if (vr < PI_VR_PARAMS) {
         PiState preview = c->state;
+        const char *overflow = NULL;
         if (!c->initialized)   /* before initialisation: the law on the inputs as set */
-            pi_initialize(&preview, c->p, c->in);
+            overflow = pi_initialize(&preview, c->p, c->in);
+        if (overflow)
+            return overflowed(c, overflow, c->time);
         pi_outputs(&preview, out);
         *value = out[vr - PI_VR_OUTPUTS];
         return MODEL_OK;
@@ -228,10 +240,15 @@ static int check_together(Pi *c, const double p[PI_N_PARAMS])
 static int initialize(void *m, double start_time)
 {
     Pi *c = m;
+    PiState state;
+    const char *overflow;
     if (check_together(c, c->p) != MODEL_OK)
         return MODEL_ERROR;
-    pi_state_clear(&c->state);
-    pi_initialize(&c->state, c->p, c->in);
+    pi_state_clear(&state);
+    overflow = pi_initialize(&state, c->p, c->in);
+    if (overflow)
+        return overflowed(c, overflow, start_time);
+    c->state = state;
     c->start_time = c->time = start_time;
     c->initialized = 1;
     return MODEL_OK;
@@ -242,7 +259,13 @@ static int initialized(const void *m) { return ((const Pi *)m)->initialized; }
 static int step(void *m, double t, double h)
 {
     Pi *c = m;
-    pi_sample(&c->state, c->p, c->in, h);
+    const char *overflow;
+    if (!isfinite(t + h))
+        return refuse(c, "the time t + h = %.17g s + %.17g s is not finite (an overflow; the state is as before)",
+                      t, h);
+    overflow = pi_sample(&c->state, c->p, c->in, h);
+    if (overflow)
+        return overflowed(c, overflow, t);
     c->time = t + h;
     return MODEL_OK;
 }

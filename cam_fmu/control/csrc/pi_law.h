@@ -5,6 +5,8 @@
 #ifndef PI_LAW_H
 #define PI_LAW_H
 
+#include <stddef.h>
+
 #include "pi_params.h"
 
 typedef struct {
@@ -19,12 +21,15 @@ typedef struct {
 /* Before initialisation: integral 0, no previous setpoint, outputs 0. */
 void pi_state_clear(PiState *s);
 
-/* The output before the first step: the law on the inputs, no integration; sets w_prev. */
-void pi_initialize(PiState *s, const double p[PI_N_PARAMS], const double in[PI_N_INPUTS]);
+/* The output before the first step: the law on the inputs, no integration; sets w_prev. Returns NULL, or
+ * (an overflow: finite inputs whose error, setpoint rate, feedforward or command is beyond a double) the name
+ * of the first quantity that is not finite, s unchanged. */
+const char *pi_initialize(PiState *s, const double p[PI_N_PARAMS], const double in[PI_N_INPUTS]);
 
 /* One sample at the start of a step of length h [s] > 0 with the inputs at its start; the command is
- * published at its end. Integrates unless the clamp is active and the error pushes further into it. */
-void pi_sample(PiState *s, const double p[PI_N_PARAMS], const double in[PI_N_INPUTS], double h);
+ * published at its end. Integrates unless the clamp is active and the error pushes further into it.
+ * Returns NULL, or as pi_initialize the name of what overflowed (the integral too), s unchanged. */
+const char *pi_sample(PiState *s, const double p[PI_N_PARAMS], const double in[PI_N_INPUTS], double h);
 
 /* The outputs in PI_O_* order. */
 void pi_outputs(const PiState *s, double out[PI_N_OUTPUTS]);

@@ -9,14 +9,17 @@ from ..drive import DriveModel
 from ..variables import output_record
 
 
-def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot: float, s: float, engaged: bool) -> dict[str, float]:
+def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot: float, s: float, engaged: bool,
+                        direction: float | None = None) -> dict[str, float]:
     """Torque, inertia, current and voltage needed for a given motion.
 
     c_m i = J_0 omega_dot + M, J_0 = J_m + J_cam (consistent formulation); the voltage adds
     L di/dt, with di/dt = omega dM/dtheta at constant speed (central difference,
-    1e-6 rad).
+    1e-6 rad). ``direction`` (+1, -1, 0) is the way the cam moves, sgn(omega) unless given (at a stop, the
+    left limit's: the way it moved into it).
     """
-    direction = 1.0 if omega > 0.0 else (-1.0 if omega < 0.0 else 0.0)
+    if direction is None:
+        direction = 1.0 if omega > 0.0 else (-1.0 if omega < 0.0 else 0.0)
     load = model.load(theta, omega, omega_dot, direction, engaged)
     i = (model.J_0 * omega_dot + load.M) / model.c_m
     voltage = model.motor.voltage(i, omega)

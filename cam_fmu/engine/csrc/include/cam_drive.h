@@ -62,11 +62,13 @@ typedef struct {
 } CamSpeedState;
 
 /* The follower as a body of its own in the speed drive (follower.c; docs/model.md section 13): its contact at the
- * start, a step of h [s] (st->theta not moved), the outputs. */
+ * start, a step of h [s] (st->theta not moved), the outputs (direction: the way the cam moves, sgn(omega), at a stop
+ * at the step's end the way it moved into it: the left limit, docs/model.md 8.1). */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot);
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err);
-void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[]);
+void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction,
+                          double out[]);
 /* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
 typedef double (*CamEventValue)(void *ctx, int code, double x);
 /* The earliest of the n event functions codes[k] (non-zero codes) to cross, as `crossed(before, after)` says, from

@@ -308,7 +308,7 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
 }
 
 /* physics.speed_follower.SpeedFollower.outputs: the speed drive's outputs with the follower's own s, v, a. */
-void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double out[])
+void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction, double out[])
 {
     Motion mo = {m, st->theta, st->speed, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
@@ -317,7 +317,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
     CamLoad load;
     cam_profile_eval(&m->profile, theta, d);
     tan_a = d[1] / (m->r_b + d[0]);
-    shaft = m->M_f * sgn(omega);
+    shaft = m->M_f * direction;
     if (st->contact != 0.0) {
         int k;
         double Ms[3], step = 1e-6;
@@ -326,7 +326,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
             on_flank(&mo, angle, st->contact, e);
             push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + closing(m, e[0]);
             t_a = e[1] / (m->r_b + e[3]);
-            sigma = sgn(e[1] * omega);
+            sigma = sgn(e[1] * direction);
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);
             Ms[k] = shaft + (push + sigma * f) * e[1];
             if (k == 0)   /* the force along X over cos(alpha): > 0 on the +1 flank, < 0 on a groove's -1 flank */

@@ -4,6 +4,7 @@
  * (where the extrema of s_cam lie), not only the end point. At rest the follower lies on the cam at the
  * edge of the gap its weight pushes it to (physics.contact.rest_position), so the holding torque does
  * not vanish with a clearance. */
+#include <float.h>
 #include <math.h>
 
 #include "cam_drive.h"
@@ -101,8 +102,8 @@ static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double ome
             cam_follower_start(&d->model, &d->speed, omega_ref, omega_dot_ref);
         return;
     }
-    if (omega_ref == 0.0)   /* at rest from now: the follower lies where the force along the stroke pushes it, as at
-                               the end of a step that stops (the reference: at every output time with omega = 0) */
+    if (omega_ref == 0.0)   /* at rest from now: the follower lies where the force along the stroke pushes it (the
+                               reference: after the output at a time where omega_ref is 0) */
         d->speed.s = rest_position(&d->model, d->speed.theta, d->speed.s);
 }
 
@@ -129,10 +130,22 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
     st->speed = d->omega_ref + d->omega_dot_ref * h;
     st->s = follower_along(&d->model.profile, st->s, st->theta, end, d->model.c);
     st->theta = end;
-    if (st->speed == 0.0)
+    if (st->speed == 0.0 && d->omega_ref == 0.0)   /* a step at rest; one that stops the cam at its end still moves
+                                                        there (the left limit), at rest from the next input on */
         st->s = rest_position(&d->model, st->theta, st->s);
     *steps = 1;
     return CAM_OK;
+}
+
+/* The way the cam moves at the end of the step with the inputs held (the left limit, docs/model.md 8.1): sgn(omega),
+ * and where omega ends at 0 the way the step started: a stop at the step's end still moves there. "At 0": within the
+ * rounding of omega_ref + omega_dot_ref h and of the step's end time t [s] (a grid time k h is a few ulps off the
+ * input's time stamp; the reference's Signal.left_value takes stamps within 1e-12 max(1, t) as t). */
+static double motion_sign(double omega, double omega_ref, double omega_dot_ref, double t)
+{
+    double stop = 1e-12 * (t > 1.0 ? t : 1.0) * fabs(omega_dot_ref) + 4.0 * DBL_EPSILON * fabs(omega_ref);
+    double x = fabs(omega) <= stop ? omega_ref : omega;
+    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
 /* speed.speed_drive_outputs: c_m i = J_0 omega_dot + M (J_0 = J_m + J_cam); the voltage adds L di/dt, di/dt = omega dM/dtheta
@@ -144,12 +157,12 @@ static void speed_outputs(CamDrive *d, double out[])
     double omega = st->speed, omega_dot = d->omega_dot_ref, theta = st->theta, direction, i, voltage;
     CamLoad load, ahead, behind;
     int on;
+    direction = motion_sign(omega, d->omega_ref, omega_dot, fabs(d->time));
     if (m->free_follower) {
-        cam_follower_outputs(m, st, omega_dot, out);
+        cam_follower_outputs(m, st, omega_dot, direction, out);
         return;
     }
-    on = engaged(m, theta, st->s, omega, omega_dot);
-    direction = omega > 0.0 ? 1.0 : (omega < 0.0 ? -1.0 : 0.0);
+    on = engaged(m, theta, st->s, direction, omega_dot);
     cam_load(m, theta, omega, omega_dot, direction, on, &load);
     i = (m->J_0 * omega_dot + load.M) / m->c_m;
     voltage = m->R * i + m->c_e * omega;
