@@ -268,23 +268,6 @@ def _max_pressure_angle(s: np.ndarray, s1: np.ndarray, r_b: float, e: float) -> 
     return float(np.max(np.abs(np.arctan2(s1 - e, math.sqrt(r_b * r_b - e * e) + s))))
 
 
-def _golden_min(f, a: float, b: float, tol: float) -> float:
-    """The argument of the least f between a and b (golden-section search to ``tol``)."""
-    g = (math.sqrt(5.0) - 1.0) / 2.0
-    c, d = b - g * (b - a), a + g * (b - a)
-    fc, fd = f(c), f(d)
-    while b - a > tol:
-        if fc < fd:
-            b, d, fd = d, c, fc
-            c = b - g * (b - a)
-            fc = f(c)
-        else:
-            a, c, fc = c, d, fd
-            d = a + g * (b - a)
-            fd = f(d)
-    return 0.5 * (a + b)
-
-
 def pressure_angle_advice(cam: DiscCam, limit: float) -> PressureAngleAdvice:
     """What lowers the max pressure angle of ``cam`` (module of the offset's effect: tan alpha = (s' - e) /
     (sqrt(r_b^2 - e^2) + s), an offset e > 0 lowers it on the rise, s' > 0, and raises it on the return):
@@ -303,7 +286,7 @@ def pressure_angle_advice(cam: DiscCam, limit: float) -> PressureAngleAdvice:
     scan = np.linspace(-span, span, 197)
     k = int(np.argmin([_max_pressure_angle(s, s1, r_b, x) for x in scan]))
     lo, hi = scan[max(k - 1, 0)], scan[min(k + 1, len(scan) - 1)]
-    best_offset = _golden_min(lambda x: _max_pressure_angle(s, s1, r_b, x), float(lo), float(hi), 1e-6 * r_b)
+    best_offset = golden_max(lambda x: -_max_pressure_angle(s, s1, r_b, x), float(lo), float(hi), 1e-6 * r_b)[0]
     if abs(best_offset) < 1e-6 * r_b:  # within the search's resolution of in line (a symmetric program)
         best_offset = 0.0
     lo, hi = max(r_r, abs(e)) * (1.0 + 1e-9) + 1e-12, r_b
