@@ -77,11 +77,14 @@ int cam_locate_first_event(int n, const int codes[], double a, double b, const d
 /* Append one transition to a step's log line `events` of `len` bytes (*dropped counts what no longer fits). */
 void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...);
 
+#define CAM_MAX_SLOTS 16         /* slots of a formulation's own state vector at most (cam_solver.h cam_tableau_step) */
+
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
 typedef struct {
     double h_next;              /* s: the next trial step of an adaptive method */
-    int k1_valid;               /* k1 holds f(x) under fsal_u and the mode */
+    int k1_valid;               /* k1 (k_own: of a formulation's own state vector) holds f(x) under fsal_u and the mode */
     double k1[CAM_NX];
+    double k_own[CAM_MAX_SLOTS];
     double fsal_u;
 } CamSolverState;
 

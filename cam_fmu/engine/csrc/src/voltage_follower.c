@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cam_solver.h"
 #include "cam_voltage_follower.h"
 
 #define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
@@ -29,6 +30,7 @@
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
+#define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
 #define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
 
 
@@ -214,23 +216,30 @@ static void set_on_flank(const CamModel *m, double y[NY], int contact)
     y[4] = d[1] * y[1];
 }
 
-/* One classic Runge-Kutta step of h [s] from y into out. */
-static void rk4(const CamModel *m, double u, int contact, const double y[NY], double h, double out[NY])
+typedef struct {                /* cam_vf_rates' arguments but the state (a CamRates context) */
+    const CamModel *m;
+    double u;
+    int contact;
+} Rates;
+
+static void rates(void *ctx, const double *y, double *dy)
 {
-    double k1[NY], k2[NY], k3[NY], k4[NY], t[NY];
-    int j;
-    cam_vf_rates(m, u, contact, y, k1);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + 0.5 * h * k1[j];
-    cam_vf_rates(m, u, contact, t, k2);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + 0.5 * h * k2[j];
-    cam_vf_rates(m, u, contact, t, k3);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + h * k3[j];
-    cam_vf_rates(m, u, contact, t, k4);
-    for (j = 0; j < NY; j++)
-        out[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    const Rates *r = ctx;
+    cam_vf_rates(r->m, r->u, r->contact, y, dy);
+}
+
+/* One step of the tableau t of h [s] from y into out (the follower set on its flank in contact); err: the embedded
+ * pair's error estimate, or NULL. k: the stages (NULL: scratch of its own), k[0] the rates at y already if k0. */
+static void vf_step(const CamModel *m, const CamTableau *t, double u, int contact, const double y[NY], double h,
+                    double out[NY], double *err, double *k, int k0)
+{
+    double scratch[(CAM_MAX_STAGES + 1) * NY];
+    Rates r = {m, u, contact};
+    if (k == NULL)
+        k = scratch, k0 = 0;
+    if (!k0)
+        rates(&r, y, k);
+    cam_tableau_step(t, m->compliant ? Y_SIGMA : Y_TWIST, NY, rates, &r, y, h, k, out, err);   /* sigma, dir: held */
     if (contact)
         set_on_flank(m, out, contact);
 }
@@ -271,6 +280,7 @@ static int crossed(double before, double after)
 
 typedef struct {                /* a Runge-Kutta step from y and its event functions (trial_event) */
     const CamModel *m;
+    const CamTableau *t;
     double u;
     int contact;
     const double *ends, *y;
@@ -281,7 +291,7 @@ static double trial_event(void *ctx, int code, double h)
 {
     const Trial *t = ctx;
     double out[NY];
-    rk4(t->m, t->u, t->contact, t->y, h, out);
+    vf_step(t->m, t->t, t->u, t->contact, t->y, h, out, NULL, NULL, 0);
     return event_at(t->m, t->u, code, t->contact, t->ends, out);
 }
 
@@ -292,6 +302,29 @@ static double acceleration_scale(const CamModel *m, const double y[NY], double u
     cam_profile_eval(&m->profile, y[0], d);
     return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
+}
+
+/* The error norm of an embedded step from y to out (rk.c cam_error_norm over y's slots): RMS of err / (atol + rtol
+ * max(|y|, |out|)) over theta (its scale capped at 2 pi), omega, the current and a compliant shaft's slots where they
+ * are states, and the follower's s, v in flight (on a flank they follow the cam's). */
+static double vf_error_norm(const CamModel *m, int contact, const double y[NY], const double out[NY],
+                            const double err[NY])
+{
+    static const int SLOTS[] = {0, 1, 2, Y_TWIST, Y_ROTOR, 3, 4};
+    double total = 0.0, scale;
+    int k, n = 0;
+    for (k = 0; k < 7; k++) {
+        int j = SLOTS[k];
+        if ((j == 2 && !m->has_current) || ((j == Y_TWIST || j == Y_ROTOR) && !m->compliant) || ((j == 3 || j == 4)
+                                                                                                   && contact))
+            continue;
+        scale = fmax(fabs(y[j]), fabs(out[j]));
+        if (j == 0)
+            scale = fmin(scale, 2.0 * 3.141592653589793);
+        total += pow(err[j] / (m->atol + m->rtol * scale), 2.0);
+        n += 1;
+    }
+    return sqrt(total / n);
 }
 
 /* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
@@ -481,7 +514,12 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                                                                                                   + 1.0 / m->J_0)
                 : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
     int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
+    int adaptive = cam_method(m->solver)->adaptive;   /* rk45: error control; else classic RK4 steps of STEP_ANGLE */
+    const CamTableau *tableau = adaptive ? cam_method(m->solver)->tableau : &cam_rk4;
     long dropped = 0, taken = 0;
+    double stages[(CAM_MAX_STAGES + 1) * NY], fsal_sigma = 0.0;   /* the adaptive steps' stages */
+    double after_before[6];   /* the event functions at the last step's end, codes_before[] */
+    int fsal = 0, fsal_contact = 0, have_before = 0, n_before = 0, codes_before[6];
     d->step_events[0] = '\0';
     cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
@@ -489,12 +527,19 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
+    if (adaptive && d->solver.k1_valid && d->solver.fsal_u == u && contact == (int)d->speed.contact && y[1] != 0.0) {
+        memcpy(stages, d->solver.k_own, NY * sizeof *stages);   /* the last step's end under the same input and mode */
+        fsal = 1;
+        fsal_contact = contact;
+        fsal_sigma = y[Y_SIGMA];
+    }
+    d->solver.k1_valid = 0;
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
         double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
-        if (y[1] != 0.0)
-            dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
-        if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {   /* from rest: STEP_ANGLE at the acceleration */
+        if (y[1] != 0.0 && (!adaptive || !contact))   /* in flight a step at most scans the gap's events */
+            dt = fmin(dt, (adaptive ? FLIGHT_ANGLE : STEP_ANGLE) / fabs(y[1]));
+        if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW && !adaptive) {   /* from rest: STEP_ANGLE at the acceleration */
             double rate[NY];
             cam_vf_rates(m, u, contact, y, rate);
             if (rate[1] != 0.0)
@@ -508,7 +553,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             if (y[4] != 0.0)
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
         }
-        if (pole > 0.0)
+        if (pole > 0.0)   /* also under error control: measured, the shaft's twist drifted 1.8e-8 of M_shaft without */
             dt = fmin(dt, POLE_STEP / pole);
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
@@ -520,7 +565,30 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             return cam_error(err, CAM_ERR_SIMULATION, "more than %d Runge-Kutta steps in one step from t = %g s (at "
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
-        rk4(m, u, contact, y, dt, next);
+        if (adaptive) {   /* error control on rtol, atol within the bounds above (integrate.c cam_step_adaptive) */
+            double bound = fmin(dt, m->h_max), norm, factor, e[NY];
+            dt = fmin(bound, d->solver.h_next);
+            if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
+                fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
+            for (;;) {
+                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal);
+                fsal = 1;   /* k[0] is the rates at y from here on */
+                norm = vf_error_norm(m, contact, y, next, e);
+                if (norm <= 1.0)
+                    break;
+                dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, tableau->error_exponent), 0.1);
+                if (dt < 1e-12 * h)
+                    return cam_error(err, CAM_ERR_REJECTED, "solver 'rk45' cannot meet rtol = %g, atol = %g: its step "
+                                     "fell below %g s (1e-12 of the communication step) at t = %g s: loosen rtol/atol, "
+                                     "or check the inputs and parameters", m->rtol, m->atol, 1e-12 * h, time + tau);
+            }
+            factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, tableau->error_exponent), 5.0);
+            if (dt < bound || factor < 1.0)
+                d->solver.h_next = fmin(dt * factor, 1e3);
+            else   /* a step the bounds cut: its success says nothing against a longer next one */
+                d->solver.h_next = fmax(d->solver.h_next, dt * fmin(factor, 1.0));
+        } else
+            vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0);
         codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
         if (contact) {
             if (y[Y_DIR] != 0.0)
@@ -538,18 +606,33 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
             codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
+        if (!(have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma && n == n_before))
+            have_before = 0;   /* the functions at y are the last step's at its end while its mode holds */
         for (k = 0; k < n; k++) {
-            before[k] = event_at(m, u, codes[k], contact, ends, y);
+            int kept = have_before && codes[k] == codes_before[k] && codes[k] != EV_BREAK && codes[k] != EV_SIDE;
+            before[k] = kept ? after_before[k] : event_at(m, u, codes[k], contact, ends, y);
             after[k] = event_at(m, u, codes[k], contact, ends, next);
         }
         {
-            Trial tr = {m, u, contact, ends, y};
+            Trial tr = {m, tableau, u, contact, ends, y};
             code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
         }
+        have_before = code == EV_NONE;
+        if (have_before) {   /* the mode the next step must keep to reuse the end's rates and event functions */
+            fsal_contact = contact;
+            fsal_sigma = y[Y_SIGMA];
+            n_before = n;
+            memcpy(codes_before, codes, sizeof codes_before);
+            memcpy(after_before, after, sizeof after_before);
+        }
+        if (code == EV_NONE && adaptive && tableau->fsal)   /* first same as last: the next step's k[0] */
+            memcpy(stages, stages + tableau->stages * NY, NY * sizeof *stages);
+        else
+            fsal = 0;
         if (code == EV_NONE) {
             memcpy(y, next, sizeof y);
         } else if (at < dt) {
-            rk4(m, u, contact, y, at, trial);
+            vf_step(m, tableau, u, contact, y, at, trial, NULL, NULL, 0);
             memcpy(y, trial, sizeof y);
         } else {
             memcpy(y, next, sizeof y);
@@ -588,6 +671,11 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more", dropped);
+    if (fsal && contact == fsal_contact && cam_vf_flight_direction(m, y) == fsal_sigma) {   /* the next step's k[0] */
+        memcpy(d->solver.k_own, stages, NY * sizeof *stages);
+        d->solver.k1_valid = 1;
+        d->solver.fsal_u = u;
+    }
     cam_vf_store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
