@@ -74,8 +74,9 @@ def _stored(model: DriveModel, r: dict) -> np.ndarray:
 def test_each_moved_answer_passes_its_physical_checks(case):
     """The re-recorded engine answer against the reference: theta to 1e-8 rad, omega to 2e-7 of its largest value
     (measured: 2.9e-9 rad and 1.2e-7 on extremes/seed27, which swings from -26 rad/s through 0 under 122 A in 1 ms;
-    at most 3.1e-11 rad and 1.6e-9 rad/s on the others), s to 1e-11 m and v to 1e-9 m/s (measured 4.7e-13 m,
-    5.6e-11 m/s); the follower within the clearance (2 pm); w+ = -e w- at each of the reference's touch-downs (1e-12);
+    at most 3.1e-11 rad and 1.6e-9 rad/s on the others), s to 3e-11 m and v to 1e-9 m/s (measured 1.1e-11 m on
+    backlash since its follower takes rk45's error-controlled steps, issue 38: the lift-off's s_cam(theta) carries theta's
+    2e-9 rad times s' into the flight; 4.7e-13 m with the former fixed 1e-4 rad steps; v 5.6e-11 m/s); the follower within the clearance (2 pm); w+ = -e w- at each of the reference's touch-downs (1e-12);
     in the voltage drive, the balance E_in - E_copper - E_shaft - E_guide - E_impact = the change of the stored
     energy on the same case with a lossless converter c_e = c_m (1e-9 of the largest stored or supplied energy;
     measured at most 1.1e-10 relative, extremes/seed58). The current and the voltage are not compared: at an input step the
@@ -84,7 +85,7 @@ def test_each_moved_answer_passes_its_physical_checks(case):
     rec = case["result"]
     steps = np.array(rec["steps"])
     c = effective_clearance(resolve(case["params"]))
-    for name, tol, relative in (("theta", 1e-8, False), ("omega", 2e-7, True), ("s", 1e-11, False),
+    for name, tol, relative in (("theta", 1e-8, False), ("omega", 2e-7, True), ("s", 3e-11, False),
                                 ("v", 1e-9, False)):
         got, want = np.array(rec["outputs"][name]), ref[name][steps]
         limit = tol * max(np.max(np.abs(want)), 1.0) if relative else tol

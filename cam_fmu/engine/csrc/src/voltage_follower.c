@@ -519,15 +519,16 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     long dropped = 0, taken = 0;
     double stages[(CAM_MAX_STAGES + 1) * NY], fsal_sigma = 0.0;   /* the adaptive steps' stages */
     double after_before[6];   /* the event functions at the last step's end, codes_before[] */
-    int fsal = 0, fsal_contact = 0, have_before = 0, n_before = 0, codes_before[6];
+    int fsal = 0, fsal_contact = 0, have_before = 0, n_before = 0, codes_before[6], carried;
     d->step_events[0] = '\0';
     cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
         cam_vf_at_rest(m, y, u, &contact, &left, 0);
-    if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
+    carried = adaptive && d->solver.k1_valid && d->solver.fsal_u == u && y[1] != 0.0;   /* as the last step ended */
+    if (contact && !carried && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))   /* its end was settled */
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
-    if (adaptive && d->solver.k1_valid && d->solver.fsal_u == u && contact == (int)d->speed.contact && y[1] != 0.0) {
+    if (carried && contact == (int)d->speed.contact) {
         memcpy(stages, d->solver.k_own, NY * sizeof *stages);   /* the last step's end under the same input and mode */
         fsal = 1;
         fsal_contact = contact;
