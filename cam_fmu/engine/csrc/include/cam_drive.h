@@ -74,6 +74,9 @@ typedef double (*CamEventValue)(void *ctx, int code, double x);
  * code, or 0 for none, and *at (follower.c, voltage_follower.c). */
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
                            int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at);
+#define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
+#define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
+
 /* Append one transition to a step's log line `events` of `len` bytes (*dropped counts what no longer fits). */
 void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...);
 

@@ -2,7 +2,7 @@
  * reference's physics/speed_follower.py and reference/flight.py, which integrate the flight numerically where
  * this file takes its closed form). Closures 'spring' (one flank, a return spring) and 'form' (a groove with
  * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
- * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -TOUCH, an impact with
+ * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -CAM_TOUCH, an impact with
  * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
  * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The output
  * N_contact is the flank's force along X (with the guide friction) over cos(alpha), signed: > 0 on the +1 flank,
@@ -14,8 +14,6 @@
 
 #include "cam_drive.h"
 
-#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
-#define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
 #define SCAN_ANGLE 1e-3         /* rad: cam angle between two samples of an event function */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 
@@ -117,7 +115,7 @@ static double event_value(const Motion *mo, const Piece *p, double contact, int 
     if (code == EV_HALT)
         return p->sigma * v;
     cam_profile_eval(&mo->m->profile, theta, d);
-    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + TOUCH : (d[0] + mo->c) - s + TOUCH;
+    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + CAM_TOUCH : (d[0] + mo->c) - s + CAM_TOUCH;
 }
 
 /* m/s2: a bound of the follower's acceleration relative to the flank near theta (speed_follower.acceleration_scale). */
@@ -233,7 +231,7 @@ void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, doub
 }
 
 /* An impact of the flank `flank` on the follower at theta (physics.speed_follower.land with J_0 = inf): the relative
- * speed w -> -e w; a rebound rising less than ZENO_HEIGHT is plastic and leaves the follower on the flank if it holds
+ * speed w -> -e w; a rebound rising less than CAM_ZENO_HEIGHT is plastic and leaves the follower on the flank if it holds
  * it. Sets the contact, s, v and the rebound's time bound. */
 static void strike(const Motion *mo, CamSpeedState *st, double flank, double theta, double omega, double omega_dot,
                    double time, char *events, size_t events_len, long *dropped)
@@ -246,7 +244,7 @@ static void strike(const Motion *mo, CamSpeedState *st, double flank, double the
     w_after = v_after - d[1] * omega;
     st->s = d[0];
     st->impacts += 1.0;
-    if (w_after * w_after < 2.0 * scale * ZENO_HEIGHT)
+    if (w_after * w_after < 2.0 * scale * CAM_ZENO_HEIGHT)
         w_after = 0.0;   /* the Zeno guard: a plastic impact */
     cam_follower_note(events, events_len, dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
                       "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time, theta, w, w_after);
@@ -270,7 +268,7 @@ static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, doubl
     double d[4], w;
     on_flank(mo, st->theta, st->contact, d);
     w = st->v - d[1] * omega0;
-    if (w * w < 2.0 * acceleration_scale(mo, st->theta, omega0, omega_dot) * ZENO_HEIGHT)
+    if (w * w < 2.0 * acceleration_scale(mo, st->theta, omega0, omega_dot) * CAM_ZENO_HEIGHT)
         return;
     if (st->contact * w > 0.0) {
         cam_follower_note(events, events_len, dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g "
@@ -362,7 +360,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);
             Ms[k] = shaft + (push + sigma * f) * e[1];
             if (k == 0)   /* the force along X over cos(alpha): > 0 on the +1 flank, < 0 on a groove's -1 flank */
-                N = (push + sigma * f) * sqrt(1.0 + t_a * t_a);
+                N = cam_normal_force(push + sigma * f, t_a);
         }
         M = Ms[0];
         J = m->J_0 + m->m * d[1] * d[1];

@@ -22,6 +22,11 @@ static double sign_of(double x)
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
+double cam_normal_force(double along_x, double tan_a)
+{
+    return along_x * sqrt(1.0 + tan_a * tan_a);
+}
+
 double cam_guide_friction(double n0, double kappa, double sigma, double mu, double n_support, double side)
 {
     double sk, f;
@@ -165,7 +170,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     push = m->m * a - m->F_gx;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;
-    out->N = (push + sigma * f) * sqrt(1.0 + tan_a * tan_a);   /* N cos(alpha) = the force along X (4.2) */
+    out->N = cam_normal_force(push + sigma * f, tan_a);
     out->J = m->J_0 + m->m * s1 * s1;
     out->f = f;
     out->v = v;

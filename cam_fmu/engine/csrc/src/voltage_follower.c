@@ -10,7 +10,7 @@
  * with J = J_0 + m s'^2, the guide friction f solved with omega_dot as model.c's load_terms does (section 4.4 with
  * F_close in gravity's place), and the force P = m (s'' omega^2 + s' omega_dot) + F_close + sgn(v) f along X;
  * lift-off where contact P reaches 0; in flight J_0 omega_dot = T and m s_dd = -F_close(s) - sigma f0 (f0 the
- * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -TOUCH, an impact exchanging
+ * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -CAM_TOUCH, an impact exchanging
  * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
  * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
  * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
@@ -24,7 +24,6 @@
 #include "cam_solver.h"
 #include "cam_voltage_follower.h"
 
-#define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
 #define STEP_ANGLE 1e-4         /* rad: cam angle of one Runge-Kutta step */
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
@@ -259,7 +258,7 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + TOUCH;
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + CAM_TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + CAM_TOUCH;
 }
 
 /* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
@@ -355,7 +354,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     impact(m, y, d[1], m->restitution);
     unstick(y);
     w = y[4] - d[1] * y[1];
-    if (w * w >= 2.0 * scale * ZENO_HEIGHT) {
+    if (w * w >= 2.0 * scale * CAM_ZENO_HEIGHT) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * acceleration_scale(m, y, u)) : 0.0;
         return 0;
     }
@@ -705,7 +704,7 @@ static void vf_outputs(CamDrive *d, double out[])
         on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
                  : m->M_f * shaft_direction(y) + P * dd[1];
-        load.N = P * sqrt(1.0 + tan_a * tan_a);   /* P / cos(alpha), signed as contact */
+        load.N = cam_normal_force(P, tan_a);   /* signed as contact */
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
