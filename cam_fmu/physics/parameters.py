@@ -144,7 +144,7 @@ _MODE = (
 )
 
 _SOLVER = (
-    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole); not used by the speed drive; a follower of its own in the voltage drive allows only 'rk45', with its rtol, atol and h_max (docs/model.md 13.6)", kind="string", choices=SOLVERS),
+    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole); not used by the speed drive; each runs a follower of its own in the voltage drive too (docs/model.md 13.6)", kind="string", choices=SOLVERS),
     _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; not used by the speed drive, "
        "which takes its own steps, docs/model.md 13.4)",
        low=1e-9, high=10.0),

@@ -32,21 +32,31 @@ def _moved() -> list[dict]:
 
 MOVED = _moved()
 RUNNING = [(new, old) for new, old in MOVED if new["result"]["error"] is None]
-REFUSED = [(new, old) for new, old in MOVED if new["result"]["error"] is not None]
+# rk45's cases are held to the reference below; the fixed-step solvers' answers carry their order's error (issue 38:
+# they were refused until their steps ran the follower; tests/engine/test_engine_voltage_follower.py checks the order)
+FIXED = [(new, old) for new, old in RUNNING
+         if new["params"].get("solver", "rk45") != "rk45" and DriveModel(new["params"]).drive == "voltage"]
+ADAPTIVE = [case for case in RUNNING if case not in FIXED]   # rk45, or the speed drive's own steps
 
 
-def test_the_moved_cases_are_the_free_followers_and_the_refusals_name_the_solver():
-    """21 cases moved (4 of the backlash scene, 17 extremes): each has a follower of its own now; 8 run, the other
-    13 are refused when built, naming 'solver' (a non-default solver with a free follower in the voltage drive) and
-    closure 'kinematic'; every kept record is the same case under closure 'kinematic'."""
-    assert len(MOVED) == 21 and len(RUNNING) == 8
+def test_the_moved_cases_are_the_free_followers_and_each_runs_its_solver():
+    """21 cases moved (4 of the backlash scene, 17 extremes): each has a follower of its own now and runs; 8 with
+    rk45 or the speed drive's own steps, the other 13 in the voltage drive with euler, rk4 or etdrk4 (refused when
+    built until issue 38, naming 'solver', and re-recorded then); every kept record is the same case under closure
+    'kinematic'."""
+    assert len(MOVED) == 21 and len(RUNNING) == 21 and len(ADAPTIVE) == 8 and len(FIXED) == 13
     for new, old in MOVED:
         assert own_follower(resolve(new["params"])) and not DriveModel(old["params"]).free_follower
         assert old["params"] == dict(new["params"], closure="kinematic")
-    for new, _ in REFUSED:
-        error = new["result"]["error"]
-        assert error["class"] == "ParameterError" and error["step"] == 0
-        assert error["message"].startswith("parameter 'solver' = ") and "closure 'kinematic'" in error["message"]
+
+
+@pytest.mark.parametrize("case", [new for new, _ in FIXED], ids=[new["name"] for new, _ in FIXED])
+def test_a_fixed_step_solver_keeps_the_follower_in_the_clearance(case):
+    """The fixed-step solvers' touch-downs are located on their own steps: the follower never enters a flank by more
+    than 2 pm (measured: their theta lies 3.7e-14 to 0.66 rad from the reference, as their order and h_max give)."""
+    c = effective_clearance(resolve(case["params"]))
+    out = case["result"]["outputs"]
+    assert np.max(np.abs(np.array(out["s"]) - np.array(out["s_cam"]))) <= c + 2e-12
 
 
 def _reference(case: dict):
@@ -70,7 +80,7 @@ def _stored(model: DriveModel, r: dict) -> np.ndarray:
             + 0.5 * model.L * r["i"] ** 2)
 
 
-@pytest.mark.parametrize("case", [new for new, _ in RUNNING], ids=[new["name"] for new, _ in RUNNING])
+@pytest.mark.parametrize("case", [new for new, _ in ADAPTIVE], ids=[new["name"] for new, _ in ADAPTIVE])
 def test_each_moved_answer_passes_its_physical_checks(case):
     """The re-recorded engine answer against the reference: theta to 1e-8 rad, omega to 2e-7 of its largest value
     (measured: 2.9e-9 rad and 1.2e-7 on extremes/seed27, which swings from -26 rad/s through 0 under 122 A in 1 ms;

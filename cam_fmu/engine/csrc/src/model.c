@@ -330,7 +330,6 @@ static int check_closure(const CamModel *model, CamError *err)
     char a[40], b[40];
     const double *v = model->params.v;
     const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
-    const CamParamSpec *solver = cam_param_spec(CAM_P_SOLVER);
     int paper = model->formulation == CAM_FORM_PAPER;
     if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
@@ -364,13 +363,6 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
                          "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
                          "'consistent'", closure);
-    if (model->solver != (int)solver->default_value)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'solver' = '%s': a follower of its own (closure '%s') in "
-                         "the voltage drive takes its own event-located Runge-Kutta steps (docs/model.md 13.6); "
-                         "allowed with it: '%s'%s", solver->choices[model->solver], closure,
-                         solver->choices[(int)solver->default_value],
-                         model->closure == CAM_CHOICE_CLOSURE_FORM
-                         ? "; closure 'kinematic' (the paper's rule) runs the chosen solver" : "");
     return CAM_OK;   /* voltage_follower.c */
 }
 

@@ -11,8 +11,10 @@
  * F_close in gravity's place), and the force P = m (s'' omega^2 + s' omega_dot) + F_close + sgn(v) f along X;
  * lift-off where contact P reaches 0; in flight J_0 omega_dot = T and m s_dd = -F_close(s) - sigma f0 (f0 the
  * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -CAM_TOUCH, an impact exchanging
- * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
- * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
+ * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. The steps of the parameter
+ * `solver` (rk.c's tableaus: rk45 with error control on rtol, atol; euler, rk4 and etdrk4's RK4 core fixed at h_max
+ * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's and the shaft's oscillation, a tenth of
+ * the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
  * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
@@ -24,13 +26,12 @@
 #include "cam_solver.h"
 #include "cam_voltage_follower.h"
 
-#define STEP_ANGLE 1e-4         /* rad: cam angle of one Runge-Kutta step */
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
-#define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
+#define SLOW 1.0                /* rad/s: below it a fixed step also sweeps at most its share from rest */
 
 
 static double sgn(double x)
@@ -513,8 +514,10 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                                                                                                   + 1.0 / m->J_0)
                 : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
     int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
-    int adaptive = cam_method(m->solver)->adaptive;   /* rk45: error control; else classic RK4 steps of STEP_ANGLE */
-    const CamTableau *tableau = adaptive ? cam_method(m->solver)->tableau : &cam_rk4;
+    const CamMethod *method = cam_method(m->solver);
+    int adaptive = method->adaptive;   /* rk45: error control; else fixed steps of h_max within the method's limits */
+    const CamTableau *tableau = method->tableau != NULL ? method->tableau : &cam_rk4;   /* etdrk4: its RK4 core */
+    double sweep = m->feature_angle * (method->resolution < HUGE_VAL ? method->resolution : method->max_sweep);
     long dropped = 0, taken = 0;
     double stages[(CAM_MAX_STAGES + 1) * NY], fsal_sigma = 0.0;   /* the adaptive steps' stages */
     double after_before[6];   /* the event functions at the last step's end, codes_before[] */
@@ -537,13 +540,24 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
         double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
-        if (y[1] != 0.0 && (!adaptive || !contact))   /* in flight a step at most scans the gap's events */
-            dt = fmin(dt, (adaptive ? FLIGHT_ANGLE : STEP_ANGLE) / fabs(y[1]));
-        if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW && !adaptive) {   /* from rest: STEP_ANGLE at the acceleration */
-            double rate[NY];
-            cam_vf_rates(m, u, contact, y, rate);
-            if (rate[1] != 0.0)
-                dt = fmin(dt, sqrt(2.0 * STEP_ANGLE / fabs(rate[1])));
+        if (y[1] != 0.0 && !contact)   /* in flight a step at most scans the gap's events */
+            dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
+        if (!adaptive) {   /* the internal step h_max, the cam sweeping at most the method's share of the finest
+                            * feature (fixed_step.c's resolution; euler's max_sweep), from rest at its acceleration */
+            double rate[NY], x[CAM_NX] = {y[0], y[1], y[2], y[Y_TWIST], y[Y_ROTOR]}, fastest;
+            CamMode engaged = d->mode;
+            engaged.contact = contact != 0;   /* fixed_step.c's stability limit, the pole explicit (RK4's core) */
+            fastest = cam_stiffness_rate(m, &engaged, x, 1);
+            dt = fmin(dt, m->h_max);
+            if (fastest > 0.0)
+                dt = fmin(dt, method->stability / fastest);
+            if (y[1] != 0.0)
+                dt = fmin(dt, sweep / fabs(y[1]));
+            if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {
+                cam_vf_rates(m, u, contact, y, rate);
+                if (rate[1] != 0.0)
+                    dt = fmin(dt, sqrt(2.0 * sweep / fabs(rate[1])));
+            }
         }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
@@ -726,8 +740,8 @@ static void vf_outputs(CamDrive *d, double out[])
 
 static void vf_advice(const CamDrive *d, char *buf, size_t len)
 {
-    (void)d;
-    snprintf(buf, len, "Runge-Kutta steps of %g rad of cam angle (fixed): reduce the communication step", STEP_ANGLE);
+    snprintf(buf, len, d->model.solver == CAM_CHOICE_SOLVER_RK45 ? "tighten rtol and atol, or lower h_max"
+             : "lower h_max, or use solver 'rk45'");
 }
 
 const CamFormulation cam_voltage_follower = {
