@@ -182,7 +182,8 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
 }
 
-void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+/* cam_vf_rates, and on a moving flank the contact's force *P [N] along X (else *P untouched). */
+static void flank_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY], double *P)
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -196,8 +197,8 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
         return;
     }
     if (contact) {
-        double d[4], P;
-        on_flank(m, y, u, contact, d, &dy[1], &P);
+        double d[4];
+        on_flank(m, y, u, contact, d, &dy[1], P);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
@@ -205,6 +206,12 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+}
+
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+{
+    double P;
+    flank_rates(m, u, contact, y, dy, &P);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -220,26 +227,29 @@ typedef struct {                /* cam_vf_rates' arguments but the state (a CamR
     const CamModel *m;
     double u;
     int contact;
+    double P;                   /* N: the flank's force at the last state the rates were taken at (on a flank) */
 } Rates;
 
 static void rates(void *ctx, const double *y, double *dy)
 {
-    const Rates *r = ctx;
-    cam_vf_rates(r->m, r->u, r->contact, y, dy);
+    Rates *r = ctx;
+    flank_rates(r->m, r->u, r->contact, y, dy, &r->P);
 }
 
 /* One step of the tableau t of h [s] from y into out (the follower set on its flank in contact); err: the embedded
  * pair's error estimate, or NULL. k: the stages (NULL: scratch of its own), k[0] the rates at y already if k0. */
 static void vf_step(const CamModel *m, const CamTableau *t, double u, int contact, const double y[NY], double h,
-                    double out[NY], double *err, double *k, int k0)
+                    double out[NY], double *err, double *k, int k0, double *P_end)
 {
     double scratch[(CAM_MAX_STAGES + 1) * NY];
-    Rates r = {m, u, contact};
+    Rates r = {m, u, contact, NAN};
     if (k == NULL)
         k = scratch, k0 = 0;
     if (!k0)
         rates(&r, y, k);
     cam_tableau_step(t, m->compliant ? Y_SIGMA : Y_TWIST, NY, rates, &r, y, h, k, out, err);   /* sigma, dir: held */
+    if (P_end != NULL)   /* an embedded FSAL pair took its last rates at out: the lift-off function's force there */
+        *P_end = err != NULL && t->fsal && t->error_exponent != 0.0 ? r.P : NAN;
     if (contact)
         set_on_flank(m, out, contact);
 }
@@ -291,7 +301,7 @@ static double trial_event(void *ctx, int code, double h)
 {
     const Trial *t = ctx;
     double out[NY];
-    vf_step(t->m, t->t, t->u, t->contact, t->y, h, out, NULL, NULL, 0);
+    vf_step(t->m, t->t, t->u, t->contact, t->y, h, out, NULL, NULL, 0, NULL);
     return event_at(t->m, t->u, code, t->contact, t->ends, out);
 }
 
@@ -539,7 +549,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     d->solver.k1_valid = 0;
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6], P_end = NAN;
         if (y[1] != 0.0 && !contact)   /* in flight a step at most scans the gap's events */
             dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
         if (!adaptive) {   /* the internal step h_max, the cam sweeping at most the method's share of the finest
@@ -585,7 +595,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
                 fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
             for (;;) {
-                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal);
+                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, &P_end);
                 fsal = 1;   /* k[0] is the rates at y from here on */
                 norm = vf_error_norm(m, contact, y, next, e);
                 if (norm <= 1.0)
@@ -602,7 +612,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             else   /* a step the bounds cut: its success says nothing against a longer next one */
                 d->solver.h_next = fmax(d->solver.h_next, dt * fmin(factor, 1.0));
         } else
-            vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0);
+            vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0, NULL);
         codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
         if (contact) {
             if (y[Y_DIR] != 0.0)
@@ -625,7 +635,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         for (k = 0; k < n; k++) {
             int kept = have_before && codes[k] == codes_before[k] && codes[k] != EV_BREAK && codes[k] != EV_SIDE;
             before[k] = kept ? after_before[k] : event_at(m, u, codes[k], contact, ends, y);
-            after[k] = event_at(m, u, codes[k], contact, ends, next);
+            after[k] = codes[k] == EV_LIFT_OFF && P_end == P_end ? contact * P_end   /* the FSAL stage's */
+                       : event_at(m, u, codes[k], contact, ends, next);
         }
         {
             Trial tr = {m, tableau, u, contact, ends, y};
@@ -646,7 +657,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (code == EV_NONE) {
             memcpy(y, next, sizeof y);
         } else if (at < dt) {
-            vf_step(m, tableau, u, contact, y, at, trial, NULL, NULL, 0);
+            vf_step(m, tableau, u, contact, y, at, trial, NULL, NULL, 0, NULL);
             memcpy(y, trial, sizeof y);
         } else {
             memcpy(y, next, sizeof y);
