@@ -182,8 +182,10 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
 }
 
-/* cam_vf_rates, and on a moving flank the contact's force *P [N] along X (else *P untouched). */
-static void flank_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY], double *P)
+/* cam_vf_rates, and on a moving flank the contact's force *P [N] along X and the guide's side force *n_r [N] (else
+ * both untouched). */
+static void flank_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY], double *P,
+                        double *n_r)
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -198,7 +200,7 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
     }
     if (contact) {
         double d[4];
-        on_flank(m, y, u, contact, d, &dy[1], P);
+        flank_terms(m, y, u, contact, d, &dy[1], P, n_r);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
@@ -210,8 +212,8 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
 
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
-    double P;
-    flank_rates(m, u, contact, y, dy, &P);
+    double P, n_r;
+    flank_rates(m, u, contact, y, dy, &P, &n_r);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -227,29 +229,32 @@ typedef struct {                /* cam_vf_rates' arguments but the state (a CamR
     const CamModel *m;
     double u;
     int contact;
-    double P;                   /* N: the flank's force at the last state the rates were taken at (on a flank) */
+    double P, n_r;              /* N: the flank's force and the side force where the rates were last taken (a flank) */
 } Rates;
 
 static void rates(void *ctx, const double *y, double *dy)
 {
     Rates *r = ctx;
-    flank_rates(r->m, r->u, r->contact, y, dy, &r->P);
+    flank_rates(r->m, r->u, r->contact, y, dy, &r->P, &r->n_r);
 }
 
 /* One step of the tableau t of h [s] from y into out (the follower set on its flank in contact); err: the embedded
  * pair's error estimate, or NULL. k: the stages (NULL: scratch of its own), k[0] the rates at y already if k0. */
 static void vf_step(const CamModel *m, const CamTableau *t, double u, int contact, const double y[NY], double h,
-                    double out[NY], double *err, double *k, int k0, double *P_end)
+                    double out[NY], double *err, double *k, int k0, double end[2])
 {
     double scratch[(CAM_MAX_STAGES + 1) * NY];
-    Rates r = {m, u, contact, NAN};
+    Rates r = {m, u, contact, NAN, NAN};
     if (k == NULL)
         k = scratch, k0 = 0;
     if (!k0)
         rates(&r, y, k);
     cam_tableau_step(t, m->compliant ? Y_SIGMA : Y_TWIST, NY, rates, &r, y, h, k, out, err);   /* sigma, dir: held */
-    if (P_end != NULL)   /* an embedded FSAL pair took its last rates at out: the lift-off function's force there */
-        *P_end = err != NULL && t->fsal && t->error_exponent != 0.0 ? r.P : NAN;
+    if (end != NULL) {   /* an embedded FSAL pair took its last rates at out: the flank's forces there (P, N_r) */
+        int fsal = err != NULL && t->fsal && t->error_exponent != 0.0;
+        end[0] = fsal ? r.P : NAN;
+        end[1] = fsal ? r.n_r : NAN;
+    }
     if (contact)
         set_on_flank(m, out, contact);
 }
@@ -532,6 +537,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     double stages[(CAM_MAX_STAGES + 1) * NY], fsal_sigma = 0.0;   /* the adaptive steps' stages */
     double after_before[6];   /* the event functions at the last step's end, codes_before[] */
     int fsal = 0, fsal_contact = 0, have_before = 0, n_before = 0, codes_before[6], carried;
+    double n_r_end = NAN;   /* N: the side force at the last step's end (NAN: not computed) */
     d->step_events[0] = '\0';
     cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
@@ -549,7 +555,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     d->solver.k1_valid = 0;
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6], P_end = NAN;
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6], forces[2] = {NAN, NAN}, n_r_y;
+        int carry = have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma;   /* the last step's end */
         if (y[1] != 0.0 && !contact)   /* in flight a step at most scans the gap's events */
             dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
         if (!adaptive) {   /* the internal step h_max, the cam sweeping at most the method's share of the finest
@@ -595,7 +602,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
                 fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
             for (;;) {
-                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, &P_end);
+                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, forces);
                 fsal = 1;   /* k[0] is the rates at y from here on */
                 norm = vf_error_norm(m, contact, y, next, e);
                 if (norm <= 1.0)
@@ -627,16 +634,27 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
         if (ends[0] == ends[0])   /* the step ends just past the profile's breakpoint (s'' or s''' jumps there) */
             codes[n++] = EV_BREAK;
-        if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
+        n_r_y = carry && n_r_end == n_r_end ? n_r_end : (contact && y[Y_DIR] != 0.0 && m->mu > 0.0
+                                                         ? side_force(m, y, u, contact) : 0.0);
+        if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(n_r_y)) != 0.0)
             codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
-        if (!(have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma && n == n_before))
+        if (!(carry && n == n_before))
             have_before = 0;   /* the functions at y are the last step's at its end while its mode holds */
+        if (contact && y[Y_DIR] != 0.0 && forces[0] != forces[0] && n > 1) {   /* the lift-off's and side force's */
+            double d[4], omega_dot;
+            flank_terms(m, next, u, contact, d, &omega_dot, &forces[0], &forces[1]);
+        }
+        n_r_end = forces[1];
         for (k = 0; k < n; k++) {
             int kept = have_before && codes[k] == codes_before[k] && codes[k] != EV_BREAK && codes[k] != EV_SIDE;
+            if (codes[k] == EV_SIDE) {   /* event_at's at[1] N_r + CAM_SIDE_HYSTERESIS from the forces in hand */
+                before[k] = ends[1] * n_r_y + CAM_SIDE_HYSTERESIS;
+                after[k] = ends[1] * forces[1] + CAM_SIDE_HYSTERESIS;
+                continue;
+            }
             before[k] = kept ? after_before[k] : event_at(m, u, codes[k], contact, ends, y);
-            after[k] = codes[k] == EV_LIFT_OFF && P_end == P_end ? contact * P_end   /* the FSAL stage's */
-                       : event_at(m, u, codes[k], contact, ends, next);
+            after[k] = codes[k] == EV_LIFT_OFF ? contact * forces[0] : event_at(m, u, codes[k], contact, ends, next);
         }
         {
             Trial tr = {m, tableau, u, contact, ends, y};
