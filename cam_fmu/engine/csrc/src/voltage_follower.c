@@ -556,7 +556,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
         double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6], forces[2] = {NAN, NAN}, n_r_y;
-        int carry = have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma;   /* the last step's end */
+        int carry;
         if (y[1] != 0.0 && !contact)   /* in flight a step at most scans the gap's events */
             dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
         if (!adaptive) {   /* the internal step h_max, the cam sweeping at most the method's share of the finest
@@ -590,6 +590,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
             y[Y_SIGMA] = cam_vf_flight_direction(m, y);
+        carry = have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma;   /* y is the last step's end */
         if (rebound > 0.0)
             dt = fmin(dt, rebound);   /* a bounce lasts about 4 rebound: the first step cannot hold it */
         if (++taken > MAX_STEPS)
@@ -642,8 +643,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (!(carry && n == n_before))
             have_before = 0;   /* the functions at y are the last step's at its end while its mode holds */
         if (contact && y[Y_DIR] != 0.0 && forces[0] != forces[0] && n > 1) {   /* the lift-off's and side force's */
-            double d[4], omega_dot;
-            flank_terms(m, next, u, contact, d, &omega_dot, &forces[0], &forces[1]);
+            double dd[4], omega_dot;
+            flank_terms(m, next, u, contact, dd, &omega_dot, &forces[0], &forces[1]);
         }
         n_r_end = forces[1];
         for (k = 0; k < n; k++) {
