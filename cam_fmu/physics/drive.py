@@ -19,7 +19,7 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import (BY_NAME, FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError,
+from .parameters import (FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError,
                          law_spec, mounting_component, resolve)
 
 
@@ -136,11 +136,6 @@ def check_closure(p: Mapping[str, Any]) -> None:
     if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
         raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
                              "with it: formulation 'consistent'")
-    if p["solver"] != BY_NAME["solver"].default:
-        kinematic = "; closure 'kinematic' (the paper's rule) runs the chosen solver" if closure == "form" else ""
-        raise ParameterError(f"parameter 'solver' = {p['solver']!r}: a follower of its own (closure {closure!r}) "
-                             "in the voltage drive takes its own event-located Runge-Kutta steps (docs/model.md "
-                             f"13.6); allowed with it: {BY_NAME['solver'].default!r}{kinematic}")
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:

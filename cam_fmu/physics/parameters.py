@@ -144,12 +144,11 @@ _MODE = (
 )
 
 _SOLVER = (
-    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole); not used by the speed drive; a follower of its own in the voltage drive takes its own event-located Runge-Kutta steps and allows only 'rk45' (docs/model.md 13.6)", kind="string", choices=SOLVERS),
-    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; not used by the speed drive "
-       "nor by a follower of its own in the voltage drive, which take their own steps, docs/model.md 13.4, 13.6)",
+    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole); not used by the speed drive; each runs a follower of its own in the voltage drive too (docs/model.md 13.6)", kind="string", choices=SOLVERS),
+    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; not used by the speed drive, "
+       "which takes its own steps, docs/model.md 13.4)",
        low=1e-9, high=10.0),
-    _P("rtol", "1", 1e-10, "relative tolerance of 'rk45' (not used by the speed drive nor by a follower of its own, "
-       "as h_max)", low=1e-14, high=0.1),
+    _P("rtol", "1", 1e-10, "relative tolerance of 'rk45' (not used by the speed drive, as h_max)", low=1e-14, high=0.1),
     _P("atol", "1", 1e-12, "absolute tolerance of 'rk45' (on rad, rad/s, A; not used where rtol is not)",
        low=1e-16, high=1.0),
     _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4); bounds the work of one step", low=1.0, high=1e6),
@@ -170,7 +169,7 @@ FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (
        "c = 0, m = 0 or follower_inertia false, or the paper's formulation (its eqs. 6-8): the kinematic rule, bit for "
        "bit), 'kinematic' (the paper's rule, eqs. 6-8, in any formulation: the follower rests in the clearance until a "
        "flank takes it along), 'spring' (one flank and a return spring k_spring, F_spring0; c = 0, m > 0). A flight: "
-       "speed drive, and voltage drive (consistent, solver 'rk45': its own Runge-Kutta steps; docs/model.md 13)",
+       "speed drive, and voltage drive (consistent, solver 'rk45' with its tolerances; docs/model.md 13)",
        kind="string", choices=CLOSURES),
     _P("k_spring", "N/m", 0.0, "rate of the return spring (closure 'spring')", low=0.0, high=1e9),
     _P("F_spring0", "N", 0.0, "preload of the return spring at s = 0 (closure 'spring')", low=0.0, high=1e6),

@@ -92,6 +92,25 @@ class SpeedFollower:
         stay = contact if self.held(theta, omega, omega_dot, contact) >= 0.0 else 0.0  # a tie: the events decide
         return stay, s1 * omega, impact(math.inf, self.m, s1, omega, v, 0.0)
 
+    def speed_step(self, theta: float, omega: float, omega_dot: float, v: float,
+                   contact: float) -> tuple[float, float, Impact | None]:
+        """(contact after, v after [m/s], the impact or None) where the imposed speed jumps to omega [rad/s] with the
+        follower on the flank ``contact`` at speed v (a step of omega_ref, docs/model.md 13.2).
+
+        The follower's speed is kept while the flank's jumps to s' omega, so the relative speed w = v - s' omega
+        jumps too. A flank moving away from the follower (contact w > 0) stops pushing: it lifts off with v. A
+        flank moving into it (contact w < 0) strikes it: ``land``, the impact law with restitution. Below the Zeno
+        guard's speed (w^2 < 2 A ZENO_HEIGHT, the rebound ``land`` would call plastic) nothing happens: the
+        follower stays on the flank at its speed.
+        """
+        s1 = self.program.derivatives(theta)[1]
+        w = v - s1 * omega
+        if w * w < 2.0 * self.acceleration_scale(theta, omega, omega_dot) * ZENO_HEIGHT:
+            return contact, s1 * omega, None
+        if contact * w > 0.0:
+            return 0.0, v, None
+        return self.land(theta, omega, omega_dot, v, contact)
+
     def outputs(self, theta: float, omega: float, omega_dot: float, s: float, v: float, contact: float,
                 direction: float | None = None) -> dict:
         """Every output of the speed drive with the follower's own s, v, a and the contact force N_contact [N];

@@ -211,8 +211,14 @@ class FollowerRun(PieceRun):
         if kind == "halt":
             return 0.0, [y[0], y[1], 0.0]
         flank = 1.0 if kind == "touch-down +1" else -1.0
+        return self._struck(t, y, flank, body.land(y[0], omega, omega_dot, y[2], flank))
+
+    def _struck(self, t: float, y: list, flank: float, landed: tuple) -> tuple[float, list]:
+        """The state after an impact on ``flank`` (``landed``: SpeedFollower.land's answer), counted."""
+        body = self.body
+        omega, omega_dot = self._speed(t)
+        after, v, _ = landed
         s, s1, _, _ = body.flank(y[0], flank)
-        after, v, hit = body.land(y[0], omega, omega_dot, y[2], flank)
         w = v - s1 * omega
         self.impacts.append((t, y[2] - s1 * omega, w))
         if after == 0.0 and w != 0.0:
@@ -221,9 +227,16 @@ class FollowerRun(PieceRun):
         return after, [y[0], s, v]
 
     def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
-        """Apply at once a lift-off whose function is already < 0 (s'' jumped at a breakpoint or the input did)."""
+        """Apply at once a step of omega (the flank's speed jumped, the follower's did not: a lift-off or an impact,
+        SpeedFollower.speed_step) and a lift-off whose function is already < 0 (s'' jumped at a breakpoint or the
+        input did)."""
         if contact != 0.0:
             omega, omega_dot = self._speed(t)
+            after, v, hit = self.body.speed_step(y[0], omega, omega_dot, y[2], contact)
+            if hit is not None:
+                return self._struck(t, y, contact, (after, v, hit))
+            if after == 0.0:   # the flank moves away faster than the follower: it flies on with its speed
+                return 0.0, [y[0], self.body.flank(y[0], contact)[0], v]
             if self.body.held(y[0], omega, omega_dot, contact) < 0.0:
                 return self._transition(t, y, contact, "lift-off")
             s, s1, _, _ = self.body.flank(y[0], contact)

@@ -98,6 +98,69 @@ def test_restitution_one_keeps_the_flight_energy_and_less_settles():
     assert damped["s"][-1] == damped["s_cam"][-1] and np.max(damped["s"] - damped["s_cam"]) > 4e-3
 
 
+GROOVE = dict(drive="speed", closure="form", c=0.05, restitution=1.0, gamma=-math.pi / 2, mu=0.0, M_f=0.0)
+
+
+def stepped_runs(params: dict, before: float, after: float, t_step: float, stop: float, n: int):
+    """(model, times, engine, reference, the reference's impacts) with omega_ref stepping from ``before`` to ``after``
+    [rad/s] at t_step [s]: the engine stepped by a host that sets omega_ref at each communication point."""
+    from cam_fmu.physics.drive import DriveModel
+    from cam_fmu.physics.signals import Signal
+    from cam_fmu.reference.flight import FollowerRun
+
+    model = DriveModel(params)
+    times = np.linspace(0.0, stop, n + 1)
+    omega_ref = Signal((0.0, t_step, t_step), (before, before, after))
+    run = FollowerRun(model, omega_ref, 1e-12, 1e-13)
+    ref = run.run(times, model.params["theta0"])
+    sim = DriveSimulator(params)
+    sim.set_inputs(u=0.0, omega_ref=before, omega_dot_ref=0.0)
+    rows = [sim.outputs()]
+    for t0, t1 in zip(times[:-1], times[1:]):
+        sim.do_step(float(t0), float(t1 - t0), omega_ref=omega_ref.value(float(t0)), omega_dot_ref=0.0)
+        rows.append(sim.outputs())
+    got = {name: np.array([row[name] for row in rows]) for name in rows[0]}
+    return model, times, got, ref, run.impacts
+
+
+def test_a_step_of_omega_to_zero_lets_the_follower_fly_and_land_with_its_energy():
+    """Issue 39.3: the flank rides the rise at 1.05 m/s when omega_ref steps from 15 rad/s to 0. A flank only pushes:
+    the follower flies on with 1.05 m/s, turns under gravity and lands on the stopped flank, again and again
+    (restitution 1, no friction): its energy m v^2/2 - F_gx s stays what it was at the step, in the engine and the
+    reference (before the fix the speed fell to 0 at the step and the energy from 0.438 to 0.222 J of the issue's
+    scene)."""
+    model, times, got, ref, impacts = stepped_runs(GROOVE, 15.0, 0.0, 0.1, 0.6, 600)
+    k = 100   # the row at the step: its left limit in the engine (omega = 15 rad/s before it)
+    assert got["v"][k] == pytest.approx(1.05, abs=1e-12)
+    energy_at_step = 0.5 * model.m * got["v"][k] ** 2 - model.F_gx * got["s"][k]
+    assert len(impacts) >= 2 and all(t > 0.1 for t, _, _ in impacts)   # it lands on the stopped flank, twice
+    for out in (got, ref):
+        after = slice(k + 1, None)
+        energy = 0.5 * model.m * out["v"][after] ** 2 - model.F_gx * out["s"][after]
+        assert np.max(np.abs(energy - energy_at_step)) < 1e-9 * energy_at_step
+        assert np.max(out["s"][after] - out["s_cam"][after]) > 0.0   # it rose above the flank's middle
+    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10
+    rows = np.arange(len(times)) != k   # at the step the reference reports its right limit with the follower on the flank
+    assert np.max(np.abs(got["v"][rows] - ref["v"][rows])) < 1e-8
+
+
+@pytest.mark.parametrize("e", [1.0, 0.5])
+def test_a_step_of_omega_up_strikes_the_resting_follower(e):
+    """Issue 39.3: the follower rests on the rise's flank (s' = 0.07 m/rad at theta0 = 1 rad) when omega_ref steps
+    from 0 to 15 rad/s: the flank strikes it, v+ = (1 + e) s' omega+ from rest (the impact law with an imposed
+    speed), then it flies under gravity alone: v = v+ - g t, s = s0 + v+ t - g t^2 / 2 after the step."""
+    params = dict(GROOVE, restitution=e, theta0=1.0)
+    model, times, got, ref, impacts = stepped_runs(params, 0.0, 15.0, 0.1, 0.2, 200)
+    s_cam0, s1, _, _ = model.program.derivatives(1.0)
+    v_plus, g, s0 = (1.0 + e) * s1 * 15.0, -model.F_gx / model.m, s_cam0 - model.c
+    assert s1 * 15.0 == pytest.approx(1.05, rel=1e-3) and impacts[0][0] == 0.1
+    assert got["v"][100] == 0.0   # the engine's left limit at the step: at rest
+    for out in (got, ref):
+        t = times[101:104] - 0.1
+        assert np.max(np.abs(out["v"][101:104] - (v_plus - g * t))) < 1e-9
+        assert np.max(np.abs(out["s"][101:104] - (s0 + v_plus * t - 0.5 * g * t * t))) < 1e-10
+
+
 def test_a_state_saved_in_flight_repeats_its_run():
     scene = find_scene("spring_bounce")
     sim = DriveSimulator(dict(scene.primary.params))

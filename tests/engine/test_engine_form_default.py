@@ -32,21 +32,31 @@ def _moved() -> list[dict]:
 
 MOVED = _moved()
 RUNNING = [(new, old) for new, old in MOVED if new["result"]["error"] is None]
-REFUSED = [(new, old) for new, old in MOVED if new["result"]["error"] is not None]
+# rk45's cases are held to the reference below; the fixed-step solvers' answers carry their order's error (issue 38:
+# they were refused until their steps ran the follower; tests/engine/test_engine_voltage_follower.py checks the order)
+FIXED = [(new, old) for new, old in RUNNING
+         if new["params"].get("solver", "rk45") != "rk45" and DriveModel(new["params"]).drive == "voltage"]
+ADAPTIVE = [case for case in RUNNING if case not in FIXED]   # rk45, or the speed drive's own steps
 
 
-def test_the_moved_cases_are_the_free_followers_and_the_refusals_name_the_solver():
-    """21 cases moved (4 of the backlash scene, 17 extremes): each has a follower of its own now; 8 run, the other
-    13 are refused when built, naming 'solver' (a non-default solver with a free follower in the voltage drive) and
-    closure 'kinematic'; every kept record is the same case under closure 'kinematic'."""
-    assert len(MOVED) == 21 and len(RUNNING) == 8
+def test_the_moved_cases_are_the_free_followers_and_each_runs_its_solver():
+    """21 cases moved (4 of the backlash scene, 17 extremes): each has a follower of its own now and runs; 8 with
+    rk45 or the speed drive's own steps, the other 13 in the voltage drive with euler, rk4 or etdrk4 (refused when
+    built until issue 38, naming 'solver', and re-recorded then); every kept record is the same case under closure
+    'kinematic'."""
+    assert len(MOVED) == 21 and len(RUNNING) == 21 and len(ADAPTIVE) == 8 and len(FIXED) == 13
     for new, old in MOVED:
         assert own_follower(resolve(new["params"])) and not DriveModel(old["params"]).free_follower
         assert old["params"] == dict(new["params"], closure="kinematic")
-    for new, _ in REFUSED:
-        error = new["result"]["error"]
-        assert error["class"] == "ParameterError" and error["step"] == 0
-        assert error["message"].startswith("parameter 'solver' = ") and "closure 'kinematic'" in error["message"]
+
+
+@pytest.mark.parametrize("case", [new for new, _ in FIXED], ids=[new["name"] for new, _ in FIXED])
+def test_a_fixed_step_solver_keeps_the_follower_in_the_clearance(case):
+    """The fixed-step solvers' touch-downs are located on their own steps: the follower never enters a flank by more
+    than 2 pm (measured: their theta lies 3.7e-14 to 0.66 rad from the reference, as their order and h_max give)."""
+    c = effective_clearance(resolve(case["params"]))
+    out = case["result"]["outputs"]
+    assert np.max(np.abs(np.array(out["s"]) - np.array(out["s_cam"]))) <= c + 2e-12
 
 
 def _reference(case: dict):
@@ -70,12 +80,13 @@ def _stored(model: DriveModel, r: dict) -> np.ndarray:
             + 0.5 * model.L * r["i"] ** 2)
 
 
-@pytest.mark.parametrize("case", [new for new, _ in RUNNING], ids=[new["name"] for new, _ in RUNNING])
+@pytest.mark.parametrize("case", [new for new, _ in ADAPTIVE], ids=[new["name"] for new, _ in ADAPTIVE])
 def test_each_moved_answer_passes_its_physical_checks(case):
     """The re-recorded engine answer against the reference: theta to 1e-8 rad, omega to 2e-7 of its largest value
     (measured: 2.9e-9 rad and 1.2e-7 on extremes/seed27, which swings from -26 rad/s through 0 under 122 A in 1 ms;
-    at most 3.1e-11 rad and 1.6e-9 rad/s on the others), s to 1e-11 m and v to 1e-9 m/s (measured 4.7e-13 m,
-    5.6e-11 m/s); the follower within the clearance (2 pm); w+ = -e w- at each of the reference's touch-downs (1e-12);
+    at most 3.1e-11 rad and 1.6e-9 rad/s on the others), s to 3e-11 m and v to 1e-9 m/s (measured 1.1e-11 m on
+    backlash since its follower takes rk45's error-controlled steps, issue 38: the lift-off's s_cam(theta) carries theta's
+    2e-9 rad times s' into the flight; 4.7e-13 m with the former fixed 1e-4 rad steps; v 5.6e-11 m/s); the follower within the clearance (2 pm); w+ = -e w- at each of the reference's touch-downs (1e-12);
     in the voltage drive, the balance E_in - E_copper - E_shaft - E_guide - E_impact = the change of the stored
     energy on the same case with a lossless converter c_e = c_m (1e-9 of the largest stored or supplied energy;
     measured at most 1.1e-10 relative, extremes/seed58). The current and the voltage are not compared: at an input step the
@@ -84,7 +95,7 @@ def test_each_moved_answer_passes_its_physical_checks(case):
     rec = case["result"]
     steps = np.array(rec["steps"])
     c = effective_clearance(resolve(case["params"]))
-    for name, tol, relative in (("theta", 1e-8, False), ("omega", 2e-7, True), ("s", 1e-11, False),
+    for name, tol, relative in (("theta", 1e-8, False), ("omega", 2e-7, True), ("s", 3e-11, False),
                                 ("v", 1e-9, False)):
         got, want = np.array(rec["outputs"][name]), ref[name][steps]
         limit = tol * max(np.max(np.abs(want)), 1.0) if relative else tol

@@ -15,10 +15,11 @@ SOLVER_KEYS = ("solver", "h_max", "rtol", "atol", "max_steps")
 FIXED_STEP_H = (1e-3, 2.5e-4, 1e-4)  # s, h_max of euler, rk4, etdrk4
 RK45_RTOL = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)  # atol = rtol / 100 (1e-10 is the default)
 COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s
-CASES = ("fig6", "backlash", "inductance")
+CASES = ("fig6", "backlash", "inductance", "groove_voltage", "spring_voltage")   # the last two: followers of their own
 LEVELS = (1e-3, 1e-6, 1e-8)  # rad: accuracy levels of the choice table
 
-CASE_SCENES = {"fig6": "paper_fig6", "backlash": "backlash", "inductance": "inductance"}  # shipped scenes
+CASE_SCENES = {"fig6": "paper_fig6", "backlash": "backlash", "inductance": "inductance",   # shipped scenes
+               "groove_voltage": "groove_voltage", "spring_voltage": "spring_voltage"}
 
 # the CSV columns: report.COLUMNS
 

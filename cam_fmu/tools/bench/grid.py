@@ -1,7 +1,7 @@
 """The error grid: every solver over a grid of settings and communication steps, cam.fmu through fmpy.
 
 For every solver over a grid of internal settings (fixed-step solvers: h_max; rk45: rtol with atol =
-rtol / 100) and communication steps, on the scenes paper_fig6, backlash and inductance (``cases.py``),
+rtol / 100) and communication steps, on the scenes paper_fig6, backlash, inductance, groove_voltage and spring_voltage (``cases.py``),
 cam.fmu runs through ``fmpy.simulate_fmu`` (one instance, reset between runs, best of a few repeats); per
 run:
 

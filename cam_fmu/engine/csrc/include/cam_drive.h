@@ -76,14 +76,20 @@ typedef double (*CamEventValue)(void *ctx, int code, double x);
  * code, or 0 for none, and *at (follower.c, voltage_follower.c). */
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
                            int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at);
+#define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
+#define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
+
 /* Append one transition to a step's log line `events` of `len` bytes (*dropped counts what no longer fits). */
 void cam_follower_note(char *events, size_t len, long *dropped, const char *format, ...);
+
+#define CAM_MAX_SLOTS 16         /* slots of a formulation's own state vector at most (cam_solver.h cam_tableau_step) */
 
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
 typedef struct {
     double h_next;              /* s: the next trial step of an adaptive method */
-    int k1_valid;               /* k1 holds f(x) under fsal_u and the mode */
+    int k1_valid;               /* k1 (k_own: of a formulation's own state vector) holds f(x) under fsal_u and the mode */
     double k1[CAM_NX];
+    double k_own[CAM_MAX_SLOTS];
     double fsal_u;
 } CamSolverState;
 

@@ -82,6 +82,16 @@ void cam_etdrk4_step(const struct CamMethod *method, const CamModel *m, const Ca
 void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX],
                  double u, double h, CamStepWork *w);
 
+/* The derivatives dy [per s] of a hybrid driver's own state vector y (its slots its own), ctx its arguments. */
+typedef void (*CamRates)(void *ctx, const double *y, double *dy);
+
+/* cam_rk_step's step, in its order of operations, over a state vector y of `width` <= CAM_MAX_SLOTS slots whose first
+ * n move (the rest carried unchanged: their rates are 0): the stages in k (rows of `width` doubles, CAM_MAX_STAGES + 1
+ * rows; k[0] = rates(y) on entry), the new state in y_new and, for a tableau with an embedded pair and error != NULL,
+ * its error estimate h sum e_j k_j over the n slots (the FSAL stage computed into k's row `stages`). */
+void cam_tableau_step(const CamTableau *t, int n, int width, CamRates rates, void *ctx, const double *y, double h,
+                      double *k, double *y_new, double *error);
+
 /* The error norm of an embedded step: RMS over the nx slots of error / (atol + rtol max(|x|, |x_new|)),
  * theta's scale capped at 2 pi (it enters the physics mod 2 pi). */
 double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w);

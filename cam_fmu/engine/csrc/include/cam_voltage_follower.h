@@ -7,7 +7,6 @@
 
 #include "cam_drive.h"
 
-#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
 #define NY 9
 #define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
 #define Y_ROTOR 6

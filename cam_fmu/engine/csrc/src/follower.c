@@ -2,7 +2,7 @@
  * reference's physics/speed_follower.py and reference/flight.py, which integrate the flight numerically where
  * this file takes its closed form). Closures 'spring' (one flank, a return spring) and 'form' (a groove with
  * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
- * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -TOUCH, an impact with
+ * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -CAM_TOUCH, an impact with
  * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
  * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The output
  * N_contact is the flank's force along X (with the guide friction) over cos(alpha), signed: > 0 on the +1 flank,
@@ -14,8 +14,6 @@
 
 #include "cam_drive.h"
 
-#define TOUCH 1e-12             /* m: a touch-down is located this far inside the flank (reference/flight.py) */
-#define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
 #define SCAN_ANGLE 1e-3         /* rad: cam angle between two samples of an event function */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 
@@ -117,7 +115,7 @@ static double event_value(const Motion *mo, const Piece *p, double contact, int 
     if (code == EV_HALT)
         return p->sigma * v;
     cam_profile_eval(&mo->m->profile, theta, d);
-    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + TOUCH : (d[0] + mo->c) - s + TOUCH;
+    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + CAM_TOUCH : (d[0] + mo->c) - s + CAM_TOUCH;
 }
 
 /* m/s2: a bound of the follower's acceleration relative to the flank near theta (speed_follower.acceleration_scale). */
@@ -232,6 +230,55 @@ void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, doub
     st->v = d[1] * omega;
 }
 
+/* An impact of the flank `flank` on the follower at theta (physics.speed_follower.land with J_0 = inf): the relative
+ * speed w -> -e w; a rebound rising less than CAM_ZENO_HEIGHT is plastic and leaves the follower on the flank if it holds
+ * it. Sets the contact, s, v and the rebound's time bound. */
+static void strike(const Motion *mo, CamSpeedState *st, double flank, double theta, double omega, double omega_dot,
+                   double time, char *events, size_t events_len, long *dropped)
+{
+    const CamModel *m = mo->m;
+    double d[4], w, v_after, w_after, scale = acceleration_scale(mo, theta, omega, omega_dot);
+    on_flank(mo, theta, flank, d);
+    w = st->v - d[1] * omega;
+    v_after = st->v - (1.0 + m->restitution) * w;   /* the impulse -(1 + e) m w over m */
+    w_after = v_after - d[1] * omega;
+    st->s = d[0];
+    st->impacts += 1.0;
+    if (w_after * w_after < 2.0 * scale * CAM_ZENO_HEIGHT)
+        w_after = 0.0;   /* the Zeno guard: a plastic impact */
+    cam_follower_note(events, events_len, dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
+                      "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time, theta, w, w_after);
+    if (w_after != 0.0) {
+        st->contact = 0.0;
+        st->v = v_after;
+        st->rebound = fabs(w_after) / (2.0 * scale);
+    } else {
+        st->contact = held(mo, theta, omega, omega_dot, flank) >= 0.0 ? flank : 0.0;
+        st->v = d[1] * omega;
+        st->rebound = 0.0;
+    }
+}
+
+/* A step of omega to omega0 at the step's start (docs/model.md 13.2, physics.speed_follower.speed_step): the flank's
+ * speed jumps, the follower's does not. A flank now moving away from the follower lets it fly on with its speed; a
+ * flank moving into it strikes it; below the Zeno guard's relative speed nothing happens. */
+static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, double omega_dot, double time,
+                       char *events, size_t events_len, long *dropped)
+{
+    double d[4], w;
+    on_flank(mo, st->theta, st->contact, d);
+    w = st->v - d[1] * omega0;
+    if (w * w < 2.0 * acceleration_scale(mo, st->theta, omega0, omega_dot) * CAM_ZENO_HEIGHT)
+        return;
+    if (st->contact * w > 0.0) {
+        cam_follower_note(events, events_len, dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g "
+                          "rad), the cam's speed stepped to %.6g rad/s; ", (int)st->contact, time, st->theta, omega0);
+        st->contact = 0.0;
+        st->rebound = 0.0;
+    } else
+        strike(mo, st, st->contact, st->theta, omega0, omega_dot, time, events, events_len, dropped);
+}
+
 /* The follower over a step of h [s] from st->theta at omega0 + omega_dot tau; st->theta is left unchanged
  * (the caller moves it). */
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
@@ -242,6 +289,8 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
     double tau = 0.0, d[4];
     long count = 0, dropped = 0;
     Piece p = {0.0, st->s, st->v, 0.0};
+    if (st->contact != 0.0)
+        speed_step(&mo, st, omega0, omega_dot, time, events, events_len, &dropped);
     for (;;) {
         double at = h, theta, omega;
         int code;
@@ -280,30 +329,11 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
                  (int)st->contact, time + at, theta);
             st->contact = 0.0;
             st->rebound = 0.0;
-        } else if (code == EV_HALT) {
+        } else if (code == EV_HALT)
             st->v = 0.0;
-        } else {
-            double flank = code == EV_TOUCH_UP ? 1.0 : -1.0, w, impulse, v_after, w_after;
-            on_flank(&mo, theta, flank, d);
-            w = st->v - d[1] * omega;
-            impulse = -(1.0 + m->restitution) * m->m * w;   /* physics.follower.impact with J_0 = inf */
-            v_after = st->v + impulse / m->m;
-            w_after = v_after - d[1] * omega;
-            st->s = d[0];
-            st->impacts += 1.0;
-            if (w_after * w_after < 2.0 * acceleration_scale(&mo, theta, omega, omega_dot) * ZENO_HEIGHT)
-                w_after = 0.0;   /* the Zeno guard: a plastic impact */
-            cam_follower_note(events, events_len, &dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
-                 "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time + at, theta, w, w_after);
-            if (w_after != 0.0) {
-                st->v = v_after;
-                st->rebound = fabs(w_after) / (2.0 * acceleration_scale(&mo, theta, omega, omega_dot));
-            } else {   /* the Zeno guard: a plastic impact, on the flank if it holds the follower */
-                st->contact = held(&mo, theta, omega, omega_dot, flank) >= 0.0 ? flank : 0.0;
-                st->v = d[1] * omega;
-                st->rebound = 0.0;
-            }
-        }
+        else
+            strike(&mo, st, code == EV_TOUCH_UP ? 1.0 : -1.0, theta, omega, omega_dot, time + at, events, events_len,
+                   &dropped);
     }
 }
 
@@ -330,7 +360,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);
             Ms[k] = shaft + (push + sigma * f) * e[1];
             if (k == 0)   /* the force along X over cos(alpha): > 0 on the +1 flank, < 0 on a groove's -1 flank */
-                N = (push + sigma * f) * sqrt(1.0 + t_a * t_a);
+                N = cam_normal_force(push + sigma * f, t_a);
         }
         M = Ms[0];
         J = m->J_0 + m->m * d[1] * d[1];

@@ -22,6 +22,11 @@ static double sign_of(double x)
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
+double cam_normal_force(double along_x, double tan_a)
+{
+    return along_x * sqrt(1.0 + tan_a * tan_a);
+}
+
 double cam_guide_friction(double n0, double kappa, double sigma, double mu, double n_support, double side)
 {
     double sk, f;
@@ -165,7 +170,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     push = m->m * a - m->F_gx;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;
-    out->N = (push + sigma * f) * sqrt(1.0 + tan_a * tan_a);   /* N cos(alpha) = the force along X (4.2) */
+    out->N = cam_normal_force(push + sigma * f, tan_a);
     out->J = m->J_0 + m->m * s1 * s1;
     out->f = f;
     out->v = v;
@@ -325,7 +330,6 @@ static int check_closure(const CamModel *model, CamError *err)
     char a[40], b[40];
     const double *v = model->params.v;
     const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
-    const CamParamSpec *solver = cam_param_spec(CAM_P_SOLVER);
     int paper = model->formulation == CAM_FORM_PAPER;
     if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
         return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
@@ -359,13 +363,6 @@ static int check_closure(const CamModel *model, CamError *err)
         return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
                          "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
                          "'consistent'", closure);
-    if (model->solver != (int)solver->default_value)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'solver' = '%s': a follower of its own (closure '%s') in "
-                         "the voltage drive takes its own event-located Runge-Kutta steps (docs/model.md 13.6); "
-                         "allowed with it: '%s'%s", solver->choices[model->solver], closure,
-                         solver->choices[(int)solver->default_value],
-                         model->closure == CAM_CHOICE_CLOSURE_FORM
-                         ? "; closure 'kinematic' (the paper's rule) runs the chosen solver" : "");
     return CAM_OK;   /* voltage_follower.c */
 }
 

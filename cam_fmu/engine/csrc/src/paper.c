@@ -231,7 +231,7 @@ static double paper_contact_force(const CamModel *m, const CamPaperState *p, con
     if (p->v == 0.0 && m->c > 0.0)
         return 0.0;
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
-    return (push + sigma * f) * sqrt(1.0 + tan_a * tan_a);
+    return cam_normal_force(push + sigma * f, tan_a);
 }
 
 static void paper_outputs(CamDrive *d, double out[])

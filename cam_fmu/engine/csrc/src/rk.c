@@ -112,6 +112,66 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_RIGID);
 }
 
+/* sum[slot] = h * sum_j coef[j] k[j][slot] over the nonzero coefficients idx[0..count-1], left to right (count >= 2),
+ * for the first n slots of rows of `width`: combine's sum, slot by slot in the same order, over whole rows. */
+static inline void weighted_sum(const double *coef, const int *idx, int count, const double *k, int n, int width,
+                                double h, double *sum)
+{
+    int j, slot;
+    const double *row = k + idx[0] * width;
+    for (slot = 0; slot < n; slot++)
+        sum[slot] = coef[idx[0]] * row[slot];
+    for (j = 1; j < count; j++) {
+        double a = coef[idx[j]];
+        row = k + idx[j] * width;
+        for (slot = 0; slot < n; slot++)
+            sum[slot] += a * row[slot];
+    }
+    for (slot = 0; slot < n; slot++)
+        sum[slot] *= h;
+}
+
+/* rk_step_slots over any state vector: k holds the stages as rows of `width`, k[0] = rates(y) on entry; the slots
+ * from n on are carried unchanged. */
+void cam_tableau_step(const CamTableau *t, int n, int width, CamRates rates, void *ctx, const double *y, double h,
+                      double *k, double *y_new, double *error)
+{
+    double arg[CAM_MAX_SLOTS], sum[CAM_MAX_SLOTS];
+    int i, slot, s = t->stages, idx[CAM_MAX_STAGES + 1] = {0}, count;
+    for (slot = n; slot < width; slot++)
+        arg[slot] = y_new[slot] = y[slot];
+    for (i = 1; i < s; i++) {   /* the stages: x + (h a) k for a single coefficient, else x + h sum (combine) */
+        count = nonzero(t->a[i], i, idx);
+        if (count == 1) {
+            double ha = h * t->a[i][idx[0]];
+            const double *row = k + idx[0] * width;
+            for (slot = 0; slot < n; slot++)
+                arg[slot] = y[slot] + ha * row[slot];
+        } else {
+            weighted_sum(t->a[i], idx, count, k, n, width, h, sum);
+            for (slot = 0; slot < n; slot++)
+                arg[slot] = y[slot] + sum[slot];
+        }
+        rates(ctx, arg, k + i * width);
+    }
+    count = nonzero(t->b, s, idx);
+    if (count == 1 && t->b_divisor <= 0.0) {   /* Euler */
+        double hb = h * t->b[idx[0]];
+        for (slot = 0; slot < n; slot++)
+            y_new[slot] = y[slot] + hb * k[idx[0] * width + slot];
+    } else {   /* (h / d) * (b_1 k_1 + ...) with the weights' common factor d, else h * (b_1 k_1 + ...) */
+        weighted_sum(t->b, idx, count, k, n, width, 1.0, sum);
+        for (slot = 0; slot < n; slot++)
+            y_new[slot] = y[slot] + (t->b_divisor > 0.0 ? h / t->b_divisor : h) * sum[slot];
+    }
+    if (error == NULL || t->error_exponent == 0.0)
+        return;
+    if (t->fsal)
+        rates(ctx, y_new, k + s * width);
+    count = nonzero(t->e, s + (t->fsal ? 1 : 0), idx);
+    weighted_sum(t->e, idx, count, k, n, width, h, error);
+}
+
 double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w)
 {
     double total = 0.0, scale, atol = m->atol, rtol = m->rtol;

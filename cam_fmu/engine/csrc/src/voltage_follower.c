@@ -10,9 +10,11 @@
  * with J = J_0 + m s'^2, the guide friction f solved with omega_dot as model.c's load_terms does (section 4.4 with
  * F_close in gravity's place), and the force P = m (s'' omega^2 + s' omega_dot) + F_close + sgn(v) f along X;
  * lift-off where contact P reaches 0; in flight J_0 omega_dot = T and m s_dd = -F_close(s) - sigma f0 (f0 the
- * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -TOUCH, an impact exchanging
- * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. Classic Runge-Kutta steps of
- * at most STEP_ANGLE of cam angle, STEP_PHASE of the flight's and the shaft's oscillation; an event function gone
+ * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -CAM_TOUCH, an impact exchanging
+ * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. The steps of the parameter
+ * `solver` (rk.c's tableaus: rk45 with error control on rtol, atol; euler, rk4 and etdrk4's RK4 core fixed at h_max
+ * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's and the shaft's oscillation, a tenth of
+ * the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
  * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
@@ -21,15 +23,15 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "cam_solver.h"
 #include "cam_voltage_follower.h"
 
-#define ZENO_HEIGHT 1e-9        /* m: a rebound rising less ends in contact (physics/speed_follower.py) */
-#define STEP_ANGLE 1e-4         /* rad: cam angle of one Runge-Kutta step */
 #define STEP_PHASE 4e-4         /* rad: phase of the flight's oscillation sqrt(k/m) t in one step */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 #define MAX_STEPS 10000000 /* Runge-Kutta steps in one step before the step is refused (never a hang) */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
-#define SLOW 1.0                /* rad/s: below it a step also turns the cam at most STEP_ANGLE from rest */
+#define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
+#define SLOW 1.0                /* rad/s: below it a fixed step also sweeps at most its share from rest */
 
 
 static double sgn(double x)
@@ -180,7 +182,10 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
 }
 
-void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+/* cam_vf_rates, and on a moving flank the contact's force *P [N] along X and the guide's side force *n_r [N] (else
+ * both untouched). */
+static void flank_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY], double *P,
+                        double *n_r)
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -194,8 +199,8 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
         return;
     }
     if (contact) {
-        double d[4], P;
-        on_flank(m, y, u, contact, d, &dy[1], &P);
+        double d[4];
+        flank_terms(m, y, u, contact, d, &dy[1], P, n_r);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
@@ -203,6 +208,12 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+}
+
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
+{
+    double P, n_r;
+    flank_rates(m, u, contact, y, dy, &P, &n_r);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -214,23 +225,36 @@ static void set_on_flank(const CamModel *m, double y[NY], int contact)
     y[4] = d[1] * y[1];
 }
 
-/* One classic Runge-Kutta step of h [s] from y into out. */
-static void rk4(const CamModel *m, double u, int contact, const double y[NY], double h, double out[NY])
+typedef struct {                /* cam_vf_rates' arguments but the state (a CamRates context) */
+    const CamModel *m;
+    double u;
+    int contact;
+    double P, n_r;              /* N: the flank's force and the side force where the rates were last taken (a flank) */
+} Rates;
+
+static void rates(void *ctx, const double *y, double *dy)
 {
-    double k1[NY], k2[NY], k3[NY], k4[NY], t[NY];
-    int j;
-    cam_vf_rates(m, u, contact, y, k1);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + 0.5 * h * k1[j];
-    cam_vf_rates(m, u, contact, t, k2);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + 0.5 * h * k2[j];
-    cam_vf_rates(m, u, contact, t, k3);
-    for (j = 0; j < NY; j++)
-        t[j] = y[j] + h * k3[j];
-    cam_vf_rates(m, u, contact, t, k4);
-    for (j = 0; j < NY; j++)
-        out[j] = y[j] + h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    Rates *r = ctx;
+    flank_rates(r->m, r->u, r->contact, y, dy, &r->P, &r->n_r);
+}
+
+/* One step of the tableau t of h [s] from y into out (the follower set on its flank in contact); err: the embedded
+ * pair's error estimate, or NULL. k: the stages (NULL: scratch of its own), k[0] the rates at y already if k0. */
+static void vf_step(const CamModel *m, const CamTableau *t, double u, int contact, const double y[NY], double h,
+                    double out[NY], double *err, double *k, int k0, double end[2])
+{
+    double scratch[(CAM_MAX_STAGES + 1) * NY];
+    Rates r = {m, u, contact, NAN, NAN};
+    if (k == NULL)
+        k = scratch, k0 = 0;
+    if (!k0)
+        rates(&r, y, k);
+    cam_tableau_step(t, m->compliant ? Y_SIGMA : Y_TWIST, NY, rates, &r, y, h, k, out, err);   /* sigma, dir: held */
+    if (end != NULL) {   /* an embedded FSAL pair took its last rates at out: the flank's forces there (P, N_r) */
+        int fsal = err != NULL && t->fsal && t->error_exponent != 0.0;
+        end[0] = fsal ? r.P : NAN;
+        end[1] = fsal ? r.n_r : NAN;
+    }
     if (contact)
         set_on_flank(m, out, contact);
 }
@@ -250,7 +274,7 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + TOUCH;
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + CAM_TOUCH : (d[0] + cam_vf_clearance(m)) - y[3] + CAM_TOUCH;
 }
 
 /* event_value, and the step's ends: for EV_BREAK the cam's angle short of the profile's breakpoint at[0] [rad], for
@@ -271,6 +295,7 @@ static int crossed(double before, double after)
 
 typedef struct {                /* a Runge-Kutta step from y and its event functions (trial_event) */
     const CamModel *m;
+    const CamTableau *t;
     double u;
     int contact;
     const double *ends, *y;
@@ -281,7 +306,7 @@ static double trial_event(void *ctx, int code, double h)
 {
     const Trial *t = ctx;
     double out[NY];
-    rk4(t->m, t->u, t->contact, t->y, h, out);
+    vf_step(t->m, t->t, t->u, t->contact, t->y, h, out, NULL, NULL, 0, NULL);
     return event_at(t->m, t->u, code, t->contact, t->ends, out);
 }
 
@@ -292,6 +317,29 @@ static double acceleration_scale(const CamModel *m, const double y[NY], double u
     cam_profile_eval(&m->profile, y[0], d);
     return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
+}
+
+/* The error norm of an embedded step from y to out (rk.c cam_error_norm over y's slots): RMS of err / (atol + rtol
+ * max(|y|, |out|)) over theta (its scale capped at 2 pi), omega, the current and a compliant shaft's slots where they
+ * are states, and the follower's s, v in flight (on a flank they follow the cam's). */
+static double vf_error_norm(const CamModel *m, int contact, const double y[NY], const double out[NY],
+                            const double err[NY])
+{
+    static const int SLOTS[] = {0, 1, 2, Y_TWIST, Y_ROTOR, 3, 4};
+    double total = 0.0, scale;
+    int k, n = 0;
+    for (k = 0; k < 7; k++) {
+        int j = SLOTS[k];
+        if ((j == 2 && !m->has_current) || ((j == Y_TWIST || j == Y_ROTOR) && !m->compliant) || ((j == 3 || j == 4)
+                                                                                                   && contact))
+            continue;
+        scale = fmax(fabs(y[j]), fabs(out[j]));
+        if (j == 0)
+            scale = fmin(scale, 2.0 * 3.141592653589793);
+        total += pow(err[j] / (m->atol + m->rtol * scale), 2.0);
+        n += 1;
+    }
+    return sqrt(total / n);
 }
 
 /* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
@@ -322,7 +370,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     impact(m, y, d[1], m->restitution);
     unstick(y);
     w = y[4] - d[1] * y[1];
-    if (w * w >= 2.0 * scale * ZENO_HEIGHT) {
+    if (w * w >= 2.0 * scale * CAM_ZENO_HEIGHT) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * acceleration_scale(m, y, u)) : 0.0;
         return 0;
     }
@@ -481,24 +529,52 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                                                                                                   + 1.0 / m->J_0)
                 : 0.0;   /* rad/s: the shaft's rate (docs/model.md 12.1) */
     int contact = (int)d->speed.contact, left = (int)d->speed.left, events = 0;
+    const CamMethod *method = cam_method(m->solver);
+    int adaptive = method->adaptive;   /* rk45: error control; else fixed steps of h_max within the method's limits */
+    const CamTableau *tableau = method->tableau != NULL ? method->tableau : &cam_rk4;   /* etdrk4: its RK4 core */
+    double sweep = m->feature_angle * (method->resolution < HUGE_VAL ? method->resolution : method->max_sweep);
     long dropped = 0, taken = 0;
+    double stages[(CAM_MAX_STAGES + 1) * NY], fsal_sigma = 0.0;   /* the adaptive steps' stages */
+    double after_before[6];   /* the event functions at the last step's end, codes_before[] */
+    int fsal = 0, fsal_contact = 0, have_before = 0, n_before = 0, codes_before[6], carried;
+    double n_r_end = NAN;   /* N: the side force at the last step's end (NAN: not computed) */
     d->step_events[0] = '\0';
     cam_vf_load_y(d, y);
     if (y[1] == 0.0)   /* at rest: the step's input may start or hold it */
         cam_vf_at_rest(m, y, u, &contact, &left, 0);
-    if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
+    carried = adaptive && d->solver.k1_valid && d->solver.fsal_u == u && y[1] != 0.0;   /* as the last step ended */
+    if (contact && !carried && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))   /* its end was settled */
         cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
+    if (carried && contact == (int)d->speed.contact) {
+        memcpy(stages, d->solver.k_own, NY * sizeof *stages);   /* the last step's end under the same input and mode */
+        fsal = 1;
+        fsal_contact = contact;
+        fsal_sigma = y[Y_SIGMA];
+    }
+    d->solver.k1_valid = 0;
     while (tau < h) {
         int codes[6], n = 0, k, code = EV_NONE;
-        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6];
-        if (y[1] != 0.0)
-            dt = fmin(dt, STEP_ANGLE / fabs(y[1]));
-        if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {   /* from rest: STEP_ANGLE at the acceleration */
-            double rate[NY];
-            cam_vf_rates(m, u, contact, y, rate);
-            if (rate[1] != 0.0)
-                dt = fmin(dt, sqrt(2.0 * STEP_ANGLE / fabs(rate[1])));
+        double dt = h - tau, at = dt, ends[2] = {0.0, 0.0}, before[6], after[6], forces[2] = {NAN, NAN}, n_r_y;
+        int carry;
+        if (y[1] != 0.0 && !contact)   /* in flight a step at most scans the gap's events */
+            dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
+        if (!adaptive) {   /* the internal step h_max, the cam sweeping at most the method's share of the finest
+                            * feature (fixed_step.c's resolution; euler's max_sweep), from rest at its acceleration */
+            double rate[NY], x[CAM_NX] = {y[0], y[1], y[2], y[Y_TWIST], y[Y_ROTOR]}, fastest;
+            CamMode engaged = d->mode;
+            engaged.contact = contact != 0;   /* fixed_step.c's stability limit, the pole explicit (RK4's core) */
+            fastest = cam_stiffness_rate(m, &engaged, x, 1);
+            dt = fmin(dt, m->h_max);
+            if (fastest > 0.0)
+                dt = fmin(dt, method->stability / fastest);
+            if (y[1] != 0.0)
+                dt = fmin(dt, sweep / fabs(y[1]));
+            if (y[Y_DIR] != 0.0 && fabs(y[1]) < SLOW) {
+                cam_vf_rates(m, u, contact, y, rate);
+                if (rate[1] != 0.0)
+                    dt = fmin(dt, sqrt(2.0 * sweep / fabs(rate[1])));
+            }
         }
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
@@ -508,19 +584,43 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             if (y[4] != 0.0)
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
         }
-        if (pole > 0.0)
+        if (pole > 0.0)   /* also under error control: measured, the shaft's twist drifted 1.8e-8 of M_shaft without */
             dt = fmin(dt, POLE_STEP / pole);
         if (ws > 0.0)
             dt = fmin(dt, STEP_PHASE / ws);
         if (!contact)
             y[Y_SIGMA] = cam_vf_flight_direction(m, y);
+        carry = have_before && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma;   /* y is the last step's end */
         if (rebound > 0.0)
             dt = fmin(dt, rebound);   /* a bounce lasts about 4 rebound: the first step cannot hold it */
         if (++taken > MAX_STEPS)
             return cam_error(err, CAM_ERR_SIMULATION, "more than %d Runge-Kutta steps in one step from t = %g s (at "
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
-        rk4(m, u, contact, y, dt, next);
+        if (adaptive) {   /* error control on rtol, atol within the bounds above (integrate.c cam_step_adaptive) */
+            double bound = fmin(dt, m->h_max), norm, factor, e[NY];
+            dt = fmin(bound, d->solver.h_next);
+            if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
+                fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
+            for (;;) {
+                vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, forces);
+                fsal = 1;   /* k[0] is the rates at y from here on */
+                norm = vf_error_norm(m, contact, y, next, e);
+                if (norm <= 1.0)
+                    break;
+                dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, tableau->error_exponent), 0.1);
+                if (dt < 1e-12 * h)
+                    return cam_error(err, CAM_ERR_REJECTED, "solver 'rk45' cannot meet rtol = %g, atol = %g: its step "
+                                     "fell below %g s (1e-12 of the communication step) at t = %g s: loosen rtol/atol, "
+                                     "or check the inputs and parameters", m->rtol, m->atol, 1e-12 * h, time + tau);
+            }
+            factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, tableau->error_exponent), 5.0);
+            if (dt < bound || factor < 1.0)
+                d->solver.h_next = fmin(dt * factor, 1e3);
+            else   /* a step the bounds cut: its success says nothing against a longer next one */
+                d->solver.h_next = fmax(d->solver.h_next, dt * fmin(factor, 1.0));
+        } else
+            vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0, NULL);
         codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
         if (contact) {
             if (y[Y_DIR] != 0.0)
@@ -535,21 +635,48 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
         if (ends[0] == ends[0])   /* the step ends just past the profile's breakpoint (s'' or s''' jumps there) */
             codes[n++] = EV_BREAK;
-        if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(side_force(m, y, u, contact))) != 0.0)
+        n_r_y = carry && n_r_end == n_r_end ? n_r_end : (contact && y[Y_DIR] != 0.0 && m->mu > 0.0
+                                                         ? side_force(m, y, u, contact) : 0.0);
+        if (contact && y[Y_DIR] != 0.0 && m->mu > 0.0 && (ends[1] = sgn(n_r_y)) != 0.0)
             codes[n++] = EV_SIDE;   /* and just past the kink of |N_r| (docs/model.md 10) */
         at = dt;
+        if (!(carry && n == n_before))
+            have_before = 0;   /* the functions at y are the last step's at its end while its mode holds */
+        if (contact && y[Y_DIR] != 0.0 && forces[0] != forces[0] && n > 1) {   /* the lift-off's and side force's */
+            double dd[4], omega_dot;
+            flank_terms(m, next, u, contact, dd, &omega_dot, &forces[0], &forces[1]);
+        }
+        n_r_end = forces[1];
         for (k = 0; k < n; k++) {
-            before[k] = event_at(m, u, codes[k], contact, ends, y);
-            after[k] = event_at(m, u, codes[k], contact, ends, next);
+            int kept = have_before && codes[k] == codes_before[k] && codes[k] != EV_BREAK && codes[k] != EV_SIDE;
+            if (codes[k] == EV_SIDE) {   /* event_at's at[1] N_r + CAM_SIDE_HYSTERESIS from the forces in hand */
+                before[k] = ends[1] * n_r_y + CAM_SIDE_HYSTERESIS;
+                after[k] = ends[1] * forces[1] + CAM_SIDE_HYSTERESIS;
+                continue;
+            }
+            before[k] = kept ? after_before[k] : event_at(m, u, codes[k], contact, ends, y);
+            after[k] = codes[k] == EV_LIFT_OFF ? contact * forces[0] : event_at(m, u, codes[k], contact, ends, next);
         }
         {
-            Trial tr = {m, u, contact, ends, y};
+            Trial tr = {m, tableau, u, contact, ends, y};
             code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
         }
+        have_before = code == EV_NONE;
+        if (have_before) {   /* the mode the next step must keep to reuse the end's rates and event functions */
+            fsal_contact = contact;
+            fsal_sigma = y[Y_SIGMA];
+            n_before = n;
+            memcpy(codes_before, codes, sizeof codes_before);
+            memcpy(after_before, after, sizeof after_before);
+        }
+        if (code == EV_NONE && adaptive && tableau->fsal)   /* first same as last: the next step's k[0] */
+            memcpy(stages, stages + tableau->stages * NY, NY * sizeof *stages);
+        else
+            fsal = 0;
         if (code == EV_NONE) {
             memcpy(y, next, sizeof y);
         } else if (at < dt) {
-            rk4(m, u, contact, y, at, trial);
+            vf_step(m, tableau, u, contact, y, at, trial, NULL, NULL, 0, NULL);
             memcpy(y, trial, sizeof y);
         } else {
             memcpy(y, next, sizeof y);
@@ -588,6 +715,11 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more", dropped);
+    if (fsal && contact == fsal_contact && cam_vf_flight_direction(m, y) == fsal_sigma) {   /* the next step's k[0] */
+        memcpy(d->solver.k_own, stages, NY * sizeof *stages);
+        d->solver.k1_valid = 1;
+        d->solver.fsal_u = u;
+    }
     cam_vf_store_y(d, y);
     d->speed.contact = contact;
     d->speed.rebound = rebound;
@@ -616,7 +748,7 @@ static void vf_outputs(CamDrive *d, double out[])
         on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
                  : m->M_f * shaft_direction(y) + P * dd[1];
-        load.N = P * sqrt(1.0 + tan_a * tan_a);   /* P / cos(alpha), signed as contact */
+        load.N = cam_normal_force(P, tan_a);   /* signed as contact */
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
@@ -638,8 +770,8 @@ static void vf_outputs(CamDrive *d, double out[])
 
 static void vf_advice(const CamDrive *d, char *buf, size_t len)
 {
-    (void)d;
-    snprintf(buf, len, "Runge-Kutta steps of %g rad of cam angle (fixed): reduce the communication step", STEP_ANGLE);
+    snprintf(buf, len, d->model.solver == CAM_CHOICE_SOLVER_RK45 ? "tighten rtol and atol, or lower h_max"
+             : "lower h_max, or use solver 'rk45'");
 }
 
 const CamFormulation cam_voltage_follower = {

@@ -106,7 +106,7 @@ double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
     const CamModel *m = &d->model;
     double y[NY], g = x[CAM_ME_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
-        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + TOUCH;
+        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + CAM_TOUCH;
     me_load(d, x, y);
     return cam_vf_event_value(m, d->form_u, code, (int)d->speed.contact, y);
 }
