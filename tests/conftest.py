@@ -79,6 +79,13 @@ def pi_speed_fmu_path(tmp_path_factory, request) -> Path:
 
 
 @pytest.fixture(scope="session")
+def cam3_fmu_path(tmp_path_factory, request) -> Path:
+    """cam3.fmu (the drive as FMI 3.0 co-simulation) built once per test session (build_fmu.py --model cam3):
+    every test of it reads this one build (six modules built their own, 8-9 minutes of zig in a full run)."""
+    return _build_fmu(tmp_path_factory.mktemp("cam3_build") / "cam3.fmu", "cam3", host_only=_fast_loop(request.config))
+
+
+@pytest.fixture(scope="session")
 def engine_fmu_path(cam_fmu_path) -> Path:
     """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
     pytest process is safe."""

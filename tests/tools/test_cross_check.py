@@ -31,13 +31,15 @@ FILES = ("{m}.fmu", "{m}_in.csv", "{m}_ref.csv", "{m}_ref.opt", "ReadMe.md", "{m
 
 
 @pytest.fixture(scope="module")
-def shipped(engine_fmu_path, tmp_path_factory) -> list[Path]:
-    """Every FMU the command packages by default (the drive's: cam.fmu, cam3.fmu), built from this checkout."""
-    from conftest import _build_fmu
-
+def shipped(cam_fmu_path, cam3_fmu_path) -> list[Path]:
+    """Every FMU the command packages by default (the drive's: cam.fmu, cam3.fmu): the session's builds from this
+    checkout (conftest.py). A new FMU of the drive fails here until it has its session build."""
     from cam_fmu.fmu.build import ENGINE_MODELS
-    others = [name for name, (c_model, _v) in ENGINE_MODELS.items() if c_model == "cam" and name != "cam"]
-    return [engine_fmu_path] + [_build_fmu(tmp_path_factory.mktemp(f"{n}_build") / f"{n}.fmu", n) for n in others]
+
+    built = {"cam": cam_fmu_path, "cam3": cam3_fmu_path}
+    drives = [name for name, (c_model, _v) in ENGINE_MODELS.items() if c_model == "cam"]
+    assert sorted(drives) == sorted(built), f"the drive's FMUs {drives}: give each a session build in conftest.py"
+    return [built[name] for name in drives]
 
 
 @pytest.fixture(scope="module")
