@@ -92,6 +92,15 @@ def engine_fmu_path(cam_fmu_path) -> Path:
     return cam_fmu_path
 
 
+@pytest.fixture(scope="session")
+def reference_runs():
+    """The scipy reference's runs, each integrated once per session (reference_runs.py): the modules that compare
+    against the same scene share its runs."""
+    from reference_runs import ReferenceRuns
+
+    return ReferenceRuns()
+
+
 @pytest.fixture(autouse=True)
 def _no_python_fmu_in_pytest():
     """A test that loads a pythonfmu FMU (a block written in Python) or pythonfmu itself into this process fails

@@ -211,13 +211,12 @@ def test_the_input_file_is_used(package):
         assert problem is not None and "outside epsilon band" in problem
 
 
-def test_the_reference_agrees_with_the_scipy_reference(package):
+def test_the_reference_agrees_with_the_scipy_reference(package, reference_runs):
     """The same step of u on physics/ integrated by scipy (rtol 1e-12): co-simulation within
     test_fmu_vs_reference's rk45 tolerances (theta 1e-6 rad, omega 1e-4 of its peak); every folder
     passes fmpy's importer criterion against it."""
     from cam_fmu.experiments.scenes import find_scene
     from cam_fmu.physics.signals import Signal
-    from cam_fmu.reference import simulate_reference
     from cam_fmu.tools.cross_check.experiment import STEP_TIME
 
     scene = find_scene("paper_fig6")
@@ -228,7 +227,8 @@ def test_the_reference_agrees_with_the_scipy_reference(package):
         reference = read_csv(str(folder / f"{m}_ref.csv"))
         assert opts["StopTime"] == pytest.approx(STEP_TIME + scene.stop_time)
         u = Signal((0.0, STEP_TIME, STEP_TIME), (0.0, 0.0, u_after))
-        scipy_run = simulate_reference(scene.primary.overrides, opts["StopTime"], opts["OutputIntervalLength"], u=u)
+        scipy_run = reference_runs.simulate(scene.primary.overrides, opts["StopTime"], opts["OutputIntervalLength"],
+                                            u=u)
         names = reference.dtype.names
         as_table = np.array(list(zip(*(scipy_run[n] for n in names))), dtype=reference.dtype)
         assert _validate_result(as_table, reference, opts) is None
