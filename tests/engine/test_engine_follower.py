@@ -118,6 +118,7 @@ def test_a_state_saved_in_flight_repeats_its_run():
     assert onwards() == first
 
 
+@pytest.mark.external  # the sanitizers (a tool beyond Python and gcc's compiler), as test_engine_sanitize's
 def test_the_follower_is_clean_under_asan_and_ubsan(tmp_path):
     gcc = require("gcc")
     generated = [str(p) for p in codegen.write(tmp_path / "generated") if p.suffix == ".c"]
