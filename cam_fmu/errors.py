@@ -1,4 +1,4 @@
-"""The errors a simulation reports, shared by every layer (no imports: the FMU bundles it).
+"""The errors a simulation reports, shared by every layer (no imports: any layer may import it).
 
 SimulationError: the run cannot go on correctly (the FMU: fmi2Error); its message names the
 parameter, input or setting and what to change. StepRejected: this step cannot be completed

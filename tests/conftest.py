@@ -2,10 +2,12 @@
 
 The tests sit in folders by layer (kinematics, physics, engine, fmu_cs, fmu_me, fmi3, hosts, cli, tools);
 the shared helpers (native_support.py, engine_profile.py, fmi_slave.py) and the C hosts beside this file.
-Markers, set here so that a module cannot forget them:
-- ``external``: every test of ``hosts/`` and of the modules in EXTERNAL (wine, qemu-user, valgrind,
+Markers, set here so that a module cannot forget them (the rules: markers.py):
+- ``external``: every test of ``hosts/`` and of the modules in ``markers.EXTERNAL`` (wine, qemu-user, valgrind,
   sanitizers, other CPythons, native FMU hosts, zig's other platforms, the package index);
-- ``slow``: the modules in SLOW (measured at more than about 2 s a test on this machine, or a long fixture).
+- ``slow``: measured, not listed: a test whose recorded duration in durations.json (or a module fixture's set-up
+  it needs) exceeds ``markers.SLOW_SECONDS``; ``--record-durations tests/durations.json`` on a full run
+  re-records the file.
 ``python -m pytest -m "not external and not slow"`` is the loop a developer runs while working; it builds the
 session's FMUs for this machine only (the system C compiler). CI runs everything.
 """
@@ -31,25 +33,28 @@ for _folder in (Path(__file__).resolve().parent, *sorted(p for p in Path(__file_
                                                          if p.is_dir() and any(p.glob("test_*.py")))):
     sys.path.insert(0, str(_folder))
 
-EXTERNAL = {  # outside hosts/: modules that need wine, qemu, valgrind, sanitizers or a C host
-    "test_engine_c_host", "test_engine_sanitize", "test_engine_state_fuzz", "test_engine_fmu_me_host", "test_fmi3",
-    "test_bench_floors", "test_bench_memory",
-}
-SLOW = {  # measured: a full run's --durations
-    "test_extremes", "test_extremes_property", "test_extremes_classes", "test_fmu_vs_reference", "test_scenes",
-    "test_sweep", "test_bench", "test_cross_check", "test_docs", "test_engine_fmu_me", "test_compliant_shaft",
-    "test_frequency", "test_reflect", "test_fmi_formulations", "test_plots", "test_cli_errors", "test_ssp_file",
-    "test_fmi_wrong_answers", "test_saved_states", "test_reference", "test_motion_table", "test_mounting",
-    "test_fmu_build", "test_engine_profile", "test_fmi_pole", "test_symbolic_route", "test_input_discontinuities",
-}
+from markers import DURATIONS, DurationRecorder, is_external, is_slow, load  # noqa: E402 - after sys.path
+
+RECORDED = load()
+
+
+def pytest_addoption(parser):
+    parser.addoption("--record-durations", metavar="PATH", default=None, type=Path,
+                     help="write every test's own duration and its module and session fixtures' set-ups to PATH "
+                          f"(a full run, into {DURATIONS.relative_to(ROOT)}: tests/markers.py)")
+
+
+def pytest_configure(config):
+    path = config.getoption("record_durations")
+    if path is not None:
+        config.pluginmanager.register(DurationRecorder(path), "cam_fmu_durations")
 
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        path = Path(str(item.fspath))
-        if path.parent.name == "hosts" or path.stem in EXTERNAL:
+        if is_external(item.nodeid):
             item.add_marker(pytest.mark.external)
-        if path.stem in SLOW:
+        if is_slow(item.nodeid, item.fixturenames, RECORDED):
             item.add_marker(pytest.mark.slow)
 
 
@@ -85,10 +90,26 @@ def pi_speed_fmu_path(tmp_path_factory, request) -> Path:
 
 
 @pytest.fixture(scope="session")
+def cam3_fmu_path(tmp_path_factory, request) -> Path:
+    """cam3.fmu (the drive as FMI 3.0 co-simulation) built once per test session (build_fmu.py --model cam3):
+    every test of it reads this one build (six modules built their own, 8-9 minutes of zig in a full run)."""
+    return _build_fmu(tmp_path_factory.mktemp("cam3_build") / "cam3.fmu", "cam3", host_only=_fast_loop(request.config))
+
+
+@pytest.fixture(scope="session")
 def engine_fmu_path(cam_fmu_path) -> Path:
     """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
     pytest process is safe."""
     return cam_fmu_path
+
+
+@pytest.fixture(scope="session")
+def reference_runs():
+    """The scipy reference's runs, each integrated once per session (reference_runs.py): the modules that compare
+    against the same scene share its runs."""
+    from reference_runs import ReferenceRuns
+
+    return ReferenceRuns()
 
 
 @pytest.fixture(autouse=True)

@@ -6,8 +6,8 @@ Each subcommand module defines
     run(args) -> int                                    # exit status
 
 and keeps its top-level imports light (numpy at most): every module is
-imported to build `--help`; heavy imports (matplotlib, scipy, fmpy) belong
-inside run().  To add a subcommand, write such a module and add its name here.
+imported to build `cam-fmu --help` (a run imports its own only); heavy imports
+(matplotlib, scipy, fmpy) belong inside run().  To add a subcommand, write such a module and add its name here.
 """
 
 from __future__ import annotations
@@ -41,12 +41,22 @@ SUBCOMMANDS: tuple[str, ...] = (
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def command_module(word: str) -> str | None:
+    """The module of the subcommand ``word`` names on the command line (``cross-check`` -> ``cross_check``), or
+    None when it names none."""
+    name = word.replace("-", "_")
+    return name if name in SUBCOMMANDS and word == name.replace("_", "-") else None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every subcommand, or with ``command`` (a module of SUBCOMMANDS) of that one only: a run
+    imports its own subcommand's module, not the eleven others (`cam-fmu --help` and a word that is no command
+    still import them all, to list them)."""
     parser = argparse.ArgumentParser(
         prog="cam-fmu", description="Cam motion laws and an electromechanical cam drive FMU.")
     parser._negative_number_matcher = NEGATIVE_NUMBER  # type: ignore[attr-defined]
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in SUBCOMMANDS:
+    for name in SUBCOMMANDS if command is None else (command,):
         module = importlib.import_module(f"{__name__}.{name}")
         sub = module.add_parser(subparsers)
         sub._negative_number_matcher = NEGATIVE_NUMBER  # type: ignore[attr-defined]
@@ -91,7 +101,8 @@ def _expected_errors() -> tuple[type[BaseException], ...]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(command_module(argv[0]) if argv else None)
     args = parser.parse_args(argv)
     try:
         status = args._run(args)

@@ -14,7 +14,8 @@ Convention at a breakpoint (only s'' and s''' can differ between the sides):
 the piece *ending* there is used (left limit), except at theta = 0 (mod 2 pi),
 which is the start of the rise (right limit, as MotionLaw does at T = 0).
 
-This module imports math and numpy only (kinematics imports no other layer): it is bundled into the FMU.
+This module imports math and numpy only (kinematics imports no other layer); the C engine's program
+(``csrc/src/profile.c``) is held to it (tests/engine/test_engine_profile.py).
 """
 
 from __future__ import annotations

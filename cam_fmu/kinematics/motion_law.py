@@ -28,7 +28,8 @@ both evaluation paths therefore return the values of the segment *ending* there
 right limit).  Only A and J can differ between the two sides.  Outside [0, 1]
 the law continues as dwells: (0, 0, 0, 0) for T < 0 and (1, 0, 0, 0) for T > 1.
 
-This module imports only math and numpy: it is bundled into the FMU.
+This module imports only math and numpy; the C engine's laws (``csrc/src/motion_law.c``) are held to it
+(tests/engine/test_engine_profile.py).
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ tests/kinematics/test_characteristics.py).  `paper` is the law of the paper's pr
 
 This is the one table of named laws: the parameter choices of the FMU
 (``rise_law``/``return_law``), the CLI's ``--preset`` and the docs derive
-from it.  ``math`` only: the FMU bundles it.
+from it.  ``math`` only: ``engine/codegen.py`` generates the C engine's presets from it.
 """
 
 from __future__ import annotations

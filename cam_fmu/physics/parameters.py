@@ -2,7 +2,7 @@
 
 This table is the single source of truth: the scene files, the reference
 integration, the FMU variables and the docs (docs/scenes.md, docs/fmu.md) all use these names and units.
-Only ``math`` is imported here: the module is bundled into the FMU.
+Only ``math`` is imported here: ``engine/codegen.py`` generates the C engine's table from it at build time.
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 The FMU's variables, its model description, the docs tables, the CSV
 headers and every formulation's output record derive from these tuples.
-``math``-free and import-free: the FMU bundles it.
+``math``-free and import-free: ``engine/codegen.py`` reads it at build time (the FMU carries the C table).
 """
 from __future__ import annotations
 

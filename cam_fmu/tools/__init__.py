@@ -1,1 +1,1 @@
-"""Developer tools: the bench and native-host helpers (not bundled into the FMU)."""
+"""Developer tools: the bench and native-host helpers (no FMU carries them)."""

@@ -86,6 +86,23 @@ def test_imports_stay_cheap():
     assert out.strip() == "[] []"
 
 
+def test_a_command_imports_its_own_module_and_not_the_others():
+    """`cam-fmu CMD` builds the parser of CMD only: a run (every subprocess test's start-up) imports its own
+    subcommand, not the eleven others (sweep's metrics imported numpy and dask's table code for `curve`);
+    `cam-fmu --help` still lists every command."""
+    code = ("import sys; from cam_fmu.cli import main, SUBCOMMANDS; status = main(['curve', '--preset', 'cycloidal', "
+            "'--json']); print(status, sorted(m for m in sys.modules if m.startswith('cam_fmu.cli.')), "
+            "'cam_fmu.experiments.sweep' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip().splitlines()[-1] == "0 ['cam_fmu.cli._program_options', 'cam_fmu.cli.curve'] False"
+    listed = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "--help"], capture_output=True, text=True,
+                            check=True).stdout
+    from cam_fmu.cli import SUBCOMMANDS
+    assert all(name.replace("_", "-") in listed for name in SUBCOMMANDS)
+    wrong = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "curves"], capture_output=True, text=True)
+    assert wrong.returncode == 2 and "invalid choice: 'curves'" in wrong.stderr and "cross-check" in wrong.stderr
+
+
 def test_module_entry_point_runs():
     out = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "curve", "--preset", "cycloidal", "--json"],
                          capture_output=True, text=True, check=True).stdout

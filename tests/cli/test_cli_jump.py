@@ -19,7 +19,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cam_fmu.experiments.runner import run_scene
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.follower import jump_speed
@@ -149,11 +148,11 @@ def test_reflect_says_what_it_assumes(tmp_path):
     assert "a clearance c is ignored" in json.loads(done.stdout)["assumes"]
 
 
-def test_spring_jump_runs_just_below_and_above_the_jump_speed():
+def test_spring_jump_runs_just_below_and_above_the_jump_speed(reference_runs):
     """The scene's speed is 0.98 and 1.02 times its runs' jump speeds; the reference keeps the follower on the cam in
     the first and lets it fly in the second."""
     scene = find_scene("spring_jump")
-    results = run_scene(scene, "reference")
+    results = reference_runs.scene(scene)
     omega = scene.omega_ref.value(0.0)
     for run, ratio in zip(scene.runs, (0.98, 1.02)):
         model = DriveModel(run.params)
@@ -165,11 +164,11 @@ def test_spring_jump_runs_just_below_and_above_the_jump_speed():
         assert lost == (ratio > 1.0) and np.all(r["s"] >= r["s_cam"] - 1e-12)
 
 
-def test_bounce_and_crossover_scenes_show_their_effect():
-    bounce = run_scene(find_scene("spring_bounce"), "reference")
+def test_bounce_and_crossover_scenes_show_their_effect(reference_runs):
+    bounce = reference_runs.scene(find_scene("spring_bounce"))
     assert bounce["e_0.5"]["impacts"][-1] > 2 * bounce["e_0"]["impacts"][-1] > 0  # e = 0.5 bounces, e = 0 lands
     assert bounce["e_0.5"]["contact"][-1] == 1.0  # and settles
-    groove = run_scene(find_scene("groove_crossover"), "reference")
+    groove = reference_runs.scene(find_scene("groove_crossover"))
     form, kinematic = groove["form"], groove["kinematic"]
     assert -1.0 in form["contact"] and form["impacts"][-1] >= 1  # it crossed the clearance and struck
     # the crossover shock: on the rise's deceleration (pi/2 < theta < pi) the follower's velocity jumps by 0.13 m/s at

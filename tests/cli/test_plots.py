@@ -22,7 +22,6 @@ import pytest  # noqa: E402
 from cam_fmu import cli  # noqa: E402
 from cam_fmu.experiments import fmpy_runner, runner  # noqa: E402
 from cam_fmu.experiments.progress import ProgressBar  # noqa: E402
-from cam_fmu.experiments.runner import run_scene  # noqa: E402
 from cam_fmu.experiments.scenes import find_scene  # noqa: E402
 from cam_fmu.physics.variables import OUTPUT_NAMES  # noqa: E402
 from cam_fmu.plots.scene import PLOTS, difference, draw_scene, plot_scene  # noqa: E402
@@ -119,10 +118,10 @@ def test_every_kind_is_written(tmp_path):
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_speed_drive_scene_needs_voltage_on_the_reference():
+def test_speed_drive_scene_needs_voltage_on_the_reference(reference_runs):
     """The shipped scene: the required voltage is drawn and is not the trivial k omega."""
     scene = find_scene("speed_drive").with_stop_time(0.3)
-    results = run_scene(scene, "reference")
+    results = reference_runs.scene(scene)
     v = results["L_1mH"]["voltage"]
     assert np.all(np.isfinite(v)) and v.max() - v.min() > 10.0  # V: the cam's torque shows in the voltage
     assert np.abs(results["L_1mH"]["omega"] - 10.0).max() < 1e-9
@@ -220,20 +219,19 @@ def test_progress_bar_close_ends_an_open_line():
     assert stream.getvalue().count("\n") == 1
 
 
-def test_the_paper_figures_of_the_speed_drive_show_the_voltage_needed():
+def test_the_paper_figures_of_the_speed_drive_show_the_voltage_needed(reference_runs):
     """fig4 and fig5 (speed-drive scenes) carry a voltage panel over the cam angle."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cam_fmu.experiments.runner import run_scene
     from cam_fmu.experiments.scenes import find_scene
     from cam_fmu.plots.scene import PLOTS
 
     for kind, name in (("fig4", "paper_fig4"), ("fig5", "paper_fig5a")):
         scene = find_scene(name)
         assert scene.drive == "speed"
-        results = run_scene(scene.with_stop_time(1.0), "reference")
+        results = reference_runs.scene(scene.with_stop_time(1.0))
         fig, axes = PLOTS[kind](plt, results, scene.drive)
         labels = [ax.get_ylabel() for ax in axes]
         assert "voltage [V]" in labels, labels

@@ -31,9 +31,9 @@ SHORT = 0.1  # s: voltage-drive scenes are shortened to this in the smoke test
 
 
 @pytest.fixture(scope="module")
-def full_runs():
+def full_runs(reference_runs):
     """Reference runs of the scenes whose facts need the whole duration (cheap ones only)."""
-    return {name: run_scene(load_scene(SCENES[name]), "reference")
+    return {name: reference_runs.scene(load_scene(SCENES[name]))
             for name in ("paper_fig4", "paper_fig5a", "paper_fig5b", "paper_fig6")}
 
 
@@ -211,9 +211,9 @@ def test_fig6_formulations_differ(full_runs):
     assert consistent["omega"][1:].min() > 0.0 and paper["omega"][1:].min() > 0.0
 
 
-def test_tilted_opposing_gravity_stalls_on_the_rise():
+def test_tilted_opposing_gravity_stalls_on_the_rise(reference_runs):
     scene = load_scene(SCENES["tilted"]).with_stop_time(0.3)
-    r = run_scene(scene, "reference")["opposing"]
+    r = reference_runs.scene(scene)["opposing"]
     p = scene.primary.params
     assert p["beta"] == pytest.approx(math.pi)  # F_gx = -G: gravity opposes the rise
     assert r["omega"][-1] == 0.0 and 0.0 < r["theta"][-1] < math.pi / 2
@@ -224,9 +224,9 @@ def test_tilted_opposing_gravity_stalls_on_the_rise():
     assert p["c_m"] == pytest.approx(0.015 * KGF)
 
 
-def test_backlash_follower_lags_by_the_clearance():
+def test_backlash_follower_lags_by_the_clearance(reference_runs):
     scene = load_scene(SCENES["backlash"]).with_stop_time(0.8)
-    r = run_scene(scene, "reference")
+    r = reference_runs.scene(scene)
     c = scene.primary.params["c"]
     gap = np.abs(r["c_0.5mm"]["s_cam"] - r["c_0.5mm"]["s"])
     assert c == 5e-4 and gap.max() <= c * (1 + 1e-6) and gap.max() > 0.9 * c

@@ -95,13 +95,11 @@ def test_a_failing_case_keeps_every_row_and_is_named(cam_fmu_path, tmp_path, whe
     assert "Traceback" not in proc.stderr and "distributed" not in proc.stderr, proc.stderr
 
 
-def test_the_fmi3_fmu_sweeps_as_cam_fmu(serial, tmp_path):
+def test_the_fmi3_fmu_sweeps_as_cam_fmu(serial, tmp_path, cam3_fmu_path):
     """`sweep --fmu models/cam3.fmu` failed every case ("Cannot find shared library .../linux64/cam.so": an FMI 3.0
     FMU run as 2.0). The same engine behind FMI 3.0: the same table to the bit; a failing case through it keeps
     the FMU's own message (fmi3 logMessage), as through cam.fmu."""
-    from conftest import _build_fmu
-
-    cam3 = _build_fmu(tmp_path / "cam3.fmu", "cam3")
+    cam3 = cam3_fmu_path
     assert _sweep(cam3, tmp_path / "out", "--serial") == serial
     out = tmp_path / "failing"
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *FAILING, "--fmu", str(cam3), "--out", str(out),

@@ -19,7 +19,6 @@ import pytest
 from cam_fmu.experiments.sweep import Design, SweepError, parse_sample, parse_vary
 
 ROOT = Path(__file__).resolve().parents[2]
-pytestmark = pytest.mark.slow  # each test runs a sweep or a design of thousands of cases: seconds
 
 
 def _env(**extra: str) -> dict:

@@ -22,7 +22,6 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu.experiments.runner import _reference
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.fmu.engine import DriveSimulator
 
@@ -120,10 +119,10 @@ def test_the_contact_force_moves_the_follower_along_its_path(extra, u):
 
 
 @pytest.mark.parametrize("name", ["spring_jump", "spring_bounce", "spring_voltage"])
-def test_a_spring_closed_follower_is_pushed_never_pulled_and_free_in_flight(name):
+def test_a_spring_closed_follower_is_pushed_never_pulled_and_free_in_flight(name, reference_runs):
     scene = find_scene(name)
     for r in scene.runs:
-        ref = _reference(scene, r)
+        ref = reference_runs.run(scene, r)
         u, omega = (scene.u.value(0.0), 0.0) if r.params["drive"] == "voltage" else (0.0, scene.omega_ref.value(0.0))
         got = run(dict(r.params), ref["time"], u=u, omega=omega)
         off = got["s"] - got["s_cam"] > 2e-12   # in flight (touch-down is located 1 pm inside the flank)
@@ -135,13 +134,13 @@ def test_a_spring_closed_follower_is_pushed_never_pulled_and_free_in_flight(name
 
 
 @pytest.mark.parametrize("name", ["groove_crossover", "groove_voltage"])
-def test_a_grooves_upper_flank_pushes_with_a_negative_force(name):
+def test_a_grooves_upper_flank_pushes_with_a_negative_force(name, reference_runs):
     """+1 flank (s = s_cam - c): N > 0; -1 flank (s = s_cam + c): N < 0; crossing the clearance: 0."""
     scene = find_scene(name)
     for r in scene.runs:
         if r.params["closure"] != "form":
             continue
-        ref = _reference(scene, r)
+        ref = reference_runs.run(scene, r)
         u, omega = (scene.u.value(0.0), 0.0) if r.params["drive"] == "voltage" else (0.0, scene.omega_ref.value(0.0))
         got = run(dict(r.params), ref["time"], u=u, omega=omega)
         gap, c, N = got["s"] - got["s_cam"], r.params["c"], got["N_contact"]

@@ -16,7 +16,6 @@ import pytest
 
 from cam_fmu.engine import codegen
 from cam_fmu.engine.build import CSRC, INCLUDE, SOURCES
-from cam_fmu.experiments.runner import _reference
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.fmu.engine import DriveSimulator
 from native_support import require
@@ -41,10 +40,10 @@ def engine_run(params: dict, omega: float, times: np.ndarray) -> dict[str, np.nd
 
 
 @pytest.mark.parametrize("name", ["spring_jump", "spring_bounce", "groove_crossover"])
-def test_the_engine_is_the_reference(name):
+def test_the_engine_is_the_reference(name, reference_runs):
     scene = find_scene(name)
     for run in scene.runs:
-        ref = _reference(scene, run)
+        ref = reference_runs.run(scene, run)
         got = engine_run(dict(run.params), scene.omega_ref.value(0.0), ref["time"])
         assert np.max(np.abs(got["theta"] - ref["theta"])) < 1e-11
         assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10, run.label   # m (measured 2e-12)
@@ -182,6 +181,7 @@ def test_a_state_saved_in_flight_repeats_its_run():
     assert onwards() == first
 
 
+@pytest.mark.external  # the sanitizers (a tool beyond Python and gcc's compiler), as test_engine_sanitize's
 def test_the_follower_is_clean_under_asan_and_ubsan(tmp_path):
     gcc = require("gcc")
     generated = [str(p) for p in codegen.write(tmp_path / "generated") if p.suffix == ".c"]

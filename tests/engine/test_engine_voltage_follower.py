@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cam_fmu.experiments.runner import _reference
 from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.fmu.engine import DriveSimulator
 from cam_fmu.physics.drive import DriveModel
@@ -30,10 +29,10 @@ SCENE = find_scene("spring_voltage")
 
 @pytest.mark.parametrize("name, label", [(name, run.label) for name in ("spring_voltage", "groove_voltage")
                                          for run in find_scene(name).runs])
-def test_the_engine_is_the_reference(name, label):
+def test_the_engine_is_the_reference(name, label, reference_runs):
     scene = find_scene(name)
     run = next(r for r in scene.runs if r.label == label)
-    ref = _reference(scene, run)
+    ref = reference_runs.run(scene, run)
     got = engine_run(dict(run.params), scene.u.value(0.0), ref["time"])
     assert np.max(ref["impacts"]) > 1 and np.max(np.abs(ref["s"] - ref["s_cam"])) >= 1e-4   # it leaves and lands
     if run.params["closure"] == "form":   # within the groove's clearance; a spring's follower never inside the cam

@@ -26,10 +26,8 @@ from cam_fmu.physics.variables import OUTPUT_NAMES
 
 
 @pytest.fixture(scope="module")
-def cam3(engine_fmu_path, tmp_path_factory):
-    from conftest import _build_fmu
-
-    return _build_fmu(tmp_path_factory.mktemp("cam3") / "cam3.fmu", "cam3")
+def cam3(cam3_fmu_path):
+    return cam3_fmu_path  # the session's build (conftest.py)
 
 
 @pytest.fixture(scope="module")

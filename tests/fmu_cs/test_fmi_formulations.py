@@ -79,24 +79,18 @@ def test_the_speed_drive_with_backlash_keeps_the_holding_torque(unzipped):
         assert v == pytest.approx(v0, rel=1e-6), c
 
 
-_REFERENCES: dict = {}  # beta -> the reference run (the same for every solver)
 
 
 @pytest.mark.parametrize("beta", [0.0, math.pi])
 @pytest.mark.parametrize("solver", ["rk45", "etdrk4", "rk4", "euler"])
-def test_gravity_backlash_and_inductance_pass_a_stall(unzipped, solver, beta):
+def test_gravity_backlash_and_inductance_pass_a_stall(unzipped, solver, beta, reference_runs):
     """Vertical mounting, c = 0.5 mm, L = 1 mH, 3.5 V: every solver runs through the stalls the
     reference runs through, and agrees with it to its promised order."""
-    from cam_fmu.reference.integrate import simulate_reference
-
     params = {"c": 5e-4, "L": 1e-3, "beta": beta, "closure": "kinematic", **VERTICAL}  # the solvers on the paper's rule
     ok, out, errors = _run(unzipped, {**params, "solver": solver, "h_max": 1e-5 if solver == "euler" else 1e-4},
                            [1e-3] * 500, ("theta", "omega"))
     assert ok, errors
-    key = beta
-    if key not in _REFERENCES:
-        _REFERENCES[key] = simulate_reference(params, 0.5, 1e-3)
-    ref = _REFERENCES[key]
+    ref = reference_runs.simulate(params, 0.5, 1e-3)  # the same for every solver
     tolerance = {"rk45": 1e-6, "etdrk4": 1e-3, "rk4": 1e-3, "euler": 5e-2}[solver]
     assert out[0] == pytest.approx(ref["theta"][-1], rel=tolerance, abs=tolerance)
 

@@ -15,7 +15,6 @@ from test_fmi_wrong_answers import _run
 INDUCTANCES = (1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1.0, 10.0)  # H: the documented range
 COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s: the issue's span of communication steps
 STOP = 0.1  # s: the cam starts and the follower rises (a break-away and a stop-free run)
-_REFERENCE: dict = {}
 
 
 @pytest.fixture(scope="module")
@@ -23,23 +22,19 @@ def unzipped(cam_fmu_path, tmp_path_factory):
     return extract(cam_fmu_path, tmp_path_factory.mktemp("cam_fmu_pole"))
 
 
-def _reference_theta(L: float) -> float:
-    from cam_fmu.reference.integrate import simulate_reference
-
-    if L not in _REFERENCE:
-        _REFERENCE[L] = float(simulate_reference({"L": L}, STOP, 1e-3)["theta"][-1])
-    return _REFERENCE[L]
+def _reference_theta(reference_runs, L: float) -> float:
+    return float(reference_runs.simulate({"L": L}, STOP, 1e-3)["theta"][-1])
 
 
 @pytest.mark.parametrize("h", COMM_STEPS)
 @pytest.mark.parametrize("L", INDUCTANCES)
-def test_the_default_solver_runs_and_is_accurate_at_any_inductance(unzipped, L, h):
+def test_the_default_solver_runs_and_is_accurate_at_any_inductance(unzipped, L, h, reference_runs):
     n = int(round(STOP / h))
     ok, out, errors = _run(unzipped, {"L": L}, [h] * n, ("theta", "i"))
     assert ok, errors
     theta, i = out
     # rk45's promise at the default rtol 1e-10 (tools/extremes.promised: 1e4 rtol per radian turned)
-    assert theta == pytest.approx(_reference_theta(L), rel=1e-6, abs=1e-8)
+    assert theta == pytest.approx(_reference_theta(reference_runs, L), rel=1e-6, abs=1e-8)
     assert 0.0 < i < 3.5 / 19.0 * 1.0001  # the current never exceeds u / R at rest
 
 

@@ -150,12 +150,10 @@ def test_docs_variable_table_is_the_generated_one():
     assert markdown_table().strip() in doc
 
 
-def test_every_fmu_the_project_builds_declares_the_engines_tolerance(cam_fmu_path, pi_speed_fmu_path, tmp_path):
+def test_every_fmu_the_project_builds_declares_the_engines_tolerance(cam_fmu_path, pi_speed_fmu_path, cam3_fmu_path):
     """A host that integrates with its own solver reads the DefaultExperiment's tolerance and otherwise runs at
     its own default (fmpy 1e-5, OMSimulator's own): every FMU declares the engine's rtol (docs/fmu.md)."""
-    from conftest import _build_fmu
-
-    for fmu in (cam_fmu_path, pi_speed_fmu_path, _build_fmu(tmp_path / "cam3.fmu", "cam3")):
+    for fmu in (cam_fmu_path, pi_speed_fmu_path, cam3_fmu_path):
         with zipfile.ZipFile(fmu) as z:
             exp = ET.fromstring(z.read("modelDescription.xml")).find("DefaultExperiment")
         assert exp is not None and float(exp.get("tolerance")) == parameters.BY_NAME["rtol"].default, fmu.name

@@ -54,11 +54,10 @@ def _tolerance(params: dict) -> tuple[float, float]:
 
 @pytest.mark.parametrize("factor", FACTORS)
 @pytest.mark.parametrize("name", SCENE_NAMES)
-def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, factor):
-    from cam_fmu.experiments.runner import run_scene
+def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, factor, reference_runs):
     scene = _scene(name, factor)
     fmu = fmu_runs[f"{name}@{factor}"]
-    ref = run_scene(scene, "reference")
+    ref = reference_runs.scene(scene)
     assert set(fmu) == set(ref) == {run.label for run in scene.runs}
     for run in scene.runs:
         f, r = fmu[run.label], ref[run.label]

@@ -39,11 +39,8 @@ def unzipped(engine_fmu_path, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def unzipped3(engine_fmu_path, tmp_path_factory):
-    from conftest import _build_fmu
-
-    return extract(_build_fmu(tmp_path_factory.mktemp("cam3_states") / "cam3.fmu", "cam3"),
-                   tmp_path_factory.mktemp("states3"))
+def unzipped3(cam3_fmu_path, tmp_path_factory):
+    return extract(cam3_fmu_path, tmp_path_factory.mktemp("states3"))
 
 
 def _slave(unzipped) -> tuple[Slave, bytes]:

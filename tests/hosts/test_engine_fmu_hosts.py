@@ -51,7 +51,9 @@ def _hidden_folders() -> list[str]:
         folder = str(Path(folder).resolve())
         out.add(str(Path(folder) / "lib" / f"python{sys.version_info[0]}.{sys.version_info[1]}")
                 if folder in SYSTEM else folder)
-    return sorted(out)
+    # a folder inside another is hidden with it (a venv in the checkout, as setup.sh makes: once the checkout is
+    # under a tmpfs its mount point is gone and mount failed)
+    return sorted(f for f in out if not any(Path(f).is_relative_to(other) and f != other for other in out))
 
 
 def hidden(cmd: list[str], cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:

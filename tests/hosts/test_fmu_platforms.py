@@ -36,10 +36,8 @@ LINKER_SYMBOLS = {"_mh_dylib_header", "__dso_handle"}  # (underscore dropped) wh
 
 
 @pytest.fixture(scope="module")
-def cam3(tmp_path_factory) -> Path:
-    from conftest import _build_fmu
-
-    return _build_fmu(tmp_path_factory.mktemp("platforms_cam3") / "cam3.fmu", "cam3")
+def cam3(cam3_fmu_path) -> Path:
+    return cam3_fmu_path  # the session's build (conftest.py): every platform, as hosts/ is never in the fast loop
 
 
 def _extract(fmu: Path, folder: Path) -> Path:

@@ -45,10 +45,9 @@ def _child(args: list[str], cwd: Path, isolated: bool = False, timeout: float = 
 
 
 @pytest.fixture(scope="module")
-def ssp(cam_fmu_path, tmp_path_factory) -> Path:
+def ssp(cam_fmu_path, pi_speed_fmu_path, tmp_path_factory) -> Path:
     folder = tmp_path_factory.mktemp("speed_loop")
-    pi_fmu = folder / "pi_speed.fmu"
-    _child([str(ROOT / "build_fmu.py"), "--model", "pi_speed", "--dest", str(pi_fmu)], cwd=folder)
+    pi_fmu = pi_speed_fmu_path  # the session's build (conftest.py: build_fmu.py --model pi_speed)
     # a controller with feedforward, so that every connection (u, omega, M, J) carries a signal
     system = speed_loop_system({"gamma": math.pi}, {"feedforward": 1.0, "kp": 2.0, "ki": 20.0}, stop_time=STOP)
     return write_ssp(system, {"cam": cam_fmu_path, "controller": pi_fmu}, folder / "speed_loop.ssp")

@@ -19,7 +19,7 @@ import pytest
 
 from cam_fmu.engine import targets
 
-pytestmark = [pytest.mark.external, pytest.mark.slow]
+pytestmark = pytest.mark.external  # (hosts/ is external by itself; slow by its recorded durations)
 
 ROOT = Path(__file__).resolve().parents[2]
 PYENV = Path("/root/.pyenv/versions")

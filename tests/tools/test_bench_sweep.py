@@ -13,7 +13,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.mark.slow
 def test_sweep_benchmark_reports_engine_serial_cluster_and_memory(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", "bench", "--sweep", "60", "--workers", "2", "--out",
                            str(tmp_path)], capture_output=True, text=True, cwd=tmp_path, timeout=900,

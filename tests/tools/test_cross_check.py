@@ -31,13 +31,15 @@ FILES = ("{m}.fmu", "{m}_in.csv", "{m}_ref.csv", "{m}_ref.opt", "ReadMe.md", "{m
 
 
 @pytest.fixture(scope="module")
-def shipped(engine_fmu_path, tmp_path_factory) -> list[Path]:
-    """Every FMU the command packages by default (the drive's: cam.fmu, cam3.fmu), built from this checkout."""
-    from conftest import _build_fmu
-
+def shipped(cam_fmu_path, cam3_fmu_path) -> list[Path]:
+    """Every FMU the command packages by default (the drive's: cam.fmu, cam3.fmu): the session's builds from this
+    checkout (conftest.py). A new FMU of the drive fails here until it has its session build."""
     from cam_fmu.fmu.build import ENGINE_MODELS
-    others = [name for name, (c_model, _v) in ENGINE_MODELS.items() if c_model == "cam" and name != "cam"]
-    return [engine_fmu_path] + [_build_fmu(tmp_path_factory.mktemp(f"{n}_build") / f"{n}.fmu", n) for n in others]
+
+    built = {"cam": cam_fmu_path, "cam3": cam3_fmu_path}
+    drives = [name for name, (c_model, _v) in ENGINE_MODELS.items() if c_model == "cam"]
+    assert sorted(drives) == sorted(built), f"the drive's FMUs {drives}: give each a session build in conftest.py"
+    return [built[name] for name in drives]
 
 
 @pytest.fixture(scope="module")
@@ -209,13 +211,12 @@ def test_the_input_file_is_used(package):
         assert problem is not None and "outside epsilon band" in problem
 
 
-def test_the_reference_agrees_with_the_scipy_reference(package):
+def test_the_reference_agrees_with_the_scipy_reference(package, reference_runs):
     """The same step of u on physics/ integrated by scipy (rtol 1e-12): co-simulation within
     test_fmu_vs_reference's rk45 tolerances (theta 1e-6 rad, omega 1e-4 of its peak); every folder
     passes fmpy's importer criterion against it."""
     from cam_fmu.experiments.scenes import find_scene
     from cam_fmu.physics.signals import Signal
-    from cam_fmu.reference import simulate_reference
     from cam_fmu.tools.cross_check.experiment import STEP_TIME
 
     scene = find_scene("paper_fig6")
@@ -226,7 +227,8 @@ def test_the_reference_agrees_with_the_scipy_reference(package):
         reference = read_csv(str(folder / f"{m}_ref.csv"))
         assert opts["StopTime"] == pytest.approx(STEP_TIME + scene.stop_time)
         u = Signal((0.0, STEP_TIME, STEP_TIME), (0.0, 0.0, u_after))
-        scipy_run = simulate_reference(scene.primary.overrides, opts["StopTime"], opts["OutputIntervalLength"], u=u)
+        scipy_run = reference_runs.simulate(scene.primary.overrides, opts["StopTime"], opts["OutputIntervalLength"],
+                                            u=u)
         names = reference.dtype.names
         as_table = np.array(list(zip(*(scipy_run[n] for n in names))), dtype=reference.dtype)
         assert _validate_result(as_table, reference, opts) is None
@@ -278,6 +280,11 @@ def test_bad_input_is_one_line_exit_2(engine_fmu_path, tmp_path, capsys):
     shutil.copyfile(engine_fmu_path, tmp_path / "cam-2.fmu")
     (tmp_path / "other").mkdir()
     shutil.copyfile(engine_fmu_path, tmp_path / "other" / "cam.fmu")
+    # an FMU built for other machines only (the session's build may be this machine's only: the fast loop)
+    other_platforms_only = _fmu_without(engine_fmu_path, tmp_path / "cam.fmu", f"binaries/{fmpy.platform}/")
+    with zipfile.ZipFile(other_platforms_only, "a") as z:
+        if not any(n.startswith("binaries/") and not n.endswith("/") for n in z.namelist()):
+            z.writestr("binaries/win64/cam.dll", b"MZ")
     cases = [
         ([str(tmp_path / "out"), "--fmu", str(tmp_path / "missing.fmu")], "does not exist"),
         ([str(tmp_path / "out"), "--fmu", str(a_file)], "is not an FMU"),
@@ -285,9 +292,7 @@ def test_bad_input_is_one_line_exit_2(engine_fmu_path, tmp_path, capsys):
         ([str(tmp_path / "out"), "--fmu", str(tmp_path / "cam-2.fmu")], "the file name is the model name"),
         ([str(tmp_path / "out"), "--fmu", str(engine_fmu_path), str(tmp_path / "other" / "cam.fmu")],
          "would share the folder"),
-        ([str(tmp_path / "out"), "--fmu",
-          str(_fmu_without(engine_fmu_path, tmp_path / "cam.fmu", f"binaries/{fmpy.platform}/"))],
-         f"no binary for this machine ({fmpy.platform}"),
+        ([str(tmp_path / "out"), "--fmu", str(other_platforms_only)], f"no binary for this machine ({fmpy.platform}"),
     ]
     for args, message in cases:
         assert main(["cross-check", *args]) == 2, args

@@ -49,7 +49,7 @@ def test_no_c_file_over_700_lines():
 
 
 def test_imports_inside_the_package_are_relative():
-    """So the FMU's bundle can live under any package name (the slave scripts, top-level modules, excepted)."""
+    """So the package works under any name (a pythonfmu block's slave script, a top-level module in its FMU, excepted)."""
     absolute = []
     for path in MODULES:
         if path.name.endswith("_fmu_slave.py"):  # an FMU's slave script: a top-level module in its FMU
