@@ -279,14 +279,14 @@ def test_extremes_are_the_reference(change, u):
     assert np.min(got["s"] - got["s_cam"]) >= -2e-12
 
 
-def test_rk45_tolerances_and_h_max_trade_cost_for_accuracy_with_a_follower_of_its_own():
+def test_rk45_tolerances_and_h_max_trade_cost_for_accuracy_with_a_follower_of_its_own(reference_runs):
     """Issue 38: the follower of its own takes rk45's error-controlled steps, so rtol/atol and h_max are honoured. On
     `backlash` (closure form, 8 transitions in 2 s) against the reference (rtol 1e-12): the error in theta falls and
     the internal steps grow as rtol tightens (measured 1.3e-5, 7.3e-8, 2.1e-9 rad at rtol 1e-6, 1e-8, 1e-10 with
     2049, 2187, 2610 steps), the default within 1e-8 rad; h_max = 1e-4 s caps every step (at least 20000 steps)."""
     scene = find_scene("backlash")
     params, u = dict(scene.primary.params), scene.u.value(0.0)
-    ref = _reference(scene, scene.primary)
+    ref = reference_runs.run(scene, scene.primary)
     errors, steps = [], []
     for rtol in (1e-6, 1e-8, 1e-10):
         sim = DriveSimulator(dict(params, rtol=rtol, atol=rtol * 1e-2))
@@ -306,23 +306,24 @@ def test_rk45_tolerances_and_h_max_trade_cost_for_accuracy_with_a_follower_of_it
     assert capped.steps_taken >= 2.0 / 1e-4 and abs(capped.outputs()["theta"] - ref["theta"][-1]) < 1e-8
 
 
-def _backlash_theta(change: dict) -> tuple[np.ndarray, np.ndarray]:
+def _backlash_theta(change: dict, reference_runs) -> tuple[np.ndarray, np.ndarray]:
     """theta of the `backlash` scene (closure form) at its output points under ``change``, and the reference's."""
     scene = find_scene("backlash")
     params, u = dict(scene.primary.params, **change), scene.u.value(0.0)
-    ref = _reference(scene, scene.primary)
+    ref = reference_runs.run(scene, scene.primary)
     return engine_run(params, u, ref["time"])["theta"], ref["theta"]
 
 
-def test_every_solver_runs_a_follower_of_its_own_at_its_order():
+def test_every_solver_runs_a_follower_of_its_own_at_its_order(reference_runs):
     """Issue 38: euler, rk4 and etdrk4 run the voltage drive's follower of its own (refused before), fixed steps of
     h_max with the events located on them. Against the reference on `backlash`: rk4's error falls by more than 100
     when h_max falls 5-fold (order 4: 625; measured 2.45e-4 -> 2.6e-7 rad), euler's by 5 to 20 when it falls 10-fold
     (order 1; measured 0.113 -> 0.0113 rad); etdrk4 without inductance is rk4 (its classical core), bit for bit."""
     errors = {}
     for solver, h_max in (("rk4", 1e-3), ("rk4", 2e-4), ("euler", 1e-4), ("euler", 1e-5)):
-        got, want = _backlash_theta(dict(solver=solver, h_max=h_max))
+        got, want = _backlash_theta(dict(solver=solver, h_max=h_max), reference_runs)
         errors[solver, h_max] = np.max(np.abs(got - want))
     assert errors["rk4", 1e-3] > 100.0 * errors["rk4", 2e-4] and errors["rk4", 2e-4] < 1e-6, errors
     assert 5.0 < errors["euler", 1e-4] / errors["euler", 1e-5] < 20.0, errors
-    assert np.array_equal(_backlash_theta(dict(solver="etdrk4"))[0], _backlash_theta(dict(solver="rk4"))[0])
+    assert np.array_equal(_backlash_theta(dict(solver="etdrk4"), reference_runs)[0],
+                          _backlash_theta(dict(solver="rk4"), reference_runs)[0])
