@@ -97,6 +97,18 @@ def cam3_fmu_path(tmp_path_factory, request) -> Path:
 
 
 @pytest.fixture(scope="session")
+def wheels_folder(tmp_path_factory) -> Path:
+    """Every platform's wheel built once per test session (build_fmu.py --wheels): the wheel tests install them,
+    the reproducibility test builds them once more and compares the bytes."""
+    folder = tmp_path_factory.mktemp("wheels")
+    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--wheels", str(folder)], capture_output=True,
+                          text=True, cwd=ROOT, timeout=3600)
+    if proc.returncode != 0:
+        pytest.fail(f"build_fmu.py --wheels failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
+    return folder
+
+
+@pytest.fixture(scope="session")
 def engine_fmu_path(cam_fmu_path) -> Path:
     """cam.fmu as ``cam_fmu_path`` (built from the C engine). It hosts no Python: loading it into the
     pytest process is safe."""

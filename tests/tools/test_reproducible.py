@@ -1,6 +1,8 @@
 """Reproducible builds (docs/fmu.md, "Reproducible builds"): two builds of one commit into two folders give the
-same bytes for every FMU (every platform's binaries), every SSP and every wheel. Each artefact is built twice
-here, once per session of this module (slow: zig builds every platform, pip builds every wheel).
+same bytes for every FMU (every platform's binaries), every SSP and every wheel. The session's builds
+(conftest: cam_fmu_path, cam3_fmu_path, pi_speed_fmu_path, wheels_folder; every platform in a full run) are the
+first build; this module builds each artefact once more into a folder of another path length (slow: zig builds
+every platform, pip builds every wheel).
 
 Independent checks beside the byte comparison: the zip entries carry the last commit's time as git reports it
 (or SOURCE_DATE_EPOCH when set), in name order, 0644; no binary names a build folder.
@@ -34,29 +36,34 @@ def _build_fmu(dest: Path, model: str, *extra: str, env: dict | None = None) -> 
     return dest
 
 
-@pytest.fixture(scope="module")
-def twice(tmp_path_factory) -> list[dict[str, Path]]:
-    """Every FMU (all platforms) and SSP built twice, into two folders of different path lengths."""
-    made = []
-    for folder in (tmp_path_factory.mktemp("first"), tmp_path_factory.mktemp("second_build_elsewhere") / "deeper"):
-        folder.mkdir(parents=True, exist_ok=True)
-        fmus = {f"{m}.fmu": _build_fmu(folder / f"{m}.fmu", m) for m in fmu_build.MODELS}
-        ssps = {f"{n}.ssp": fmu_build.build_ssp(folder / f"{n}.ssp", fmus["cam.fmu"], fmus["pi_speed.fmu"], n)
-                for n in fmu_build.SSP_NAMES}
-        made.append({**fmus, **ssps})
-    return made
+def _with_ssps(folder: Path, fmus: dict[str, Path]) -> dict[str, Path]:
+    ssps = {f"{n}.ssp": fmu_build.build_ssp(folder / f"{n}.ssp", fmus["cam.fmu"], fmus["pi_speed.fmu"], n)
+            for n in fmu_build.SSP_NAMES}
+    return {**fmus, **ssps}
 
 
 @pytest.fixture(scope="module")
-def wheels_twice(tmp_path_factory) -> list[dict[str, Path]]:
-    made = []
-    for name in ("wheels_a", "wheels_b"):
-        folder = tmp_path_factory.mktemp(name)
-        proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--wheels", str(folder)], cwd=ROOT,
-                              capture_output=True, text=True, timeout=3600)
-        assert proc.returncode == 0, proc.stderr[-3000:]
-        made.append({p.name: p for p in folder.glob("*.whl")})
-    return made
+def twice(tmp_path_factory, cam_fmu_path, cam3_fmu_path, pi_speed_fmu_path) -> list[dict[str, Path]]:
+    """Every FMU (all platforms) and SSP twice: the session's build, and one more into a folder of another path
+    length."""
+    assert set(fmu_build.MODELS) == {"cam", "cam3", "pi_speed"}, fmu_build.MODELS  # the session builds these
+    first = _with_ssps(tmp_path_factory.mktemp("first"),
+                       {"cam.fmu": cam_fmu_path, "cam3.fmu": cam3_fmu_path, "pi_speed.fmu": pi_speed_fmu_path})
+    folder = tmp_path_factory.mktemp("second_build_elsewhere") / "deeper"
+    folder.mkdir(parents=True, exist_ok=True)
+    second = _with_ssps(folder, {f"{m}.fmu": _build_fmu(folder / f"{m}.fmu", m) for m in fmu_build.MODELS})
+    return [first, second]
+
+
+@pytest.fixture(scope="module")
+def wheels_twice(tmp_path_factory, wheels_folder) -> list[dict[str, Path]]:
+    """Every wheel twice: the session's build and one more."""
+    folder = tmp_path_factory.mktemp("wheels_again") / "elsewhere"
+    folder.mkdir(parents=True)
+    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--wheels", str(folder)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=3600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return [{p.name: p for p in wheels_folder.glob("*.whl")}, {p.name: p for p in folder.glob("*.whl")}]
 
 
 @pytest.mark.external
