@@ -129,7 +129,7 @@ class DurationRecorder:
         modules updates those; a full run updates all, and a test no longer collected keeps its entry, which
         only over-counts the fast loop's bound)."""
         record = load(self.path)
-        record["command"] = "python -m pytest -q --record-durations tests/durations.json"
+        record["command"] = ".venv/bin/python -m pytest -q --record-durations tests/durations.json"
         record["tests"].update({n: round(max(s - self.shared[n], 0.0), 3) for n, s in self.tests.items()})
         record["fixtures"].update({k: round(s, 3) for k, s in self.fixtures.items()})
         record["session"].update({k: round(s, 3) for k, s in self.session.items()})

@@ -26,9 +26,21 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY]);
 /* The event function `code` at y (> 0: nothing happens). */
 double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY]);
+/* m/s2: the scale of the follower's relative acceleration at y (the Zeno guard's and the rebound's). */
+double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u);
+/* On the flank `contact` at y: d = (s_cam, s', s'', s''') at the cam, omega_dot [rad/s2], the contact force P [N]. */
+void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                     double *P);
+/* The follower's s, v set on the flank `contact` at y. */
+void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact);
+/* rad/s2: > 0 where the stuck shaft starts, *dir the way it starts. */
+double cam_vf_breakaway(const CamModel *m, const double y[NY], double u, int contact, double *dir);
 /* y from the drive's state, and back (the follower's s, v in d->speed, the shaft's mode in d->mode). */
 void cam_vf_load_y(const CamDrive *d, double y[NY]);
 void cam_vf_store_y(CamDrive *d, const double y[NY]);
+/* On the flank `contact`: the follower set on it, or lifted off at once where its contact force is already < 0: the
+ * contact after. */
+int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact);
 /* On the flank `contact`: the follower set on it, or let go where the flank would pull (*left: the flank it lets
  * go of); the contact after. */
 int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left);

@@ -13,12 +13,12 @@
  * friction at no contact force; a halt where v reaches 0); touch-down where a gap reaches -CAM_TOUCH, an impact exchanging
  * momentum with the cam side (J_0 omega + m s' v kept, w+ = -e w-) and the Zeno guard. The steps of the parameter
  * `solver` (rk.c's tableaus: rk45 with error control on rtol, atol; euler, rk4 and etdrk4's RK4 core fixed at h_max
- * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's and the shaft's oscillation, a tenth of
- * the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
+ * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's oscillation and
+ * of the shaft's (SHAFT_PHASE_RK45 under rk45), a tenth of the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
  * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
- * follower off it: the follower flies alone and lands on the cam at rest (unstick). */
+ * follower off it: the follower flies alone and lands on the cam at rest (voltage_follower_events.c unstick). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -138,7 +138,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 
 /* rad/s2: > 0 where the stuck shaft starts (model.c cam_breakaway_margin with the follower's contact): the larger of
  * its acceleration forward and backward, each with the shaft's and the guide's friction against that direction. */
-static double breakaway(const CamModel *m, const double y[NY], double u, int contact, double *dir)
+double cam_vf_breakaway(const CamModel *m, const double y[NY], double u, int contact, double *dir)
 {
     double d[4], forward, backward, P, n_r;
     if (contact) {
@@ -153,7 +153,7 @@ static double breakaway(const CamModel *m, const double y[NY], double u, int con
     return fmax(forward, backward);
 }
 
-static void on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
                      double *P)
 {
     double n_r;
@@ -220,7 +220,7 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
-static void set_on_flank(const CamModel *m, double y[NY], int contact)
+void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
@@ -259,7 +259,7 @@ static void vf_step(const CamModel *m, const CamTableau *t, double u, int contac
         end[1] = fsal ? r.n_r : NAN;
     }
     if (contact)
-        set_on_flank(m, out, contact);
+        cam_vf_set_on_flank(m, out, contact);
 }
 
 /* The event function `code` at y on or off the flank `contact` (> 0: nothing happens). */
@@ -269,9 +269,9 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_STOP)
         return y[Y_DIR] * y[1];
     if (code == EV_BREAK_AWAY)
-        return -breakaway(m, y, u, contact, &omega_dot);
+        return -cam_vf_breakaway(m, y, u, contact, &omega_dot);
     if (code == EV_LIFT_OFF) {
-        on_flank(m, y, u, contact, d, &omega_dot, &P);
+        cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P);
         return contact * P;
     }
     if (code == EV_HALT)
@@ -314,7 +314,7 @@ static double trial_event(void *ctx, int code, double h)
 }
 
 /* m/s2: a bound of the follower's acceleration relative to the flank near y (voltage_follower.acceleration_scale). */
-static double acceleration_scale(const CamModel *m, const double y[NY], double u)
+double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u)
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
@@ -345,147 +345,6 @@ static double vf_error_norm(const CamModel *m, int contact, const double y[NY], 
     return sqrt(total / n);
 }
 
-/* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
-static void impact(const CamModel *m, double y[NY], double s1, double e)
-{
-    double w = y[4] - s1 * y[1], m_eff = m->m * m->J_0 / (m->J_0 + m->m * s1 * s1);
-    double P = -(1.0 + e) * m_eff * w;
-    y[4] += P / m->m;
-    y[1] -= s1 * P / m->J_0;
-}
-
-/* A stuck cam struck by the follower: its static friction, a finite force, gives no impulse; the cam moves off
- * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). */
-static void unstick(double y[NY])
-{
-    if (y[Y_DIR] == 0.0 && y[1] != 0.0)
-        y[Y_DIR] = sgn(y[1]);
-}
-
-/* A touch-down on the flank `flank` at y (voltage_follower.land): the contact after; y's follower on the flank,
- * omega and v after. */
-static int land(const CamModel *m, double y[NY], double u, int flank, double *rebound)
-{
-    double d[4], before[NY], w, omega_dot, P, scale = acceleration_scale(m, y, u);
-    memcpy(before, y, sizeof before);
-    cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - flank * cam_vf_clearance(m);
-    impact(m, y, d[1], m->restitution);
-    unstick(y);
-    w = y[4] - d[1] * y[1];
-    if (w * w >= 2.0 * scale * CAM_ZENO_HEIGHT) {
-        *rebound = w != 0.0 ? fabs(w) / (2.0 * acceleration_scale(m, y, u)) : 0.0;
-        return 0;
-    }
-    memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0] - flank * cam_vf_clearance(m);
-    impact(m, y, d[1], 0.0);
-    unstick(y);
-    y[4] = d[1] * y[1];
-    on_flank(m, y, u, flank, d, &omega_dot, &P);
-    return flank * P >= 0.0 ? flank : 0;
-}
-
-void cam_vf_load_y(const CamDrive *d, double y[NY])
-{
-    y[0] = d->x[CAM_THETA];
-    y[1] = d->x[CAM_OMEGA];
-    y[2] = d->x[CAM_CURRENT];
-    y[3] = d->speed.s;
-    y[4] = d->speed.v;
-    y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
-    y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
-    y[Y_SIGMA] = cam_vf_flight_direction(&d->model, y);
-    y[Y_DIR] = d->mode.stuck ? 0.0 : d->mode.direction;
-}
-
-void cam_vf_store_y(CamDrive *d, const double y[NY])
-{
-    d->x[CAM_THETA] = y[0];
-    d->x[CAM_OMEGA] = y[1];
-    d->x[CAM_CURRENT] = y[2];
-    d->speed.s = y[3];
-    d->speed.v = y[4];
-    if (d->model.compliant) {
-        d->x[CAM_TWIST] = y[Y_TWIST];
-        d->x[CAM_OMEGA_M] = y[Y_ROTOR];
-    }
-    d->speed.theta = y[0];
-    d->speed.speed = y[1];
-    d->mode.stuck = y[Y_DIR] == 0.0;
-    if (y[Y_DIR] != 0.0)
-        d->mode.direction = y[Y_DIR];
-}
-
-/* On the flank `contact`: the follower set on it, or lifted off at once where contact P is already < 0 (a jump of
- * s''): the contact after. */
-static int settle(const CamModel *m, double y[NY], double u, int contact)
-{
-    double d[4], omega_dot, P;
-    if (!contact)
-        return 0;
-    set_on_flank(m, y, contact);
-    on_flank(m, y, u, contact, d, &omega_dot, &P);
-    return contact * P >= 0.0 ? contact : 0;
-}
-
-/* settle, and *left the flank the follower lets go of where it does. */
-int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
-{
-    int after = settle(m, y, u, contact);
-    if (contact && !after)
-        *left = contact;
-    return after;
-}
-
-/* The lift-off or touch-down `code` from the contact `contact` at y at time [s] (a touch-down: the impact and the
- * rebound guard of land, *rebound its guard), for co-simulation's step and Model Exchange's event update alike: the
- * contact after, *left the flank the follower leaves (its gap's origin in Model Exchange); its line appended to
- * d->step_events. */
-int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
-                      int *left, long *dropped)
-{
-    const CamModel *m = &d->model;
-    double dd[4], w_before, w_after;
-    int flank = code == EV_TOUCH_UP ? 1 : -1;
-    if (code == EV_LIFT_OFF) {
-        set_on_flank(m, y, contact);
-        cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: lift-off from flank %+d at "
-                          "t = %.9g s (theta = %.6g rad); ", contact, time, y[0]);
-        *left = contact;
-        return 0;
-    }
-    cam_profile_eval(&m->profile, y[0], dd);
-    w_before = y[4] - dd[1] * y[1];
-    *rebound = 0.0;
-    contact = land(m, y, u, flank, rebound);
-    w_after = y[4] - dd[1] * y[1];
-    d->speed.impacts += 1.0;
-    if (!contact)
-        *left = flank;
-    cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: touch-down on flank %+d at "
-                      "t = %.9g s (theta = %.6g rad), relative speed %.6g m/s, after %.6g m/s; ", flank, time, y[0],
-                      w_before, w_after);
-    return contact;
-}
-
-/* At rest (omega = 0: the start, a new input, a stop, a located break-away): the shaft stays stuck, the follower at
- * rest on its flank, or starts toward where it accelerates (model.c cam_breakaway_direction's rule with the contact's
- * load; at a located break-away, where the margin is 0 to rounding, at once); *contact after, 0 where the flank lets
- * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
-void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
-{
-    double dir, margin;
-    y[1] = 0.0;
-    y[Y_DIR] = 0.0;
-    *contact = cam_vf_settle_from(m, y, u, *contact, left);
-    margin = breakaway(m, y, u, *contact, &dir);
-    if (margin > 0.0 || at_threshold) {
-        y[Y_DIR] = dir;
-        *contact = cam_vf_settle_from(m, y, u, *contact, left);
-    }
-}
-
 static int vf_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
@@ -499,10 +358,10 @@ static int vf_init(CamDrive *d, CamError *err)
     memset(&d->speed, 0, sizeof d->speed);
     d->speed.contact = 1.0;
     cam_vf_load_y(d, y);
-    contact = settle(&d->model, y, d->u, 1);
+    contact = cam_vf_settle(&d->model, y, d->u, 1);
     if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
         memcpy(other, y, sizeof other);
-        if ((contact = settle(&d->model, other, d->u, -1)) != 0)
+        if ((contact = cam_vf_settle(&d->model, other, d->u, -1)) != 0)
             memcpy(y, other, sizeof other);
     }
     if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
@@ -582,7 +441,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         if (!contact && wn > 0.0)
             dt = fmin(dt, STEP_PHASE / wn);
         if (!contact && y[Y_DIR] == 0.0 && cam_vf_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
-            double c = cam_vf_clearance(m), A = acceleration_scale(m, y, u);
+            double c = cam_vf_clearance(m), A = cam_vf_acceleration_scale(m, y, u);
             dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
             if (y[4] != 0.0)
                 dt = fmin(dt, 0.1 * c / fabs(y[4]));
@@ -748,7 +607,7 @@ static void vf_outputs(CamDrive *d, double out[])
     if (d->speed.contact != 0.0) {
         int contact = (int)d->speed.contact;
         double tan_a = dd[1] / (m->r_b + dd[0]);
-        on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
+        cam_vf_on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
                  : m->M_f * shaft_direction(y) + P * dd[1];
         load.N = cam_normal_force(P, tan_a);   /* signed as contact */
