@@ -25,7 +25,7 @@ import pytest
 
 HERE = Path(__file__).resolve().parent
 DURATIONS = HERE / "durations.json"
-SLOW_SECONDS = 0.2  # a test (or a module fixture it needs) recorded above this is `slow` [s]
+SLOW_SECONDS = 0.15 # a test (or a module fixture it needs) recorded above this is `slow` [s]
 FAST_LOOP_SECONDS = 60.0  # the fast loop's target on the 2-core development machine [s]
 # what the fast loop spends outside the recorded tests: start-up, collection and the session's FMU builds for
 # this machine (measured: tests/README.md) [s]
