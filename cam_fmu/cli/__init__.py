@@ -32,6 +32,8 @@ SUBCOMMANDS: tuple[str, ...] = (
     "bode",       # the frequency response from the motor voltage to the motor and cam speed
     "jump",       # the speed at which a spring-closed follower leaves the cam; the spring it needs
     "cross_check",  # the FMI Cross-Check folders of the shipped FMUs, validated by fmpy
+    "residual",   # the follower train's residual vibration after a rise, against r, per law
+    "optimize_law",  # the harmonic-trapezoid law shaped against the residual over a band of r
 )
 
 
