@@ -1,0 +1,99 @@
+"""`cam-fmu residual` and `cam-fmu optimize-law`: their numbers against the cycloidal's closed form and the
+integrated train, the law written as a scene's parameters that a scene accepts, the refusals."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cam_fmu.experiments.scenes import find_scene, scene_from_dict
+from cam_fmu.kinematics.motion_law import MotionLaw
+from cam_fmu.vibration.train import residual_ode
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "cam_fmu.cli", *args], capture_output=True, text=True, cwd=cwd,
+                          env={**os.environ, "PYTHONPATH": str(ROOT), "CAM_FMU_PROGRESS": "0"}, timeout=600)
+
+
+def test_residual_json_the_scene_law_first_and_the_cycloidal_closed_form(tmp_path):
+    done = cli("residual", "paper_fig6", "--set", "rise_law=cycloidal", "--laws", "cycloidal,polynomial_345",
+               "--r", "1.1:6", "--points", "50", "--check", "4", "--limit", "0.01", "--train-hz", "50", "--json",
+               "--out", str(tmp_path), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert list(out["laws"]) == ["scene: cycloidal", "polynomial_345"]   # cycloidal is the scene's: once
+    r = np.asarray(out["r"])
+    want = np.abs(np.sin(np.pi * r)) / (np.pi * r * np.abs(r * r - 1))
+    cyc = out["laws"]["scene: cycloidal"]
+    assert np.max(np.abs(np.asarray(cyc["residual"]) - want)) < 1e-11
+    assert cyc["ode_max_difference"] < 1e-9 and len(cyc["ode_checked_at"]) == 4
+    # the top speed: the rise (paper_fig6: pi rad) lasting r_limit periods of the 50 Hz train
+    assert 1 / (np.pi * cyc["r_limit"] * (cyc["r_limit"] ** 2 - 1)) >= 0.01 * (1 - 1e-9)
+    omega = cyc["rpm_max"] * 2 * math.pi / 60
+    assert math.pi / omega * 50.0 == pytest.approx(cyc["r_limit"], rel=1e-12)
+    assert (tmp_path / "paper_fig6_residual.png").stat().st_size > 0
+
+
+def test_optimize_law_writes_a_law_a_scene_takes(tmp_path):
+    done = cli("optimize-law", "paper_fig6", "--band", "1.5:3", "--front", "60,150", "--json", "--out",
+               str(tmp_path), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert out["best_classic"] == "modified_sine"
+    assert out["ratio_to_best_classic"] <= 0.873
+    # the integrated train at the band's ends and the worst r: none above the optimiser's worst, the worst met
+    assert max(out["ode_residual"]) == pytest.approx(out["worst"], abs=1e-9)
+    assert [f["max_cj"] for f in out["front"]] == [60.0, 150.0] and out["front"][1]["worst"] <= out["front"][0]["worst"]
+    text = (tmp_path / "paper_fig6_law.toml").read_text(encoding="utf-8")
+    params = tomllib.loads(text)["parameters"]
+    raw = dict(find_scene("paper_fig6").raw)
+    raw["parameters"] = {**raw.get("parameters", {}), **params}
+    scene = scene_from_dict(raw, name="optimised")
+    T = tuple(scene.primary.params[f"rise_T{k}"] for k in range(1, 7))
+    assert scene.primary.params["rise_law"] == "custom" and T == tuple(out["T"])
+    assert float(residual_ode(MotionLaw(T), out["r_worst"])[0]) == pytest.approx(out["worst"], abs=1e-9)
+    for name in ("paper_fig6_optimized.png", "paper_fig6_front.png"):
+        assert (tmp_path / name).stat().st_size > 0
+
+
+def test_a_scene_without_a_rise_law_is_refused(tmp_path):
+    scene = tmp_path / "table.toml"
+    scene.write_text('stop_time = 0.1\noutput_interval = 0.01\n[u]\ntype = "constant"\nvalue = 3.5\n'
+                     '[parameters]\nmotion_table = "0,0\\n180,10\\n"\n', encoding="utf-8")
+    for command in (["residual", str(scene)], ["optimize-law", str(scene), "--band", "1.5:3"]):
+        done = cli(*command, "--out", str(tmp_path), cwd=tmp_path)
+        assert done.returncode == 2 and "motion table" in done.stderr and "no rise law" in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--band", "0:3"], "--band 0:3: allowed R1:R2 with 0 < R1 < R2"),
+    (["--band", "3:1.5"], "--band 3:1.5: allowed R1:R2 with 0 < R1 < R2"),
+    (["--band", "x"], "--band 'x': allowed R1:R2"),
+    (["--band", "1.5:3", "--max-ca", "3"], "--max-ca 3: unreachable"),
+    (["--band", "1.5:3", "--max-cj", "-1"], "--max-cj '-1': allowed a number > 0 or none"),
+    (["--band", "1.5:3", "--zeta", "1"], "zeta 1.0: allowed"),
+])
+def test_optimize_law_refusals(tmp_path, args, message):
+    done = cli("optimize-law", "paper_fig6", *args, "--no-front", "--out", str(tmp_path), cwd=tmp_path)
+    assert done.returncode == 2 and message in done.stderr, done.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--laws", "nope"], "unknown motion law 'nope'"),
+    (["--r", "0:2"], "--r 0:2: allowed R1:R2 with 0 < R1 < R2"),
+    (["--limit", "2"], "--limit 2.0: allowed a residual / lift in (0, 1)"),
+    (["--train-hz", "0", "--limit", "0.1"], "--train-hz 0.0: allowed a frequency > 0"),
+])
+def test_residual_refusals(tmp_path, args, message):
+    done = cli("residual", "paper_fig6", *args, "--no-plot", "--check", "0", cwd=tmp_path)
+    assert done.returncode == 2 and message in done.stderr, done.stderr
