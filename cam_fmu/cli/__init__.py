@@ -34,6 +34,7 @@ SUBCOMMANDS: tuple[str, ...] = (
     "cross_check",  # the FMI Cross-Check folders of the shipped FMUs, validated by fmpy
     "residual",   # the follower train's residual vibration after a rise, against r, per law
     "optimize_law",  # the harmonic-trapezoid law shaped against the residual over a band of r
+    "polydyne",   # the cam profile that cancels the train's vibration at one speed, as a motion table
 )
 
 

@@ -97,3 +97,39 @@ def test_optimize_law_refusals(tmp_path, args, message):
 def test_residual_refusals(tmp_path, args, message):
     done = cli("residual", "paper_fig6", *args, "--no-plot", "--check", "0", cwd=tmp_path)
     assert done.returncode == 2 and message in done.stderr, done.stderr
+
+
+def test_polydyne_writes_a_table_the_drive_runs(tmp_path):
+    from cam_fmu.fmu.engine import DriveSimulator
+    from cam_fmu.kinematics.motion_table import program_from_table_text
+
+    done = cli("polydyne", "paper_fig6", "--law", "polynomial_4567", "--rpm", "600", "--train-hz", "50",
+               "--speeds", "3", "--json", "--out", str(tmp_path), cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert out["r_rise"] == pytest.approx(2.5, rel=1e-14)     # pi rad at 20 pi rad/s: 0.05 s of a 20 ms period
+    assert out["residual_plain"] > 1e-2 and out["residual_polydyne"] <= 1e-4
+    assert [row["rpm"] for row in out["band"]] == pytest.approx([540.0, 600.0, 660.0])
+    params = tomllib.loads((tmp_path / "paper_fig6_polydyne.toml").read_text(encoding="utf-8"))["parameters"]
+    text = (tmp_path / "paper_fig6_polydyne.csv").read_text(encoding="utf-8")
+    assert params["motion_table"] == text
+    raw = dict(find_scene("paper_fig6").raw)
+    raw["parameters"] = {**raw.get("parameters", {}), **params}
+    scene_from_dict(raw, name="polydyne")
+    # the drive turns it: its lift is the table's curve
+    sim = DriveSimulator({"drive": "speed", "motion_table": text})
+    program = program_from_table_text(text)
+    for k in range(20):
+        sim.do_step(k * 2.5e-3, 2.5e-3, u=0.0, omega_ref=20 * math.pi)
+        o = sim.outputs()
+        assert o["s"] == pytest.approx(program.derivatives(o["theta"])[0], abs=1e-12)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--rpm", "600"], "has no train (k_train, m_end): give its natural frequency with --train-hz"),
+    (["--rpm", "600", "--train-hz", "50", "--law", "simple_harmonic"], "acceleration jumps at T = 0"),
+    (["--rpm", "0", "--train-hz", "50"], "--rpm 0.0: allowed a cam speed in (0, 1e6]"),
+])
+def test_polydyne_refusals(tmp_path, args, message):
+    done = cli("polydyne", "paper_fig6", *args, "--out", str(tmp_path), cwd=tmp_path)
+    assert done.returncode == 2 and message in done.stderr, done.stderr
