@@ -1,4 +1,4 @@
-"""`cam-fmu optimize-law SCENE --band R1:R2 [--zeta Z] [--max-ca X] [--max-cj X|none] [--front ...] [--json] [--out DIR]`.
+"""`cam-fmu optimize-law SCENE --band R1:R2 [--zeta Z] [--max-ca X] [--max-cj X|none] [--front ...] [--json]`.
 
 The split points T1..T6 of the harmonic-trapezoid law that minimise the worst residual vibration over the band of
 r = rise time / the train's natural period, with the peak acceleration Ca <= --max-ca (default 1.15 x the

@@ -19,6 +19,7 @@ rise.
 from __future__ import annotations
 
 import math
+
 import numpy as np
 
 from ..kinematics.motion_law import SHAPE_COS, SHAPE_SIN, MotionLaw
@@ -26,8 +27,8 @@ from ..kinematics.motion_table import TableProgram, program_from_table_text
 from .spectral import check_ratios, check_zeta
 from .train import run_train
 
-__all__ = ["StrokeProgram", "corrected", "jerk_jumps", "check_smooth", "polydyne_program", "polydyne_table", "table_rise",
-           "table_residual"]
+__all__ = ["StrokeProgram", "corrected", "jerk_jumps", "check_smooth", "polydyne_program", "polydyne_table",
+           "table_rise", "table_residual"]
 
 
 def jerk_jumps(law) -> list[tuple[float, float]]:
@@ -76,7 +77,8 @@ class StrokeProgram:
     def __init__(self, rise_law, return_law, lift: float, rise_angle: float, upper_dwell: float,
                  return_angle: float) -> None:
         self.rise_law, self.return_law, self.lift = rise_law, return_law, float(lift)
-        self.rise_angle, self.upper_dwell, self.return_angle = float(rise_angle), float(upper_dwell), float(return_angle)
+        self.rise_angle, self.upper_dwell = float(rise_angle), float(upper_dwell)
+        self.return_angle = float(return_angle)
         self._b2 = self.rise_angle + self.upper_dwell
         self._b3 = self._b2 + self.return_angle
 
@@ -86,7 +88,8 @@ class StrokeProgram:
         rise, ret = th <= b1, (th > b2) & (th <= b3)
         out_r = self.rise_law.evaluate(np.where(rise, th / b1, 0.0))
         out_d = self.return_law.evaluate(np.where(ret, (th - b2) / self.return_angle, 0.0))
-        s = np.where(rise, h * out_r[0], np.where((th > b1) & (th <= b2), h, np.where(ret, h * (1 - out_d[0]), 0.0)))
+        upper = (th > b1) & (th <= b2)
+        s = np.where(rise, h * out_r[0], np.where(upper, h, np.where(ret, h * (1 - out_d[0]), 0.0)))
         derivs = [np.where(rise, h * out_r[k] / b1 ** k, np.where(ret, -h * out_d[k] / self.return_angle ** k, 0.0))
                   for k in (1, 2, 3)]
         return (s, *derivs)
