@@ -1,6 +1,6 @@
 """Shared fixtures and the test layout's markers (tests/README.md).
 
-The tests sit in folders by layer (kinematics, physics, engine, fmu_cs, fmu_me, fmi3, hosts, cli, tools);
+The tests sit in folders by layer (kinematics, vibration, physics, engine, fmu_cs, fmu_me, fmi3, hosts, cli, tools);
 the shared helpers (native_support.py, engine_profile.py, fmi_slave.py) and the C hosts beside this file.
 Markers, set here so that a module cannot forget them (the rules: markers.py):
 - ``external``: every test of ``hosts/`` and of the modules in ``markers.EXTERNAL`` (wine, qemu-user, valgrind,
