@@ -63,6 +63,35 @@ STRUCTS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("double[CAM_NX]", "x_after", "and after"),
         ("CamMode", "mode_before", "the mode before"),
     ),
+    "CamLaw": (   # one dimensionless law (cam_profile.h): its non-empty segments, CAM_SEGMENT_FIELDS doubles each
+        ("double[CAM_LAW_SEGMENTS * CAM_SEGMENT_FIELDS]", "segments", "end, start, F, c, kind, V0, S0 per segment"),
+        ("int", "n_segments", "non-empty segments"),
+    ),
+    "CamTable": (   # a user's motion table after parsing: the knots of its periodic interpolant (cam_profile.h)
+        ("double*", "angle", "rad, strictly increasing, in [0, 2 pi); the one allocation, owned"),
+        ("double*", "lift", "m"),
+        ("double*", "slope", "m/rad: Hermite slopes at the knots"),
+        ("double*", "width", "rad: piece widths, > 0"),
+        ("double*", "c2", "m/rad^2: half s'' at a piece's start (right limit)"),
+        ("double*", "e2", "m/rad^2: half s'' at a piece's end (left limit)"),
+        ("double*", "c3", "m/rad^3: a sixth of s''', constant on a piece"),
+        ("size_t", "n", "knots = pieces"),
+    ),
+    "CamProfile": (   # the cam program (cam_profile.h): two laws and dwells, or a motion table
+        ("CamProgramKind", "kind", "CAM_PROGRAM_LAWS or CAM_PROGRAM_TABLE"),
+        ("CamLaw", "rise", "laws: the rise"), ("CamLaw", "ret", "and the return"),
+        ("double", "lift", "m"),
+        ("double", "b1", "rad: end of rise"), ("double", "b2", "rad: of upper dwell"),
+        ("double", "b3", "rad: of return"),
+        ("double", "kr0", "1/beta of the rise"), ("double", "kr1", "h/beta"), ("double", "kr2", "h/beta^2"),
+        ("double", "kr3", "h/beta^3"),
+        ("double", "kd0", "the same of the return"), ("double", "kd1", ""), ("double", "kd2", ""),
+        ("double", "kd3", ""),
+        ("CamTable", "table", "a table program's interpolant"),
+        ("double*", "points", "rad, ascending in [0, 2 pi): the breakpoints (laws: owned; a table: table.angle)"),
+        ("size_t", "n_points", "breakpoints"),
+        ("double", "feature_angle", "rad: the program's finest angular detail (as the Python programs')"),
+    ),
     "CamError": (   # the one error path (cam_error.h): a status and its message
         ("CamStatus", "status", "CAM_OK or the refusal's CAM_ERR_*"),
         ("char[CAM_MESSAGE_LEN]", "message", "what is wrong and what to change"),
@@ -91,14 +120,24 @@ def event_c_name(name: str) -> str:
     return "CAM_EV_" + "".join(ch if ch.isalnum() else "_" for ch in name).upper()
 
 
-CONSTANTS = {"CAM_NX": NX, "CAM_MESSAGE_LEN": MESSAGE_LEN}
-_CTYPES = {"int": ctypes.c_int, "double": ctypes.c_double, "char": ctypes.c_char, "CamStatus": ctypes.c_int}
+LAW_SEGMENTS, SEGMENT_FIELDS = 7, 7   # segments of one law; doubles per segment
+# The constants the structures' array sizes name, and the enumerations they use (C name, value).
+CONSTANTS = {"CAM_NX": NX, "CAM_MESSAGE_LEN": MESSAGE_LEN, "CAM_LAW_SEGMENTS": LAW_SEGMENTS,
+             "CAM_SEGMENT_FIELDS": SEGMENT_FIELDS}
+ENUMS: dict[str, tuple[tuple[str, int], ...]] = {"CamProgramKind": (("CAM_PROGRAM_LAWS", 0), ("CAM_PROGRAM_TABLE", 1))}
+_CTYPES = {"int": ctypes.c_int, "double": ctypes.c_double, "char": ctypes.c_char, "size_t": ctypes.c_size_t,
+           "double*": ctypes.POINTER(ctypes.c_double), "CamStatus": ctypes.c_int, "CamProgramKind": ctypes.c_int}
 
 
 def _ctype(c_type: str) -> type:
     base, _, count = c_type.partition("[")
     kind = _CTYPES.get(base) or structure(base)
-    return kind * CONSTANTS[count.rstrip("]")] if count else kind
+    if not count:
+        return kind
+    size = 1
+    for factor in count.rstrip("]").split("*"):
+        size *= CONSTANTS[factor.strip()]
+    return kind * size
 
 
 @lru_cache(maxsize=None)

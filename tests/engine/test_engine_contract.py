@@ -18,6 +18,9 @@ def test_the_structures_have_the_libraries_sizes():
     assert lib.cam_event_record_sizeof() == ctypes.sizeof(CamEventRecord)
     assert ctypes.sizeof(CamError) == 4 + contract.MESSAGE_LEN  # an int status, then the message's bytes
     assert CamEventRecord.mode_before.offset + ctypes.sizeof(CamMode) <= ctypes.sizeof(CamEventRecord)
+    sizeof = lib.cam_profile_sizeof
+    sizeof.restype, sizeof.argtypes = ctypes.c_size_t, []
+    assert sizeof() == ctypes.sizeof(contract.structure("CamProfile"))
 
 
 def test_event_names_are_the_hybrid_systems():
