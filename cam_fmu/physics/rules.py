@@ -92,7 +92,7 @@ class _Many(Expr):
         self.args = args
 
 
-class All(_Many):
+class AllOf(_Many):
     """Every one holds."""
 
     def value(self, p: Mapping[str, Any]) -> bool:
@@ -102,7 +102,7 @@ class All(_Many):
         return "(" + " && ".join(x.c() for x in self.args) + ")"
 
 
-class Any_(_Many):
+class AnyOf(_Many):
     """One holds at least."""
 
     def value(self, p: Mapping[str, Any]) -> bool:
@@ -137,10 +137,10 @@ CLEARANCE = Where(Cmp(Num("backlash"), "!="), Num("c"))          # m: c where th
 MASS = Where(Cmp(Num("follower_inertia"), "!="), Num("m"))       # kg: m where the follower's inertia is on
 SPRING = Is("closure", ("spring",))
 FORM = Is("closure", ("form",))
-FOLLOWER_MODEL = Any_(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_FOLLOWER_FORMULATIONS))
+FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_FOLLOWER_FORMULATIONS))
 # The follower moves as a body of its own (docs/model.md 13): closure 'spring' always; 'form' where the groove has a
 # clearance to fly across, the follower a mass to carry its momentum, and the formulation the follower's momentum.
-OWN_FOLLOWER = Any_(SPRING, All(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
+OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
 
 PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
@@ -164,26 +164,26 @@ class Rule:
 
 
 RULES: tuple[Rule, ...] = (
-    Rule(All(Not(SPRING), Any_(Cmp(Num("k_spring"), "!="), Cmp(Num("F_spring0"), "!="))),
+    Rule(AllOf(Not(SPRING), AnyOf(Cmp(Num("k_spring"), "!="), Cmp(Num("F_spring0"), "!="))),
          "parameters 'k_spring' = {k_spring} N/m, 'F_spring0' = {F_spring0} N: a return spring needs closure "
          "'spring' (closure is {closure}); allowed with it: 0"),
-    Rule(All(Is("closure", ("kinematic",)), Cmp(Num("restitution"), "!=")),
+    Rule(AllOf(Is("closure", ("kinematic",)), Cmp(Num("restitution"), "!=")),
          "parameter 'restitution' = {restitution}: closure 'kinematic' " + PLASTIC),
-    Rule(All(FORM, Not(FOLLOWER_MODEL), Cmp(Num("restitution"), "!=")),
+    Rule(AllOf(FORM, Not(FOLLOWER_MODEL), Cmp(Num("restitution"), "!=")),
          "parameter 'restitution' = {restitution}: the paper's formulation (its eqs. 6-8) " + PLASTIC),
-    Rule(All(SPRING, Cmp(CLEARANCE, "!=")),
+    Rule(AllOf(SPRING, Cmp(CLEARANCE, "!=")),
          "parameter 'c' = {c} m: closure 'spring' holds the follower on one flank, there is no clearance; "
          "allowed with it: c = 0"),
-    Rule(All(SPRING, Cmp(Num("follower_inertia"), "==")),
+    Rule(AllOf(SPRING, Cmp(Num("follower_inertia"), "==")),
          f"parameter 'follower_inertia' = false: {BODY}; allowed with it: follower_inertia true (and m > 0)"),
-    Rule(All(SPRING, Not(Cmp(Num("m"), ">"))), f"parameter 'm' = {{m}} kg: {BODY}; allowed with it: m > 0"),
-    Rule(All(SPRING, Not(FOLLOWER_MODEL)),
+    Rule(AllOf(SPRING, Not(Cmp(Num("m"), ">"))), f"parameter 'm' = {{m}} kg: {BODY}; allowed with it: m > 0"),
+    Rule(AllOf(SPRING, Not(FOLLOWER_MODEL)),
          "parameter 'closure' = {closure} with drive 'voltage': the paper's formulation (steps 1-9) has no follower "
          "of its own; allowed with it: formulation 'consistent'"),
-    Rule(All(COMPLIANT, Not(Cmp(Num("J_cam"), ">"))),
+    Rule(AllOf(COMPLIANT, Not(Cmp(Num("J_cam"), ">"))),
          "parameter 'J_cam' = {J_cam} [kg.m2]: a compliant shaft (k_shaft = {k_shaft} N.m/rad) needs the inertia of "
          "its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2"),
-    *(Rule(All(COMPLIANT, Is(name, (choice,))),
+    *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),
 )
