@@ -2,8 +2,8 @@
 
 ``EngineProfile.from_laws(...)`` and ``EngineProfile.from_table(text)`` build the C
 engine's ``CamProfile`` (csrc/include/cam_profile.h); refusals raise ValueError with the
-engine's message. The structures below mirror the header (their size is checked against
-``cam_profile_sizeof``). A test helper: tests/engine/test_engine_profile.py holds the C program against
+engine's message. The structures are engine/contract.py's, from which the header's are generated (their size is
+checked against ``cam_profile_sizeof``). A test helper: tests/engine/test_engine_profile.py holds the C program against
 the Python model with it.
 """
 from __future__ import annotations
@@ -11,30 +11,18 @@ from __future__ import annotations
 import ctypes
 from typing import Sequence
 
+from cam_fmu.engine.contract import SEGMENT_FIELDS, structure
 from cam_fmu.engine.library import load
 from cam_fmu.engine.simulator import CamError
 
 __all__ = ["EngineProfile", "law_segments", "SEGMENT_FIELDS"]
 
-SEGMENT_FIELDS = 7
 _D = ctypes.c_double
 _PD = ctypes.POINTER(_D)
 _SIZE = ctypes.c_size_t
 
 
-class CamLaw(ctypes.Structure):
-    _fields_ = [("segments", _D * (7 * SEGMENT_FIELDS)), ("n_segments", ctypes.c_int)]
-
-
-class CamTable(ctypes.Structure):
-    _fields_ = [(name, _PD) for name in ("angle", "lift", "slope", "width", "c2", "e2", "c3")] + [("n", _SIZE)]
-
-
-class CamProfile(ctypes.Structure):
-    _fields_ = ([("kind", ctypes.c_int), ("rise", CamLaw), ("ret", CamLaw)]
-                + [(name, _D) for name in ("lift", "b1", "b2", "b3", "kr0", "kr1", "kr2", "kr3",
-                                           "kd0", "kd1", "kd2", "kd3")]
-                + [("table", CamTable), ("points", _PD), ("n_points", _SIZE), ("feature_angle", _D)])
+CamLaw, CamTable, CamProfile = (structure(name) for name in ("CamLaw", "CamTable", "CamProfile"))
 
 
 def _lib() -> ctypes.CDLL:

@@ -1,6 +1,7 @@
-"""Generate the engine's variable table in C from the one source, physics/parameters.py and physics/variables.py.
+"""Generate the engine's contract in C from the one source: physics/parameters.py, variables.py, rules.py and
+engine/contract.py.
 
-    python -m cam_fmu.engine.codegen FOLDER     # writes FOLDER/cam_params.h and FOLDER/cam_params.c
+    python -m cam_fmu.engine.codegen FOLDER     # writes FOLDER/cam_params.h/.c and FOLDER/cam_contract.h/.c
 
 Build time only (``build.py`` calls ``write`` into a private folder). The
 header names every parameter, input and output (``CAM_P_R``, ``CAM_I_U``,
@@ -10,7 +11,9 @@ choices of the string parameters (``CAM_CHOICE_SOLVER_RK45``) and the presets'
 split points; the source file holds the specs (kind, unit, default, range
 low/high/low_open/zero_ok, choices, description) as const data. Numbers are
 written with Python's ``repr``, which C's ``strtod`` reads back to the same
-double.
+double. ``cam_contract.h``/``.c`` hold engine/contract.py's tables (state slots, event codes and names, the
+saved state's layout and version, the structures and statuses a binding reads) and physics/rules.py's
+cross-parameter rules as C (``cam_check_rules``, ``cam_own_follower``).
 """
 from __future__ import annotations
 
@@ -19,11 +22,15 @@ import sys
 from pathlib import Path
 
 from ..kinematics.presets import PRESETS
-from ..physics.parameters import MOUNTING_ZERO, PARAMETERS, RIGID_ONLY, ParameterSpec
+from ..physics.parameters import MOUNTING_ZERO, PARAMETERS, ParameterSpec
+from ..physics.rules import OWN_FOLLOWER, RULES, Rule
 from ..physics.variables import EVENT_INDICATORS, INPUT_RANGES, INPUTS, OUTPUTS, STATES
+from . import contract
 
 HEADER = "cam_params.h"
 SOURCE = "cam_params.c"
+CONTRACT_HEADER = "cam_contract.h"
+CONTRACT_SOURCE = "cam_contract.c"
 KINDS = {"real": "CAM_KIND_REAL", "boolean": "CAM_KIND_BOOLEAN", "string": "CAM_KIND_STRING"}
 
 
@@ -121,16 +128,34 @@ def header_text() -> str:
         "const CamVariableSpec *cam_derivative_spec(int index);",
         "/* The split points T1..T6 of preset law ``choice`` (< CAM_N_PRESETS), else NULL. */",
         "const double *cam_preset_T(int choice);", "",
-        "/* The choices that model a rigid drive-train only (physics.parameters.RIGID_ONLY): parameter, choice,",
-        " * why k_shaft > 0 is refused with it, and what to use instead. */",
-        "typedef struct {", "    int param;                  /* CAM_P_* */", "    int choice;                 /* its CAM_CHOICE_* */",
-        "    const char *reason;", "    const char *instead;", "} CamRigidOnly;", "",
-        f"#define CAM_N_RIGID_ONLY {len(RIGID_ONLY)}",
-        "/* The k-th rigid-only choice (k < CAM_N_RIGID_ONLY), else NULL. */",
-        "const CamRigidOnly *cam_rigid_only(int k);", "",
         "#endif", "",
     ]
     return "\n".join(lines)
+
+
+def rule_text(rule: Rule) -> list[str]:
+    """One rule of physics/rules.py in C: its condition, then its message with printf fields."""
+    args, fmt = [], rule.message.replace("%", "%%")
+    for k, name in enumerate(rule.fields()):
+        spec = next(p for p in PARAMETERS if p.name == name)
+        value = f"v[CAM_P_{c_name(name)}]"
+        args.append(f"cam_param_spec(CAM_P_{c_name(name)})->choices[(int){value}]" if spec.choices
+                    else f"cam_num({value}, b[{k}])")
+        fmt = fmt.replace("{" + name + "}", "'%s'" if spec.choices else "%s", 1)
+    call = ", ".join([c_string(fmt)] + args)
+    return [f"    if ({rule.when.c()})", f"        return cam_error(err, CAM_ERR_PARAMETER, {call});"]
+
+
+def rules_text() -> list[str]:
+    """physics/rules.py's RULES and OWN_FOLLOWER as C functions."""
+    width = max(len(r.fields()) for r in RULES)
+    lines = ["int cam_check_rules(const double v[CAM_N_PARAMS], CamError *err)", "{",
+             f"    char b[{width}][CAM_REPR_LEN];"]
+    for rule in RULES:
+        lines += rule_text(rule)
+    return lines + ["    (void)b;", "    return CAM_OK;", "}", "",
+                    "int cam_own_follower(const double v[CAM_N_PARAMS])", "{",
+                    f"    return {OWN_FOLLOWER.c()};", "}", ""]
 
 
 def source_text() -> str:
@@ -171,14 +196,7 @@ def source_text() -> str:
     lines += ["};", "", "static const double PRESET_T[CAM_N_PRESETS][6] = {"]
     for name, T in PRESETS.items():
         lines.append(f"    {{{', '.join(c_double(t) for t in T)}}},  /* {name} */")
-    lines += ["};", "", "static const CamRigidOnly RIGID[CAM_N_RIGID_ONLY] = {"]
-    for (name, choice), (reason, instead) in RIGID_ONLY.items():
-        lines.append(f"    {{CAM_P_{c_name(name)}, CAM_CHOICE_{c_name(name)}_{c_name(choice)}, {c_string(reason)}, "
-                     f"{c_string(instead)}}},")
-    lines += [
-        "};", "",
-        "const CamRigidOnly *cam_rigid_only(int k)",
-        "{", "    return k >= 0 && k < CAM_N_RIGID_ONLY ? &RIGID[k] : NULL;", "}", "",
+    lines += ["};", "",
         "const CamParamSpec *cam_param_spec(int index)",
         "{", "    return index >= 0 && index < CAM_N_PARAMS ? &PARAMS[index] : NULL;", "}", "",
         "const CamVariableSpec *cam_input_spec(int index)",
@@ -195,9 +213,64 @@ def source_text() -> str:
     return "\n".join(lines)
 
 
+def contract_header() -> str:
+    """cam_contract.h: engine/contract.py's tables and physics/rules.py's functions."""
+    slots = contract.state_slots()
+    lines = ["/* Generated by cam_fmu/engine/codegen.py from engine/contract.py and physics/rules.py. Do not edit. */",
+             "#ifndef CAM_CONTRACT_H", "#define CAM_CONTRACT_H", "", "#include <stddef.h>", "",
+             f'#include "{HEADER}"', "",
+             "/* Slots of the continuous state x; a rigid drive carries the first CAM_NX_RIGID. */", "enum {"]
+    lines += [f"    CAM_{name} = {k},   /* Model Exchange's {state} */" for k, (name, state) in enumerate(contract.X_SLOTS)]
+    lines += [f"    CAM_NX = {contract.NX}, CAM_NX_RIGID = {contract.NX_RIGID}", "};", "",
+              "/* Event codes (physics/formulations/consistent.py EVENT_NAMES, in order; names: cam_event_name). */",
+              "enum {"]
+    lines += [f"    {contract.event_c_name(name)} = {k}," for k, name in enumerate(contract.event_names())]
+    lines += [f"    CAM_N_EVENTS = {len(contract.event_names())},",
+              f"    CAM_MAX_EVENTS = {contract.MAX_EVENTS}   /* active in one mode at most */", "};", "",
+              *(f"#define {name} {value}" for name, value in contract.CONSTANTS.items() if name != "CAM_NX"), ""]
+    for enum, members in contract.ENUMS.items():
+        lines += ["typedef enum { " + ", ".join(f"{name} = {value}" for name, value in members) + f" }} {enum};"]
+    lines += ["", "typedef enum {"]
+    lines += [f"    {name} = {value},   /* {meaning}{f' (Python: {py})' if py else ''} */"
+              for name, value, py, meaning in contract.STATUSES]
+    lines += ["} CamStatus;", ""]
+    for name, fields in contract.STRUCTS.items():
+        lines.append("typedef struct {")
+        for c_type, field, comment in fields:
+            base, _, count = c_type.partition("[")
+            star = "*" if base.endswith("*") else ""
+            note = f"   /* {comment} */" if comment else ""
+            lines.append(f"    {base.rstrip('*')} {star}{field}{'[' + count if count else ''};{note}")
+        lines += [f"}} {name};", ""]
+    lines += ["/* The saved state: CAM_STATE_LEN doubles, entry CAM_S_<name> from index CAM_S_<name> on. */", "enum {"]
+    lines += [f"    CAM_S_{name} = {index}," for name, index in slots.items() if name != "END"]
+    lines += [f"    CAM_S_END = {slots['END']}", "};",
+              f"#define CAM_STATE_VERSION {contract.STATE_VERSION!r}   /* the layout's format version */",
+              f"#define CAM_STATE_LEN {contract.STATE_LEN}   /* CAM_S_END and room for entries a later version adds */",
+              "", "/* The name of event code `code` (\"stop\"), or NULL. */", "const char *cam_event_name(int code);",
+              "/* physics/rules.py RULES, message for message: CAM_OK, or CAM_ERR_PARAMETER with the first broken "
+              "rule's", " * message; v: CamParams.v. And rules.OWN_FOLLOWER: does the follower move as a body of its "
+              "own (1/0)? */",
+              "int cam_check_rules(const double v[CAM_N_PARAMS], CamError *err);",
+              "int cam_own_follower(const double v[CAM_N_PARAMS]);", "", "#endif", ""]
+    return "\n".join(lines)
+
+
+def contract_source() -> str:
+    """cam_contract.c: the event names and the rules."""
+    names = ", ".join(c_string(n) for n in contract.event_names())
+    lines = ["/* Generated by cam_fmu/engine/codegen.py. Do not edit. */", "#include <stddef.h>", "",
+             '#include "cam_error.h"', "", f"static const char *const EVENT_NAMES[CAM_N_EVENTS] = {{{names}}};", "",
+             "const char *cam_event_name(int code)", "{",
+             "    return code >= 0 && code < CAM_N_EVENTS ? EVENT_NAMES[code] : NULL;", "}", ""]
+    return "\n".join(lines + rules_text())
+
+
 def generated() -> dict[str, str]:
     """File name -> text of every generated file."""
-    return {HEADER: header_text(), SOURCE: source_text()}
+    contract.check_states()
+    return {HEADER: header_text(), SOURCE: source_text(), CONTRACT_HEADER: contract_header(),
+            CONTRACT_SOURCE: contract_source()}
 
 
 def write_files(folder: Path, files: dict[str, str]) -> list[Path]:

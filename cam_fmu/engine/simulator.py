@@ -16,44 +16,28 @@ from typing import Any, Mapping, Sequence
 from ..errors import SimulationError, StepRejected
 from ..physics.parameters import BY_NAME, ParameterError
 from ..physics.variables import INPUT_STARTS, OUTPUT_NAMES
+from . import contract
 from .library import load
 
 __all__ = ["DriveSimulator", "run_scene"]
 
 N_OUTPUTS = len(OUTPUT_NAMES)
-MESSAGE_LEN = 1024
-NX, NX_RIGID = 5, 3  # cam_model.h CAM_NX, CAM_NX_RIGID: the state slots (theta, omega, i, twist, omega_m)
-# Slots of the engine's state array (cam_drive.h, CAM_S_*).
-(S_VERSION, S_FORMULATION, S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF, S_H_NEXT, S_STEPS_TAKEN, S_X) = range(9)
-S_STUCK = S_X + 5  # CAM_NX slots
-S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE, S_FORM_U, S_HAVE_BUDGET = range(S_STUCK + 1, S_STUCK + 7)
-S_BUDGET = S_HAVE_BUDGET + 1  # work_in, work_abs, theta, i, e_mech0, e_mag0
-S_SPEED = S_BUDGET + 6 + 11  # after the paper scheme's 11: the speed drive's and a free follower's 10 (CAM_S_SPEED)
-BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")
-STATE_VERSION = 2.0  # cam_drive.h CAM_STATE_VERSION
-
-
-from ..physics.formulations.consistent import EVENT_NAMES  # noqa: E402  (cam_model.h CAM_EV_*, in order)
-
-
-class CamMode(ctypes.Structure):
-    """cam_model.h CamMode."""
-
-    _fields_ = [("stuck", ctypes.c_int), ("direction", ctypes.c_double), ("contact", ctypes.c_int),
-                ("s_free", ctypes.c_double), ("side", ctypes.c_double)]
-
-
-class CamEventRecord(ctypes.Structure):
-    """cam_drive.h CamEventRecord: one transition of the consistent formulation."""
-
-    _fields_ = [("code", ctypes.c_int), ("time", ctypes.c_double), ("x_before", ctypes.c_double * NX),
-                ("x_after", ctypes.c_double * NX), ("mode_before", CamMode)]
-
-
-class CamError(ctypes.Structure):
-    """The engine's error: its status (0 ok, 1 parameter, 2 simulation, 3 step rejected, 4 memory) and message."""
-
-    _fields_ = [("status", ctypes.c_int), ("message", ctypes.c_char * MESSAGE_LEN)]
+NX, NX_RIGID = contract.NX, contract.NX_RIGID  # the state slots (theta, omega, i, twist, omega_m)
+SLOTS = contract.state_slots()  # the saved state's entries (CAM_S_*), from the one layout
+S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF = SLOTS["TIME"], SLOTS["U"], SLOTS["OMEGA_REF"], SLOTS["OMEGA_DOT_REF"]
+S_H_NEXT, S_STEPS_TAKEN, S_X, S_STUCK = SLOTS["H_NEXT"], SLOTS["STEPS_TAKEN"], SLOTS["X"], SLOTS["STUCK"]
+S_DIRECTION, S_CONTACT, S_S_FREE, S_SIDE = SLOTS["DIRECTION"], SLOTS["CONTACT"], SLOTS["S_FREE"], SLOTS["SIDE"]
+S_FORM_U, S_HAVE_BUDGET, S_BUDGET, S_SPEED = SLOTS["FORM_U"], SLOTS["HAVE_BUDGET"], SLOTS["WORK_IN"], SLOTS["SPEED"]
+N_SPEED = dict(contract.STATE_LAYOUT)["SPEED"]  # the speed drive's and a free follower's entries
+BUDGET_KEYS = ("work_in", "work_abs", "theta", "i", "e_mech0", "e_mag0")  # WORK_IN .. E_MAG0
+STATE_VERSION = contract.STATE_VERSION
+EVENT_NAMES = contract.event_names()  # code k's name (cam_contract.h CAM_EV_*)
+CamMode = contract.structure("CamMode")
+CamEventRecord = contract.structure("CamEventRecord")
+CamError = contract.structure("CamError")
+_RAISES = {"ParameterError": ParameterError, "SimulationError": SimulationError, "StepRejected": StepRejected,
+           "MemoryError": MemoryError}
+EXCEPTIONS = {value: _RAISES[py] for _, value, py, _ in contract.STATUSES if py}  # status -> what Python raises
 
 
 _P = ctypes.c_void_p
@@ -101,15 +85,8 @@ def engine() -> ctypes.CDLL:
 
 
 def raise_for(error: CamError) -> None:
-    """The exception of the engine's error status, with its message."""
-    message = error.message.decode("utf-8", "replace")
-    if error.status == 1:
-        raise ParameterError(message)
-    if error.status == 3:
-        raise StepRejected(message)
-    if error.status == 4:
-        raise MemoryError(message)
-    raise SimulationError(message)
+    """The exception of the engine's error status (contract.STATUSES), with its message."""
+    raise EXCEPTIONS.get(error.status, SimulationError)(error.message.decode("utf-8", "replace"))
 
 
 def _set_parameter(lib: ctypes.CDLL, params: ctypes.Array, name: str, value: Any, err: CamError) -> None:
@@ -260,7 +237,8 @@ class DriveSimulator:
         if energy is not None:
             s[S_BUDGET:S_BUDGET + 6] = array("d", [float(energy[key]) for key in BUDGET_KEYS])
         if "engine" in state:  # a follower of its own (closure 'spring'): its s, v, contact, touch-downs, guard
-            s[S_SPEED:S_SPEED + 10] = array("d", [float(x) for x in state["engine"][S_SPEED:S_SPEED + 10]])
+            speed = state["engine"][S_SPEED:S_SPEED + N_SPEED]
+            s[S_SPEED:S_SPEED + N_SPEED] = array("d", [float(x) for x in speed])
         self.set_state_array(s)
 
     def events(self) -> list[dict[str, Any]]:

@@ -3,12 +3,12 @@
 
 Build time only. A model (``CModel``) is its hand-written C (the model table of ``csrc/fmi/model.h`` and
 what it calls), a generator of its variable table in C, its variable rows (``model_description``) and its
-default experiment; the FMI glue (``csrc/fmi``: glue.c, glue_me.c and the version's files) is the same for
+default experiment; the FMI glue (``csrc/fmi``: glue.c and the version's files) is the same for
 every model. Steps:
 
 1. The GUID: a hash of the variable rows and of every source and generated file (``digest``).
 2. ``sources/``: the model's C, its generated tables, the FMI glue of the version (FMI 2.0: ``fmi2.c`` and
-   ``fmi2_me.c``; FMI 3.0: ``fmi3_cs.c``; both over ``glue.c`` and ``glue_me.c``), the official headers of
+   ``fmi2_me.c``, Model Exchange whole; FMI 3.0: ``fmi3_cs.c``; both over ``glue.c``), the official headers of
    the version (vendored, ``csrc/fmi/headers``) and ``guid.h``. They compile as they are
    (``cc -shared -fPIC sources/*.c -lm``); FMI 2.0 lists them in the model description's
    ``<SourceFiles>``, FMI 3.0 in ``sources/buildDescription.xml``.
@@ -38,7 +38,7 @@ CONTROL_CSRC = PACKAGE_DIR / "control" / "csrc"
 # The FMI glue of each version, for every model: the glue both versions share (with the saved states'
 # checksum) and the version's own files (FMI 2.0: common and co-simulation, Model Exchange; FMI 3.0:
 # co-simulation); its official headers (vendored: engine_build.fmi_headers).
-SHARED_GLUE = (FMI / "glue.c", FMI / "glue_me.c", FMI / "checksum.c")
+SHARED_GLUE = (FMI / "glue.c", FMI / "checksum.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
         3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
 GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h", FMI / "checksum.h")

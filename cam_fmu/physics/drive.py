@@ -19,8 +19,8 @@ from typing import Any, Mapping
 from ..kinematics.cam_program import CamProgram, ProgramBase
 from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
-from .parameters import (FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError,
-                         law_spec, mounting_component, resolve)
+from .parameters import ParameterError, law_spec, mounting_component, resolve
+from .rules import OWN_FOLLOWER, check_rules
 
 
 def sign(x: float) -> float:
@@ -68,18 +68,6 @@ def check_self_locking(program: ProgramBase, mu: float, r_b: float) -> None:
             f"(lower mu below {1.0 / math.tan(alpha):.4g} or raise r_b)")
 
 
-def check_compliant(p: Mapping[str, Any], J_0: float) -> None:
-    """Raise ParameterError where a compliant shaft (k_shaft > 0) cannot be modelled (docs/model.md 12)."""
-    k = f"parameter 'k_shaft' = {p['k_shaft']!r} N.m/rad"
-    if not J_0 > 0.0:
-        raise ParameterError(f"parameter 'J_cam' = {p['J_cam']!r} [kg.m2]: a compliant shaft (k_shaft = "
-                             f"{p['k_shaft']!r} N.m/rad) needs the inertia of its cam side; allowed with k_shaft > 0: "
-                             "J_cam in (0, 100] kg.m2")
-    for (name, choice), (reason, instead) in RIGID_ONLY.items():
-        if p[name] == choice:
-            raise ParameterError(f"{k}: {reason}; allowed with {name} {choice!r}: k_shaft = 0{instead}")
-
-
 def effective_clearance(p: Mapping[str, Any]) -> float:
     """The clearance c [m] the model uses: c where the backlash effect is on, else 0 (docs/model.md 6.2)."""
     return p["c"] if p["backlash"] else 0.0
@@ -95,47 +83,8 @@ def own_follower(p: Mapping[str, Any]) -> bool:
     groove has a clearance c > 0 to fly across, the follower a mass m > 0 to carry its momentum across it (without
     one no force moves it: gravity and friction scale with m), and the formulation has the follower's momentum (the
     paper's voltage-drive formulation models the clearance by its eqs. 6-8). Else 'form' is the rule of closure
-    'kinematic', bit for bit. model.c's free_follower is this rule (tests/engine/test_engine_model.py)."""
-    if p["closure"] == "spring":
-        return True
-    return (p["closure"] == "form" and effective_clearance(p) > 0.0 and follower_mass(p) > 0.0
-            and (p["drive"] in FOLLOWER_DRIVES or p["formulation"] in VOLTAGE_FOLLOWER_FORMULATIONS))
-
-
-def check_closure(p: Mapping[str, Any]) -> None:
-    """Raise ParameterError where the closure's parameters contradict each other (docs/model.md 13)."""
-    closure = p["closure"]
-    c = effective_clearance(p)
-    if closure != "spring" and (p["k_spring"] != 0.0 or p["F_spring0"] != 0.0):
-        raise ParameterError(f"parameters 'k_spring' = {p['k_spring']!r} N/m, 'F_spring0' = {p['F_spring0']!r} N: "
-                             f"a return spring needs closure 'spring' (closure is {closure!r}); allowed with it: 0")
-    paper = p["drive"] not in FOLLOWER_DRIVES and p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS
-    if closure == "kinematic" or (closure == "form" and paper):
-        if p["restitution"] != 0.0:
-            rule = "closure 'kinematic'" if closure == "kinematic" else "the paper's formulation (its eqs. 6-8)"
-            raise ParameterError(f"parameter 'restitution' = {p['restitution']!r}: {rule} has plastic impacts only "
-                                 "(docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
-                                 "consistent formulation)")
-        return
-    if closure == "spring" and c != 0.0:
-        raise ParameterError(f"parameter 'c' = {c!r} m: closure 'spring' holds the follower on one flank, there is "
-                             "no clearance; allowed with it: c = 0")
-    if closure == "spring" and not p["follower_inertia"]:
-        raise ParameterError("parameter 'follower_inertia' = false: closure 'spring' moves the follower as a body of "
-                             "its own, which needs its mass; allowed with it: follower_inertia true (and m > 0)")
-    if closure == "spring" and not p["m"] > 0.0:
-        raise ParameterError(f"parameter 'm' = {p['m']!r} kg: closure 'spring' moves the follower as a body of its "
-                             "own, which needs its mass; allowed with it: m > 0")
-    if not own_follower(p):
-        return  # a groove without clearance, or a follower without mass: the kinematic rule's motion exactly
-    if p["drive"] in FOLLOWER_DRIVES:
-        return
-    # The voltage drive (docs/model.md 13.6): closures 'spring' and 'form', consistent formulation, with guide
-    # friction and a rigid or compliant shaft, from rest or turning; each other case refused with its reason.
-    voltage = f"parameter 'closure' = {closure!r} with drive 'voltage'"
-    if p["formulation"] not in VOLTAGE_FOLLOWER_FORMULATIONS:
-        raise ParameterError(f"{voltage}: the paper's formulation (steps 1-9) has no follower of its own; allowed "
-                             "with it: formulation 'consistent'")
+    'kinematic', bit for bit. The rule is rules.OWN_FOLLOWER, from which model.c's free_follower is generated."""
+    return bool(OWN_FOLLOWER.value(p))
 
 
 def build_program(p: Mapping[str, Any]) -> ProgramBase:
@@ -223,10 +172,8 @@ class DriveModel:
         # The follower as a body of its own (docs/model.md section 13): 'kinematic' is the paper's rule.
         self.closure = p["closure"]
         self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
-        check_closure(p)
+        check_rules(p)  # the cross-parameter rules (rules.RULES; C's are generated from the same table)
         self.free_follower = own_follower(p)
-        if self.compliant:
-            check_compliant(p, self.J_0)
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
 

@@ -9,23 +9,18 @@ import random
 
 import pytest
 
-from cam_fmu.engine.simulator import CamError, _set_parameter, engine, raise_for
+from cam_fmu.engine.simulator import NX, CamError, CamMode, _set_parameter, engine, raise_for
 from cam_fmu.physics.drive import DriveModel
 from cam_fmu.physics.formulations.consistent import HybridDrive, Mode
 from cam_fmu.physics.variables import OUTPUT_NAMES
 
-D3 = ctypes.c_double * 5  # CAM_NX: the rigid slots and a compliant shaft's two
+D3 = ctypes.c_double * NX  # CAM_NX: the rigid slots and a compliant shaft's two
 NO = len(OUTPUT_NAMES)
 DRIVES = [{}, {"c": 5e-4}, {"L": 1e-3}, {"gamma": 1.5707963267948966, "beta": 3.141592653589793, "mu": 0.05},
           {"c": 1e-3, "L": 1e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0, "M_f": 0.0},
           {"k_shaft": 40.0, "d_shaft": 0.01, "J_cam": 2e-5},
           {"k_shaft": 5e3, "J_cam": 1e-4, "L": 1e-3, "c": 5e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0}]
 EVENTS = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
-
-
-class CamMode(ctypes.Structure):
-    _fields_ = [("stuck", ctypes.c_int), ("direction", ctypes.c_double), ("contact", ctypes.c_int),
-                ("s_free", ctypes.c_double), ("side", ctypes.c_double)]
 
 
 class CModel:

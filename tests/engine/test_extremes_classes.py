@@ -13,6 +13,10 @@ import shutil
 
 import pytest
 
+from cam_fmu.engine.contract import STATE_LEN, state_slots
+
+SLOTS = state_slots()  # the saved state's entries (engine/contract.py)
+
 
 def _run(params, u=3.5, stop=0.5, h=1e-3, omega_ref=1.0, t0=0.0):
     from cam_fmu.fmu.engine import DriveSimulator
@@ -274,7 +278,7 @@ def scenario_fmi(fmu):
     state = m.fmu.getFMUstate()
     blob = bytes(m.fmu.serializeFMUstate(state))
     before = m.outputs()
-    omega_at = len(blob) - 4 - 8 * 48 + 8 * 9
+    omega_at = len(blob) - 4 - 8 * STATE_LEN + 8 * (SLOTS["X"] + 1)  # the drive's state, then the CRC-32
     assert struct.unpack_from("<d", blob, omega_at)[0] == before[0]  # the layout read right: omega is there
     results = {}
     for case in ("nan", "short", "version"):
@@ -334,7 +338,7 @@ def test_class9_state_blobs_are_validated_before_anything_is_restored(fmi_result
     assert fmi_result["blob"] == {"nan": 3, "short": 3, "version": 3}
     texts = " ".join(fmi_result["blob_messages"])
     assert "not finite" in texts and "truncated" in texts and "format" in texts
-    assert fmi_result["blob_outputs_kept"] and fmi_result["blob_size"] > 8 * 48
+    assert fmi_result["blob_outputs_kept"] and fmi_result["blob_size"] > 8 * STATE_LEN
 
 
 def test_class10_messages_name_the_cause(fmi_result):

@@ -1,5 +1,5 @@
 /* The glue both FMI versions share (glue.h): state machine, logging, variable access, steps and saved
- * states over the model table (model.h); Model Exchange's calls are glue_me.c's. No FMI header, no model's
+ * states over the model table (model.h); Model Exchange is fmi2_me.c. No FMI header, no model's
  * header, no globals. */
 #include <math.h>
 #include <stdarg.h>

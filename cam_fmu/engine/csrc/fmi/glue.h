@@ -1,7 +1,8 @@
 /* What the FMI 2.0 and FMI 3.0 glues share, FMI-version neutral and model neutral: the instance's state
  * machine, logging with its message rules, the checks of value references, the variable access, the
- * communication step, Model Exchange's calls (glue_me.c) and the saved states, over the model table of
- * model.h (cam.fmu: model_cam.c; pi_speed.fmu: model_pi.c). fmi2.c, fmi2_me.c and fmi3_cs.c are thin over it.
+ * communication step and the saved states, over the model table of
+ * model.h (cam.fmu: model_cam.c; pi_speed.fmu: model_pi.c). fmi2.c and fmi3_cs.c are thin over it; fmi2_me.c
+ * is Model Exchange, whole.
  *
  * Statuses are the FMI numbering both versions share: OK 0, Warning 1, Discard 2, Error 3, Fatal 4.
  * Every call name in a message is the version's own ("fmi2GetReal", "fmi3GetFloat64"): the glue passes it.
@@ -104,18 +105,6 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
  * not a serialised state of this model. */
 int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call);
 
-/* Model Exchange (glue_me.c): each call checks the instance is one, in one of states, and attached. */
-int glue_me_allowed(Glue *g, int states, int attached, const char *call);
-int glue_enter_event_mode(Glue *g, const char *call);
-/* One event update; *needed: call again; *values_changed: the states jumped. */
-int glue_new_discrete_states(Glue *g, int *needed, int *values_changed, const char *call);
-int glue_enter_continuous_time_mode(Glue *g, const char *call);
-/* The guards at a completed integrator step; *enter_event: the host must enter event mode; on error
- * *terminate is set and the instance is in the error state. */
-int glue_completed_integrator_step(Glue *g, int *enter_event, int *terminate, const char *call);
-int glue_set_time(Glue *g, double time, const char *call);
-int glue_set_continuous_states(Glue *g, const double x[], size_t nx, const char *call);
-/* The read calls: values zeroed first; which: states, derivatives, event indicators or nominals. */
-int glue_me_read(Glue *g, ModelRead which, double values[], size_t n, const char *call);
+/* Model Exchange's calls and their state machine are fmi2_me.c's (FMI 2.0 only). */
 
 #endif

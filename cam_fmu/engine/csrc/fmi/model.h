@@ -23,7 +23,7 @@
 typedef enum { MODEL_OK = 0, MODEL_DISCARD = 1, MODEL_ERROR = 2 } ModelStatus;
 typedef enum { MODEL_REAL = 0, MODEL_BOOLEAN = 1, MODEL_STRING = 2 } ModelKind;
 
-/* Model Exchange's reads (glue_me_read). */
+/* Model Exchange's reads (fmi2_me.c). */
 typedef enum { MODEL_READ_STATES, MODEL_READ_DERIVATIVES, MODEL_READ_INDICATORS, MODEL_READ_NOMINALS } ModelRead;
 
 typedef struct {

@@ -102,7 +102,15 @@ static int initialize(void *m, double start_time)
 
 static int initialized(const void *m) { return cam_instance_initialized(((const CamFmuModel *)m)->drive); }
 
-static int step(void *m, double t, double h) { return status_of(cam_instance_step(((CamFmuModel *)m)->drive, t, h)); }
+/* The drive's step itself (cam_drive.h), so fmi2DoStep -> glue_do_step -> step -> cam_drive_do_step: the glue's
+ * state machine steps only an initialised instance (cam_instance_step is this, for C hosts without the glue). */
+static int step(void *m, double t, double h)
+{
+    CamInstance *c = ((CamFmuModel *)m)->drive;
+    const double *in = cam_instance_inputs(c);
+    return status_of(cam_drive_do_step(cam_instance_drive(c), t, h, in[CAM_I_U], in[CAM_I_OMEGA_REF],
+                                       in[CAM_I_OMEGA_DOT_REF], cam_instance_error(c)));
+}
 
 static double time_of(const void *m) { return cam_instance_time(((const CamFmuModel *)m)->drive); }
 

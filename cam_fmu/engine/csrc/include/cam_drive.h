@@ -93,15 +93,7 @@ typedef struct {
     double fsal_u;
 } CamSolverState;
 
-/* One transition of the consistent formulation, as the event log keeps it (for diagnostics and tests:
- * the impacts' momentum, where contacts were found). Not part of the saved state. */
-typedef struct {
-    int code;                   /* CAM_EV_* */
-    double time;                /* s */
-    double x_before[CAM_NX], x_after[CAM_NX];
-    CamMode mode_before;
-} CamEventRecord;
-
+/* CamEventRecord, one transition as the event log keeps it, is generated (cam_contract.h). */
 #define CAM_EVENT_LOG 256       /* the last this many transitions are kept */
 #define CAM_STEP_EVENTS 512     /* bytes of a step's line of follower events (the rest is counted, not written) */
 
@@ -167,16 +159,8 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
 /* The current outputs (computed once per state). */
 const double *cam_drive_outputs(CamDrive *d);
 
-/* The whole state as doubles (CAM_STATE_LEN of them): versioned layout, the CAM_S_* slots. */
-enum { CAM_S_VERSION = 0, CAM_S_FORMULATION, CAM_S_TIME, CAM_S_U, CAM_S_OMEGA_REF, CAM_S_OMEGA_DOT_REF,
-       CAM_S_H_NEXT, CAM_S_STEPS_TAKEN, CAM_S_X /* CAM_NX slots */, CAM_S_STUCK = CAM_S_X + CAM_NX, CAM_S_DIRECTION,
-       CAM_S_CONTACT, CAM_S_S_FREE, CAM_S_SIDE, CAM_S_FORM_U, CAM_S_HAVE_BUDGET,
-       CAM_S_WORK_IN, CAM_S_WORK_ABS, CAM_S_BUDGET_THETA, CAM_S_BUDGET_I, CAM_S_E_MECH0, CAM_S_E_MAG0,
-       CAM_S_PAPER /* 11 slots: CamPaperState in order */, CAM_S_SPEED = CAM_S_PAPER + 11 /* 10 slots */,
-       CAM_S_END = CAM_S_SPEED + 10 };
-#define CAM_STATE_VERSION 2.0   /* 2: the compliant shaft's two slots in x */
-#define CAM_STATE_LEN 48          /* CAM_S_END rounded up: room for slots a later version adds */
-typedef char cam_state_len_covers_the_layout[CAM_S_END <= CAM_STATE_LEN ? 1 : -1];
+/* The whole state as doubles (CAM_STATE_LEN of them): the layout CAM_S_* and its version CAM_STATE_VERSION are
+ * generated from engine/contract.py STATE_LAYOUT (cam_contract.h). */
 /* CAM_STATE_LEN, for bindings (engine/simulator.py reads it rather than repeating the number). */
 size_t cam_state_len(void);
 void cam_drive_get_state(const CamDrive *d, double state[CAM_STATE_LEN]);

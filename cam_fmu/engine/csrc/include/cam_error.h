@@ -14,20 +14,7 @@
 
 #include "cam_text.h"
 
-typedef enum {
-    CAM_OK = 0,
-    CAM_ERR_PARAMETER = 1,   /* a parameter outside its range (Python: ParameterError) */
-    CAM_ERR_SIMULATION = 2,  /* the run cannot go on correctly (SimulationError; FMI: fmi2Error) */
-    CAM_ERR_REJECTED = 3,    /* this step cannot be done at this size, state as before (StepRejected; fmi2Discard) */
-    CAM_ERR_MEMORY = 4       /* an allocation failed */
-} CamStatus;
-
-#define CAM_MESSAGE_LEN 1024
-
-typedef struct {
-    CamStatus status;
-    char message[CAM_MESSAGE_LEN];
-} CamError;
+#include "cam_contract.h"   /* generated: CamStatus (CAM_OK, CAM_ERR_*), CAM_MESSAGE_LEN, CamError */
 
 /* Set err (status and printf-style message; nothing when err is NULL) and return the status. */
 int cam_error(CamError *err, CamStatus status, const char *fmt, ...)

@@ -17,8 +17,6 @@
 
 #include "cam_error.h"
 
-#define CAM_LAW_SEGMENTS 7          /* segments of one law */
-#define CAM_SEGMENT_FIELDS 7        /* end, start, F, c, kind, V0, S0 per non-empty segment */
 #define CAM_SHAPE_CONST 0           /* A = c */
 #define CAM_SHAPE_SIN 1             /* A = c sin(x) */
 #define CAM_SHAPE_COS 2             /* A = c cos(x) */
@@ -31,48 +29,16 @@
 #define CAM_TABLE_MAX_NUMBER 100        /* characters of one number in a table, at most */
 #define CAM_TABLE_MIN_SPACING_DEG 1e-6  /* deg: rows closer than this are refused (the third derivative would overflow) */
 
-typedef enum { CAM_PROGRAM_LAWS = 0, CAM_PROGRAM_TABLE = 1 } CamProgramKind;
-
-/* One dimensionless law: its non-empty segments, CAM_SEGMENT_FIELDS doubles each. */
-typedef struct {
-    double segments[CAM_LAW_SEGMENTS * CAM_SEGMENT_FIELDS];
-    int n_segments;
-} CamLaw;
-
-/* A user's motion table after parsing: knots of the periodic interpolant (SI units).
- * Piece i runs from knot i to knot i + 1 (the last piece to knot 0 + 2 pi). With
- * u = theta - angle[i] in [0, width[i]] and v = u - width[i]:
+/* CAM_LAW_SEGMENTS (segments of one law), CAM_SEGMENT_FIELDS (end, start, F, c, kind, V0, S0 per non-empty
+ * segment), CamProgramKind and the structures CamLaw, CamTable and CamProfile are generated from
+ * engine/contract.py (cam_contract.h, through cam_error.h): Python's ctypes structures come from the same table.
+ * A table's piece i runs from knot i to knot i + 1 (the last to knot 0 + 2 pi); with u = theta - angle[i] in
+ * [0, width[i]] and v = u - width[i]:
  *   s = lift[i]   + u (slope[i]   + u (c2[i] + u c3[i]))     for u <= width[i] / 2,
  *   s = lift[i+1] + v (slope[i+1] + v (e2[i] + v c3[i]))     beyond (exact at both knots),
- * s clamped to the range of the piece's two lifts. All arrays are one allocation that
- * starts at angle and is owned by the table. */
-typedef struct {
-    double *angle;      /* rad, strictly increasing, in [0, 2 pi) */
-    double *lift;       /* m */
-    double *slope;      /* m/rad: Hermite slopes at the knots */
-    double *width;      /* rad: piece widths, > 0 */
-    double *c2;         /* m/rad^2: s''/2 at a piece's start (right limit) */
-    double *e2;         /* m/rad^2: s''/2 at a piece's end (left limit) */
-    double *c3;         /* m/rad^3: s'''/6, constant on a piece */
-    size_t n;           /* knots = pieces */
-} CamTable;
-
-typedef struct {
-    CamProgramKind kind;
-    /* laws */
-    CamLaw rise, ret;
-    double lift;                    /* m */
-    double b1, b2, b3;              /* rad: end of rise, of upper dwell, of return */
-    double kr0, kr1, kr2, kr3;      /* 1/beta, h/beta, h/beta^2, h/beta^3 of the rise */
-    double kd0, kd1, kd2, kd3;      /* the same of the return */
-    /* table */
-    CamTable table;
-    /* breakpoints of the program (rad, each in [0, 2 pi)), ascending: CamProgram.breakpoints()
-     * for laws (an allocation of its own), the knots for a table (the array table.angle) */
-    double *points;
-    size_t n_points;
-    double feature_angle;           /* rad: the program's finest angular detail (as the Python programs') */
-} CamProfile;
+ * s clamped to the range of the piece's two lifts; its arrays are one allocation that starts at angle. A
+ * program's breakpoints (rad, each in [0, 2 pi), ascending) are CamProgram.breakpoints() for laws (an allocation
+ * of its own), the knots for a table (the array table.angle). */
 
 /* The law with split points T[0..5] = T1..T6 (checked: finite, in [0, 1], ordered,
  * T3 > 0, T4 < 1); ``name`` names the parameters in messages ("rise": "rise law: ...

@@ -11,8 +11,9 @@ int cam_table_init(CamTable *t, const char *text, size_t text_len, CamError *err
 /* Free the table's one allocation; safe on a zeroed table. */
 void cam_table_free(CamTable *t);
 
-/* s, s', s'', s''' of the table's interpolant at theta [rad] into d[0..3] (see CamTable);
+/* s, s', s'', s''' of the table's interpolant at th [rad], reduced to [0, 2 pi) by the caller (profile.c's
+ * cam_profile_eval_counted), into d[0..3] (see CamTable);
  * adds the binary search's knot comparisons to *comparisons when not NULL. */
-void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *comparisons);
+void cam_table_eval(const CamTable *t, double th, double d[4], size_t *comparisons);
 
 #endif

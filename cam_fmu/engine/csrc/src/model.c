@@ -300,72 +300,6 @@ static int build_program(CamModel *model, CamError *err)
     return CAM_OK;
 }
 
-/* What a compliant shaft needs (physics/drive.py's check_compliant, text for text): a cam side with inertia,
- * and none of the rigid-only choices (the generated table of physics.parameters.RIGID_ONLY). */
-static int check_compliant(const CamModel *model, CamError *err)
-{
-    char k[40], j[40];
-    const double *v = model->params.v;
-    int n;
-    cam_num(model->k_shaft, k);
-    if (!(model->J_0 > 0.0))
-        return cam_error(err, CAM_ERR_PARAMETER,
-                         "parameter 'J_cam' = %s [kg.m2]: a compliant shaft (k_shaft = %s N.m/rad) needs the inertia "
-                         "of its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2",
-                         cam_num(v[CAM_P_J_CAM], j), k);
-    for (n = 0; n < CAM_N_RIGID_ONLY; n++) {
-        const CamRigidOnly *r = cam_rigid_only(n);
-        const CamParamSpec *spec = cam_param_spec(r->param);
-        if ((int)v[r->param] == r->choice)
-            return cam_error(err, CAM_ERR_PARAMETER,
-                             "parameter 'k_shaft' = %s N.m/rad: %s; allowed with %s '%s': k_shaft = 0%s", k,
-                             r->reason, spec->name, spec->choices[r->choice], r->instead);
-    }
-    return CAM_OK;
-}
-
-/* physics.drive.check_closure: the closure's parameters against each other and the drive (docs/model.md 13). */
-static int check_closure(const CamModel *model, CamError *err)
-{
-    char a[40], b[40];
-    const double *v = model->params.v;
-    const char *closure = cam_param_spec(CAM_P_CLOSURE)->choices[model->closure];
-    int paper = model->formulation == CAM_FORM_PAPER;
-    if (model->closure != CAM_CHOICE_CLOSURE_SPRING && (v[CAM_P_K_SPRING] != 0.0 || v[CAM_P_F_SPRING0] != 0.0))
-        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'k_spring' = %s N/m, 'F_spring0' = %s N: a return spring "
-                         "needs closure 'spring' (closure is '%s'); allowed with it: 0",
-                         cam_num(v[CAM_P_K_SPRING], a), cam_num(v[CAM_P_F_SPRING0], b), closure);
-    if (model->closure == CAM_CHOICE_CLOSURE_KINEMATIC || (model->closure == CAM_CHOICE_CLOSURE_FORM && paper)) {
-        if (v[CAM_P_RESTITUTION] != 0.0)
-            return cam_error(err, CAM_ERR_PARAMETER, "parameter 'restitution' = %s: %s has plastic impacts only "
-                             "(docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the consistent "
-                             "formulation)", cam_num(v[CAM_P_RESTITUTION], a),
-                             model->closure == CAM_CHOICE_CLOSURE_KINEMATIC ? "closure 'kinematic'"
-                             : "the paper's formulation (its eqs. 6-8)");
-        return CAM_OK;
-    }
-    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && model->c != 0.0)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'c' = %s m: closure 'spring' holds the follower on one "
-                         "flank, there is no clearance; allowed with it: c = 0", cam_num(model->c, a));
-    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && v[CAM_P_FOLLOWER_INERTIA] == 0.0)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'follower_inertia' = false: closure 'spring' moves the "
-                         "follower as a body of its own, which needs its mass; allowed with it: follower_inertia true "
-                         "(and m > 0)");
-    if (model->closure == CAM_CHOICE_CLOSURE_SPRING && !(v[CAM_P_M] > 0.0))
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'm' = %s kg: closure 'spring' moves the follower as a "
-                         "body of its own, which needs its mass; allowed with it: m > 0", cam_num(v[CAM_P_M], a));
-    if (!model->free_follower)
-        return CAM_OK;   /* a groove without clearance, or a follower without mass: the kinematic rule exactly */
-    if (model->formulation == CAM_FORM_SPEED)
-        return CAM_OK;
-    /* The voltage drive: the reference's refusals (docs/model.md 13.6); guide friction and a compliant shaft run. */
-    if (model->formulation != CAM_FORM_CONSISTENT)
-        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'closure' = '%s' with drive 'voltage': the paper's "
-                         "formulation (steps 1-9) has no follower of its own; allowed with it: formulation "
-                         "'consistent'", closure);
-    return CAM_OK;   /* voltage_follower.c */
-}
-
 /* The sine or cosine `value` of a mounting angle [rad], exactly 0 where the angle makes it 0 to within a few of
  * its rounding units (parameters.mounting_component; docs/model.md 4.1): sin(pi) = 1.2e-16 is no force. */
 static double mounting(double value, double angle)
@@ -424,17 +358,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->k_spring = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_K_SPRING] : 0.0;
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
     model->restitution = v[CAM_P_RESTITUTION];
-    /* physics.drive.own_follower: a groove's follower flies where it has a clearance to cross and a mass to carry
-     * its momentum (without one no force moves it); the paper's voltage-drive formulation models the clearance by
-     * its eqs. 6-8. Elsewhere closure 'form' is the kinematic rule, bit for bit. */
-    model->free_follower = model->closure == CAM_CHOICE_CLOSURE_SPRING
-                           || (model->closure == CAM_CHOICE_CLOSURE_FORM && model->c > 0.0 && model->m > 0.0
-                               && model->formulation != CAM_FORM_PAPER);
-    if ((status = check_closure(model, err)) != CAM_OK) {
-        cam_model_free(model);
-        return status;
-    }
-    if (model->compliant && (status = check_compliant(model, err)) != CAM_OK) {
+    model->free_follower = cam_own_follower(v);   /* physics/rules.py OWN_FOLLOWER (docs/model.md 13) */
+    if ((status = cam_check_rules(v, err)) != CAM_OK) {   /* physics/rules.py RULES, generated */
         cam_model_free(model);
         return status;
     }

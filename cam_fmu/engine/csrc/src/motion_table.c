@@ -198,20 +198,13 @@ static void build(CamTable *t)
     }
 }
 
-void cam_table_eval(const CamTable *t, double theta, double d[4], size_t *comparisons)
+void cam_table_eval(const CamTable *t, double th, double d[4], size_t *comparisons)
 {
     size_t n = t->n, lo = 0, hi = n, i, count = 0;
-    double th, u, w, y0, y1, c3, s;
-    if (!isfinite(theta) || n == 0) {
+    double u, w, y0, y1, c3, s;
+    if (!isfinite(th) || n == 0) {  /* th in [0, 2 pi) (cam_table.h): a knot is its own reduction */
         d[0] = d[1] = d[2] = d[3] = NAN;
         return;
-    }
-    th = cam_angle_mod(theta);  /* [0, 2 pi): a knot is its own reduction, so rows come back exactly */
-    if (th < 0.0) {
-        th += TWO_PI;
-        if (th >= TWO_PI) {  /* -tiny + 2 pi rounds to 2 pi */
-            th = 0.0;
-        }
     }
     while (lo < hi) {  /* bisect_left: the first knot >= th */
         size_t mid = lo + (hi - lo) / 2;

@@ -210,16 +210,16 @@ double cam_angle_mod(double theta)
 void cam_profile_eval_counted(const CamProfile *p, double theta, double d[4], size_t *comparisons)
 {
     double th, law[4];
-    if (p->kind == CAM_PROGRAM_TABLE) {
-        cam_table_eval(&p->table, theta, d, comparisons);
-        return;
-    }
-    th = cam_angle_mod(theta);
+    th = cam_angle_mod(theta);  /* [0, 2 pi): a knot is its own reduction, so a table's rows come back exactly */
     if (th < 0.0) {
         th += TWO_PI;
         if (th >= TWO_PI) {  /* -tiny + 2 pi rounds to 2 pi */
             th = 0.0;
         }
+    }
+    if (p->kind == CAM_PROGRAM_TABLE) {
+        cam_table_eval(&p->table, th, d, comparisons);
+        return;
     }
     if (th <= p->b1) {
         cam_law_eval(&p->rise, th * p->kr0, law);

@@ -20,7 +20,7 @@ int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EV
         if (m->backlash)
             codes[n++] = CAM_EV_CONTACT;
         if (m->guide_side)
-            codes[n++] = CAM_EV_SIDE;
+            codes[n++] = CAM_EV_SIDE_FORCE;
     }
     return n;
 }
@@ -48,7 +48,7 @@ double cam_event_value(const CamModel *m, const CamMode *mode, int code, const d
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA], d[4];
     if (code == CAM_EV_STOP)
         return omega * mode->direction;
-    if (code == CAM_EV_SIDE)
+    if (code == CAM_EV_SIDE_FORCE)
         return mode->side * cam_side_force(m, theta, omega, cam_drive_torque(m, x, omega, u), mode->direction,
                                            mode->side)
                + CAM_SIDE_HYSTERESIS;
@@ -168,7 +168,7 @@ void cam_apply_event(const CamModel *m, CamMode *mode, double x[CAM_NX], int cod
         /* the located zero of the margin: the torque is at the threshold, so the shaft starts now */
         cam_settle(m, mode, x, u, 1);
         break;
-    case CAM_EV_SIDE:
+    case CAM_EV_SIDE_FORCE:
         mode->side = -mode->side;   /* N_r passed through zero: the other friction branch */
         break;
     case CAM_EV_CONTACT:

@@ -1,0 +1,211 @@
+"""The cross-parameter rules: the combinations of parameters the drive refuses, as data.
+
+One table, two readers: ``check_rules`` interprets it here (``DriveModel`` calls it), and
+``engine/codegen.py`` writes it into C (``cam_check_rules`` in the generated ``cam_params.c``, which
+``cam_model_init`` calls), message for message. A rule is a condition over the parameters (a small
+expression tree: ``value`` evaluates it on resolved parameters, ``c`` writes it over the C array ``v``
+of ``CamParams``) and the message of its refusal, whose ``{name}`` fields are the parameters' values
+as the messages show them (``repr``: 0.5, 'form'). The first rule that holds refuses. Leaf module
+over ``parameters`` (``math`` only). docs/model.md 12.1 and 13; docs/architecture.md.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+from .parameters import (BY_NAME, FOLLOWER_DRIVES, RIGID_ONLY, VOLTAGE_FOLLOWER_FORMULATIONS, ParameterError)
+
+
+def c_name(text: str) -> str:
+    """An upper-case C identifier part (codegen's)."""
+    return "".join(ch if ch.isalnum() else "_" for ch in text).upper()
+
+
+class Expr:
+    """A condition or a number over the resolved parameters."""
+
+    def value(self, p: Mapping[str, Any]) -> Any:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def c(self) -> str:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def names(self) -> set[str]:
+        """The parameters it reads."""
+        return set().union(*(x.names() for x in getattr(self, "args", ())))
+
+
+@dataclass(frozen=True)
+class Num(Expr):
+    """A real or boolean parameter's value (booleans 1/0) [its unit]."""
+    name: str
+
+    def value(self, p: Mapping[str, Any]) -> float:
+        return float(p[self.name])
+
+    def c(self) -> str:
+        return f"v[CAM_P_{c_name(self.name)}]"
+
+    def names(self) -> set[str]:
+        return {self.name}
+
+
+@dataclass(frozen=True)
+class Is(Expr):
+    """A string parameter is one of ``choices``."""
+    name: str
+    choices: tuple[str, ...]
+
+    def value(self, p: Mapping[str, Any]) -> bool:
+        return p[self.name] in self.choices
+
+    def c(self) -> str:
+        terms = [f"(int)v[CAM_P_{c_name(self.name)}] == CAM_CHOICE_{c_name(self.name)}_{c_name(ch)}"
+                 for ch in self.choices]
+        return "(" + " || ".join(terms) + ")" if terms else "0"
+
+    def names(self) -> set[str]:
+        return {self.name}
+
+
+@dataclass(frozen=True)
+class Cmp(Expr):
+    """``a op b`` with op one of ==, !=, >; b a number."""
+    a: Expr
+    op: str
+    b: float = 0.0
+
+    def value(self, p: Mapping[str, Any]) -> bool:
+        x = self.a.value(p)
+        return {"==": x == self.b, "!=": x != self.b, ">": x > self.b}[self.op]
+
+    def c(self) -> str:
+        return f"({self.a.c()} {self.op} {float(self.b)!r})"
+
+    def names(self) -> set[str]:
+        return self.a.names()
+
+
+class _Many(Expr):
+    def __init__(self, *args: Expr) -> None:
+        self.args = args
+
+
+class AllOf(_Many):
+    """Every one holds."""
+
+    def value(self, p: Mapping[str, Any]) -> bool:
+        return all(x.value(p) for x in self.args)
+
+    def c(self) -> str:
+        return "(" + " && ".join(x.c() for x in self.args) + ")"
+
+
+class AnyOf(_Many):
+    """One holds at least."""
+
+    def value(self, p: Mapping[str, Any]) -> bool:
+        return any(x.value(p) for x in self.args)
+
+    def c(self) -> str:
+        return "(" + " || ".join(x.c() for x in self.args) + ")"
+
+
+class Not(_Many):
+    """It does not hold."""
+
+    def value(self, p: Mapping[str, Any]) -> bool:
+        return not self.args[0].value(p)
+
+    def c(self) -> str:
+        return f"!{self.args[0].c()}"
+
+
+class Where(_Many):
+    """``then`` where ``cond`` holds, else 0."""
+
+    def value(self, p: Mapping[str, Any]) -> float:
+        return self.args[1].value(p) if self.args[0].value(p) else 0.0
+
+    def c(self) -> str:
+        return f"({self.args[0].c()} ? {self.args[1].c()} : 0.0)"
+
+
+# The quantities the rules share (physics/drive.py's effective_clearance, follower_mass, own_follower).
+CLEARANCE = Where(Cmp(Num("backlash"), "!="), Num("c"))          # m: c where the backlash effect is on
+MASS = Where(Cmp(Num("follower_inertia"), "!="), Num("m"))       # kg: m where the follower's inertia is on
+SPRING = Is("closure", ("spring",))
+FORM = Is("closure", ("form",))
+FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_FOLLOWER_FORMULATIONS))
+# The follower moves as a body of its own (docs/model.md 13): closure 'spring' always; 'form' where the groove has a
+# clearance to fly across, the follower a mass to carry its momentum, and the formulation the follower's momentum.
+OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
+COMPLIANT = Cmp(Num("k_shaft"), ">")
+
+PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
+           "consistent formulation)")
+BODY = "closure 'spring' moves the follower as a body of its own, which needs its mass"
+
+
+@dataclass(frozen=True)
+class Rule:
+    """Refuse where ``when`` holds, with ``message`` (``{name}``: that parameter's value as repr shows it)."""
+    when: Expr
+    message: str
+
+    def fields(self) -> list[str]:
+        """The parameters the message shows, in order."""
+        return re.findall(r"\{(\w+)\}", self.message)
+
+    def text(self, p: Mapping[str, Any]) -> str:
+        """The message at p."""
+        return self.message.format(**{name: repr(p[name]) for name in self.fields()})
+
+
+RULES: tuple[Rule, ...] = (
+    Rule(AllOf(Not(SPRING), AnyOf(Cmp(Num("k_spring"), "!="), Cmp(Num("F_spring0"), "!="))),
+         "parameters 'k_spring' = {k_spring} N/m, 'F_spring0' = {F_spring0} N: a return spring needs closure "
+         "'spring' (closure is {closure}); allowed with it: 0"),
+    Rule(AllOf(Is("closure", ("kinematic",)), Cmp(Num("restitution"), "!=")),
+         "parameter 'restitution' = {restitution}: closure 'kinematic' " + PLASTIC),
+    Rule(AllOf(FORM, Not(FOLLOWER_MODEL), Cmp(Num("restitution"), "!=")),
+         "parameter 'restitution' = {restitution}: the paper's formulation (its eqs. 6-8) " + PLASTIC),
+    Rule(AllOf(SPRING, Cmp(CLEARANCE, "!=")),
+         "parameter 'c' = {c} m: closure 'spring' holds the follower on one flank, there is no clearance; "
+         "allowed with it: c = 0"),
+    Rule(AllOf(SPRING, Cmp(Num("follower_inertia"), "==")),
+         f"parameter 'follower_inertia' = false: {BODY}; allowed with it: follower_inertia true (and m > 0)"),
+    Rule(AllOf(SPRING, Not(Cmp(Num("m"), ">"))), f"parameter 'm' = {{m}} kg: {BODY}; allowed with it: m > 0"),
+    Rule(AllOf(SPRING, Not(FOLLOWER_MODEL)),
+         "parameter 'closure' = {closure} with drive 'voltage': the paper's formulation (steps 1-9) has no follower "
+         "of its own; allowed with it: formulation 'consistent'"),
+    Rule(AllOf(COMPLIANT, Not(Cmp(Num("J_cam"), ">"))),
+         "parameter 'J_cam' = {J_cam} [kg.m2]: a compliant shaft (k_shaft = {k_shaft} N.m/rad) needs the inertia of "
+         "its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2"),
+    *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
+           f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
+           f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),
+)
+
+
+def refusal(p: Mapping[str, Any]) -> str | None:
+    """The message of the first rule that refuses the resolved parameters p, or None."""
+    for rule in RULES:
+        if rule.when.value(p):
+            return rule.text(p)
+    return None
+
+
+def check_rules(p: Mapping[str, Any]) -> None:
+    """Raise ParameterError where the resolved parameters p break a rule of RULES."""
+    message = refusal(p)
+    if message is not None:
+        raise ParameterError(message)
+
+
+def rule_names() -> set[str]:
+    """Every parameter the rules read or show (each is in physics.parameters.PARAMETERS)."""
+    names = set().union(*(r.when.names() | set(r.fields()) for r in RULES))
+    assert names <= set(BY_NAME), names - set(BY_NAME)
+    return names
