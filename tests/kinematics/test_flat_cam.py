@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pytest
 import sympy as sp
+from closed_forms import SympyProgram, to_cam_frame
 from scipy.optimize import minimize_scalar
 
 from cam_fmu.kinematics.cam_program import CamProgram
@@ -22,12 +23,6 @@ PROG = CamProgram("cycloidal", "modified_sine", 0.02, math.radians(100), math.ra
 TH = np.linspace(0.0, 2 * math.pi, 1441)
 
 
-def _rot(theta, x, y):
-    """Rot(-theta) (x, y): the fixed frame into the cam frame."""
-    c, s = np.cos(theta), np.sin(theta)
-    return x * c + y * s, -x * s + y * c
-
-
 def test_translating_face_contour_from_the_envelope():
     r_b = 0.05
     cam = TranslatingFlatCam(PROG, r_b)
@@ -35,7 +30,7 @@ def test_translating_face_contour_from_the_envelope():
     s, s1, s2, _ = PROG.evaluate(TH)
     # the contact is s' from the axis along the face: (r_b + s, -s') in the fixed frame
     x, y = cam.contour(TH)
-    ex, ey = _rot(TH, r_b + s, -s1)
+    ex, ey = to_cam_frame(TH, r_b + s, -s1)
     assert np.allclose(x, ex, rtol=0, atol=1e-15) and np.allclose(y, ey, rtol=0, atol=1e-15)
     assert np.allclose(cam.radius_of_curvature(TH), r_b + s + s2, rtol=0, atol=1e-15)
     assert np.allclose(cam.face_position(TH), -s1, rtol=0, atol=0)
@@ -114,55 +109,39 @@ def test_smallest_base_radius_of_a_translating_face_is_the_closed_form():
     assert r5 == pytest.approx(bound + 0.005, abs=2e-9)
 
 
-class EccentricUnderFace:
+def eccentric_under_face(Rc, eps, d):
     """A disc (radius Rc, centre (-eps, 0) in the cam frame) under a flat face through the pivot P =
     (r_b, sqrt(d^2 - r_b^2)), r_b = Rc - eps: the face's normal (cos psi, sin psi) with the disc tangent to
-    it, (cos psi, sin psi) . (Q(theta) - P) = -Rc, solved for psi by sympy."""
-
-    def __init__(self, Rc, eps, d):
-        r_b = Rc - eps
-        self.P = (r_b, math.sqrt(d * d - r_b * r_b))
-        th = sp.Symbol("th")
-        Dx, Dy = -eps * sp.cos(th) - self.P[0], -eps * sp.sin(th) - self.P[1]
-        D = sp.sqrt(Dx ** 2 + Dy ** 2)
-        eta = sp.atan2(Dy, Dx)
-        cands = [eta + sgn * sp.acos(-Rc / D) for sgn in (1, -1)]
-        k0 = [float(c.subs(th, 0)) for c in cands]
-        best = min(range(2), key=lambda i: abs((k0[i] + math.pi) % (2 * math.pi) - math.pi))
-        psi = cands[best] - round(k0[best] / (2 * math.pi)) * 2 * sp.pi
-        self._f = [sp.lambdify(th, sp.diff(psi, th, j), "numpy") for j in range(4)]
-        self.Q0 = (-eps, 0.0)
-        self.lift = 1.0
-        self.lift_angle = float(np.max(self._psi(np.linspace(0, 2 * math.pi, 20001))))
-
-    def _psi(self, th):
-        return np.broadcast_to(self._f[0](th), np.shape(th))
-
-    def evaluate(self, theta):
-        theta = np.asarray(theta, dtype=float)
-        return tuple(np.broadcast_to(f(theta), theta.shape).astype(float) / self.lift_angle for f in self._f)
-
-    def derivatives(self, theta):
-        return tuple(float(f(theta)) / self.lift_angle for f in self._f)
-
-    def breakpoints(self):
-        return (0.0,)
+    it, (cos psi, sin psi) . (Q(theta) - P) = -Rc, solved for psi by sympy.  Returns (program with
+    S = psi / lift_angle, lift_angle, P)."""
+    r_b = Rc - eps
+    P = (r_b, math.sqrt(d * d - r_b * r_b))
+    th = sp.Symbol("th")
+    Dx, Dy = -eps * sp.cos(th) - P[0], -eps * sp.sin(th) - P[1]
+    D = sp.sqrt(Dx ** 2 + Dy ** 2)
+    eta = sp.atan2(Dy, Dx)
+    cands = [eta + sgn * sp.acos(-Rc / D) for sgn in (1, -1)]
+    k0 = [float(c.subs(th, 0)) for c in cands]
+    best = min(range(2), key=lambda i: abs((k0[i] + math.pi) % (2 * math.pi) - math.pi))
+    psi = cands[best] - round(k0[best] / (2 * math.pi)) * 2 * sp.pi
+    lift_angle = SympyProgram(psi, th).largest()
+    return SympyProgram(psi, th, lift_angle), lift_angle, P
 
 
 def test_oscillating_face_on_an_eccentric_circle():
     Rc, eps, d, L = 0.05, 0.008, 0.12, 0.1
-    prog = EccentricUnderFace(Rc, eps, d)
-    assert prog._psi(np.linspace(0, 2 * math.pi, 2001)).min() > -1e-12
-    cam = OscillatingFlatCam(prog, Rc - eps, L, d, prog.lift_angle)
+    prog, lift_angle, P = eccentric_under_face(Rc, eps, d)
+    assert prog.values(np.linspace(0, 2 * math.pi, 2001)).min() > -1e-12
+    cam = OscillatingFlatCam(prog, Rc - eps, L, d, lift_angle)
     refuse_unbuildable(cam)
     x, y = cam.contour(TH)
     assert np.allclose(np.hypot(x + eps, y), Rc, rtol=0, atol=1e-11)              # the disc
     assert np.allclose(cam.radius_of_curvature(TH), Rc, rtol=1e-9)
     # the contact is the foot of the disc centre on the face: Q + Rc n; its distance from P along the face
-    psi = prog._psi(TH)
-    qx, qy = _rot(-TH, -eps, 0.0)
+    psi = prog.values(TH)
+    qx, qy = to_cam_frame(-TH, -eps, 0.0)
     fx, fy = qx + Rc * np.cos(psi), qy + Rc * np.sin(psi)
-    ell = (fx - prog.P[0]) * np.sin(psi) - (fy - prog.P[1]) * np.cos(psi)          # along (sin psi, -cos psi)
+    ell = (fx - P[0]) * np.sin(psi) - (fy - P[1]) * np.cos(psi)          # along (sin psi, -cos psi)
     assert np.allclose(cam.face_position(TH), ell, rtol=0, atol=1e-11)
     # at zero lift the contact is the foot of the axis on the face, sqrt(d^2 - r_b^2) from the pivot
     assert cam.face_position(0.0) == pytest.approx(math.sqrt(d * d - (Rc - eps) ** 2), rel=1e-12)
@@ -178,14 +157,14 @@ def test_oscillating_face_closed_forms_on_a_program():
     delta = math.asin(r_b / d) + psi
     # the face is at d sin(delta) from the axis: every contour point within, the contact on it
     x, y = cam.contour(TH)
-    X, Y = _rot(-TH, x, y)                                     # the contact in the fixed frame
+    X, Y = to_cam_frame(-TH, x, y)                                     # the contact in the fixed frame
     P = np.array([r_b, math.sqrt(d * d - r_b * r_b)])
     assert np.allclose((X - P[0]) * np.cos(psi) + (Y - P[1]) * np.sin(psi), 0.0, atol=1e-15)   # on the face
     assert np.allclose(cam.face_position(TH), d * np.cos(delta) / (1 - psi1), rtol=1e-12)
     assert np.allclose(np.hypot(X - P[0], Y - P[1]), d * np.cos(delta) / (1 - psi1), rtol=1e-12)
     # the reference point at L along the face traces the pitch curve
     px, py = cam.pitch(TH)
-    RX, RY = _rot(-TH, px, py)
+    RX, RY = to_cam_frame(-TH, px, py)
     assert np.allclose(np.hypot(RX - P[0], RY - P[1]), L, atol=1e-15)
     dense = np.array(cam.contour(np.linspace(0, 2 * math.pi, 20000, endpoint=False)))
     for t, a, dl in zip(TH[::8], psi[::8], delta[::8]):

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from closed_forms import SympyProgram, to_cam_frame
 
 from cam_fmu.kinematics.cam_program import CamProgram
 from cam_fmu.kinematics.design_checks import Limits
@@ -18,12 +19,6 @@ from cam_fmu.kinematics.rocker_cam import OscillatingRollerCam
 PROG = CamProgram("cycloidal", "modified_sine", 0.02, math.radians(100), math.radians(40),
                   math.radians(120), math.radians(100))
 TH = np.linspace(0.0, 2 * math.pi, 1441)
-
-
-def _rot(theta, x, y):
-    """Rot(-theta) (x, y): the fixed frame into the cam frame."""
-    c, s = np.cos(theta), np.sin(theta)
-    return x * c + y * s, -x * s + y * c
 
 
 def _triangle(r_b, L, d):
@@ -43,10 +38,10 @@ def test_roller_centre_path_and_pressure_angle_from_the_triangle(r_b, L, d, lift
     # law of cosines: |OC|^2 = d^2 + L^2 - 2 d L cos(delta0 + psi); |PC| = L
     x, y = cam.pitch(TH)
     assert np.allclose(np.hypot(x, y), np.sqrt(d * d + L * L - 2 * d * L * np.cos(delta0 + psi)), rtol=0, atol=1e-13)
-    px, py = _rot(TH, P[0], P[1])
+    px, py = to_cam_frame(TH, P[0], P[1])
     assert np.allclose(np.hypot(x - px, y - py), L, rtol=0, atol=1e-13)
     # the arm's angle: between PO and PC, delta0 + psi (fixed frame: C = Rot(theta) c)
-    Cx, Cy = _rot(-TH, x, y)
+    Cx, Cy = to_cam_frame(-TH, x, y)
     ang = np.arccos(((-P[0]) * (Cx - P[0]) + (-P[1]) * (Cy - P[1])) / (d * L))
     assert np.allclose(ang, delta0 + psi, rtol=0, atol=1e-7)
     # pressure angle: the contact normal passes through the instant centre of cam (about O, speed 1) and
@@ -64,53 +59,37 @@ def test_roller_centre_path_and_pressure_angle_from_the_triangle(r_b, L, d, lift
     assert np.allclose(np.abs(cam.pressure_angle(TH[dwell])), np.abs(0.5 * math.pi - gamma), atol=1e-12)
 
 
-class EccentricRocker:
+def eccentric_rocker(r_b, L, d, Rp):
     """An eccentric circle (pitch circle radius Rp, centre Q0 in the cam frame) under an arm of length L about
     P: the roller centre is where the circle about P (radius L) meets the circle about Q(theta) = Rot(theta) Q0
     (radius Rp), psi(theta) by sympy from that intersection alone.  At theta = 0 the arm is at its lowest,
-    with the roller centre at (r_b, 0): the pitch circle's point nearest the cam axis, Q0 = (r_b - Rp, 0)."""
-
-    def __init__(self, r_b, L, d, Rp):
-        P, delta0 = _triangle(r_b, L, d)
-        u0 = (np.array([r_b, 0.0]) - P) / L                  # arm direction at zero lift
-        self.Q0 = np.array([r_b - Rp, 0.0])
-        th = sp.Symbol("th")
-        Qx = self.Q0[0] * sp.cos(th) - self.Q0[1] * sp.sin(th)
-        Qy = self.Q0[0] * sp.sin(th) + self.Q0[1] * sp.cos(th)
-        Dx, Dy = P[0] - Qx, P[1] - Qy
-        D = sp.sqrt(Dx ** 2 + Dy ** 2)
-        phi0 = math.atan2(u0[1], u0[0])
-        # |P + L u(phi) - Q| = Rp  <=>  cos(phi - eta) = (Rp^2 - D^2 - L^2) / (2 L D), eta = atan2(Dy, Dx)
-        eta = sp.atan2(Dy, Dx)
-        k = (Rp ** 2 - D ** 2 - L ** 2) / (2 * L * D)
-        eta0 = float(eta.subs(th, 0))
-        sign = 1.0 if (phi0 - eta0 + math.pi) % (2 * math.pi) - math.pi >= 0 else -1.0
-        psi = eta + sign * sp.acos(k) - (eta0 + sign * math.acos(float(k.subs(th, 0))))
-        self._f = [sp.lambdify(th, sp.diff(psi, th, j), "numpy") for j in range(4)]
-        dense = np.linspace(0, 2 * math.pi, 20001)
-        vals = np.broadcast_to(self._f[0](dense), dense.shape)
-        self.lift = 1.0
-        self.lift_angle = float(vals.max())
-        self.psi_min = float(vals.min())
-
-    def evaluate(self, theta):
-        theta = np.asarray(theta, dtype=float)
-        return tuple(np.broadcast_to(f(theta), theta.shape).astype(float) / self.lift_angle for f in self._f)
-
-    def derivatives(self, theta):
-        return tuple(float(f(theta)) / self.lift_angle for f in self._f)
-
-    def breakpoints(self):
-        return (0.0,)
+    with the roller centre at (r_b, 0): the pitch circle's point nearest the cam axis, Q0 = (r_b - Rp, 0).
+    Returns (program with S = psi / lift_angle, lift_angle, Q0)."""
+    P, _ = _triangle(r_b, L, d)
+    u0 = (np.array([r_b, 0.0]) - P) / L                  # arm direction at zero lift
+    Q0 = np.array([r_b - Rp, 0.0])
+    th = sp.Symbol("th")
+    Qx, Qy = Q0[0] * sp.cos(th), Q0[0] * sp.sin(th)
+    Dx, Dy = P[0] - Qx, P[1] - Qy
+    D = sp.sqrt(Dx ** 2 + Dy ** 2)
+    phi0 = math.atan2(u0[1], u0[0])
+    # |P + L u(phi) - Q| = Rp  <=>  cos(phi - eta) = (Rp^2 - D^2 - L^2) / (2 L D), eta = atan2(Dy, Dx)
+    eta = sp.atan2(Dy, Dx)
+    k = (Rp ** 2 - D ** 2 - L ** 2) / (2 * L * D)
+    eta0 = float(eta.subs(th, 0))
+    sign = 1.0 if (phi0 - eta0 + math.pi) % (2 * math.pi) - math.pi >= 0 else -1.0
+    psi = eta + sign * sp.acos(k) - (eta0 + sign * math.acos(float(k.subs(th, 0))))
+    prog = SympyProgram(psi, th)
+    lift_angle = prog.largest()
+    return SympyProgram(psi, th, lift_angle), lift_angle, Q0
 
 
 def test_eccentric_circle_under_a_rocker():
     r_b, L, d, Rp, r_r = 0.05, 0.09, 0.11, 0.06, 0.012
-    prog = EccentricRocker(r_b, L, d, Rp)
-    assert prog.psi_min > -1e-12 and prog.lift_angle > math.radians(5)      # the arm lowest at theta = 0
-    cam = OscillatingRollerCam(prog, r_b, r_r, L, d, prog.lift_angle)
+    prog, lift_angle, (qx, qy) = eccentric_rocker(r_b, L, d, Rp)
+    assert prog.values(TH).min() > -1e-12 and lift_angle > math.radians(5)      # the arm lowest at theta = 0
+    cam = OscillatingRollerCam(prog, r_b, r_r, L, d, lift_angle)
     refuse_unbuildable(cam)
-    qx, qy = prog.Q0
     x, y = cam.pitch(TH)
     assert np.allclose(np.hypot(x - qx, y - qy), Rp, rtol=0, atol=1e-11)          # the pitch circle
     x, y = cam.contour(TH)
@@ -120,7 +99,7 @@ def test_eccentric_circle_under_a_rocker():
     # the contact normal passes through the disc centre: alpha between C - Q and the path
     P, _ = _triangle(r_b, L, d)
     Cx, Cy = cam.roller_centre(TH)
-    Qx, Qy = _rot(-TH, qx, qy)
+    Qx, Qy = to_cam_frame(-TH, qx, qy)
     nx, ny = Cx - Qx, Cy - Qy
     wx, wy = -(Cy - P[1]), Cx - P[0]
     alpha = np.arccos(np.abs(nx * wx + ny * wy) / (np.hypot(nx, ny) * np.hypot(wx, wy)))
