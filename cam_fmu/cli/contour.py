@@ -65,24 +65,10 @@ def _error(msg: str) -> int:
     return 2
 
 
-def _build(args):
-    from ..kinematics.design_checks import Limits
-    from ..kinematics.follower_checks import refuse_unbuildable
-    from ..kinematics.follower_types import DEFAULTS, USES, make_cam
-    from ..kinematics.physical import MAX_RPM
+def _check_follower_options(args, kind: str) -> None:
+    """The follower's options: those the type needs given, those it does not use left out, ranges."""
+    from ..kinematics.follower_types import DEFAULTS, USES
 
-    if args.table is not None:
-        from ..kinematics.motion_table import program_from_table_text
-        try:
-            with open(args.table) as f:
-                text = f.read()
-        except OSError as exc:
-            raise ValueError(f"--table: cannot read {args.table!r}: {exc.strerror}") from None
-        program, name = program_from_table_text(text), f"table {args.table}"
-    else:
-        name, m = rise_law(args)
-        program = build_program(args, m)
-    kind = args.follower_type
     uses = USES[kind]
     if not (math.isfinite(args.base_radius_mm) and args.base_radius_mm > 0.0):
         raise ValueError(f"--base-radius-mm must be a number > 0, got {args.base_radius_mm:g}")
@@ -113,6 +99,27 @@ def _build(args):
         v = getattr(args, opt[2:].replace("-", "_"))
         if v is not None and not (math.isfinite(v) and v > 0.0):
             raise ValueError(f"{opt} must be a number > 0, got {v:g}")
+
+
+def _build(args):
+    from ..kinematics.design_checks import Limits
+    from ..kinematics.follower_checks import refuse_unbuildable
+    from ..kinematics.follower_types import make_cam
+    from ..kinematics.physical import MAX_RPM
+
+    if args.table is not None:
+        from ..kinematics.motion_table import program_from_table_text
+        try:
+            with open(args.table) as f:
+                text = f.read()
+        except OSError as exc:
+            raise ValueError(f"--table: cannot read {args.table!r}: {exc.strerror}") from None
+        program, name = program_from_table_text(text), f"table {args.table}"
+    else:
+        name, m = rise_law(args)
+        program = build_program(args, m)
+    kind = args.follower_type
+    _check_follower_options(args, kind)
     if args.rpm is not None and not (math.isfinite(args.rpm) and 0.0 < args.rpm <= MAX_RPM):
         raise ValueError(f"--rpm must be a number > 0 and <= {MAX_RPM:g}, got {args.rpm:g}")
     if not (0.0 < args.max_pressure_angle_deg < 90.0):
