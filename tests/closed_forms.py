@@ -11,11 +11,13 @@ import sympy as sp
 
 class SympyProgram:
     """The program s(th) = expr / scale (th the sympy Symbol in expr): `evaluate`, `derivatives` (s .. s''')
-    and `breakpoints` as a cam program has them; ``lift`` = 1 (s is already normalised when scale is the
+    and `breakpoints` as a cam program has them (derivatives above `order` NaN); ``lift`` = 1 (s is already normalised when scale is the
     largest value of expr, as an oscillating follower's lift_angle is of psi)."""
 
-    def __init__(self, expr, th: sp.Symbol, scale: float = 1.0) -> None:
-        self._f = [sp.lambdify(th, sp.diff(expr, th, j), "numpy") for j in range(4)]
+    def __init__(self, expr, th: sp.Symbol, scale: float = 1.0, order: int = 2) -> None:
+        # derivatives up to `order` (the geometry needs s''); above it NaN, so that a use of them shows
+        nan = sp.lambdify(th, sp.nan * th, "numpy")
+        self._f = [sp.lambdify(th, sp.diff(expr, th, j), "numpy") if j <= order else nan for j in range(4)]
         self.scale = float(scale)
         self.lift = 1.0
 
