@@ -98,8 +98,9 @@ def _rho_refusal(cam: FlatFaceCam, rho: float, at: float) -> str:
             f"{hint}")
 
 
-def _unbuildable(cam) -> str | None:
-    """The refusal's message, or None when the geometry can be built."""
+def _unbuildable(cam, explain: bool = True) -> str | None:
+    """The refusal's message, or None when the geometry can be built; without `explain` the message of a
+    flat face's rho <= 0 is short (it would search the smallest base radius: the search's own predicate)."""
     if isinstance(cam, OscillatingRollerCam):
         top = math.pi - cam.delta0
         if cam.lift_angle >= top:
@@ -124,7 +125,7 @@ def _unbuildable(cam) -> str | None:
                     f"infinity along the face; lift_angle must be < {math.degrees(cam.lift_angle / rate):.6g} deg")
     rho, at = _extreme(cam.radius_of_curvature, grid, -1.0)
     if rho <= 0.0:
-        return _rho_refusal(cam, rho, at)
+        return _rho_refusal(cam, rho, at) if explain else "rho <= 0"
     return None
 
 
@@ -173,22 +174,7 @@ def _passes(cam, r_b: float, limits: Limits) -> bool:
         other = with_base_radius(cam, r_b)
     except ValueError:
         return False
-    return _unbuildable_fast(other) is None and check_follower(other, limits).ok
-
-
-def _unbuildable_fast(cam) -> str | None:
-    """As _unbuildable, without the smallest base radius in the message (the search's own predicate)."""
-    if isinstance(cam, FlatFaceCam) and not isinstance(cam, OscillatingFlatCam):
-        grid = _grid(cam.program)
-        return None if _extreme(cam.radius_of_curvature, grid, -1.0)[0] > 0.0 else "rho"
-    if isinstance(cam, OscillatingFlatCam):
-        if cam.lift_angle >= 0.5 * math.pi - cam.delta0:
-            return "behind the pivot"
-        grid = _grid(cam.program)
-        if _extreme(lambda t: cam.arm.derivatives(t)[1], grid)[0] >= 1.0:
-            return "psi'"
-        return None if _extreme(cam.radius_of_curvature, grid, -1.0)[0] > 0.0 else "rho"
-    return _unbuildable(cam)
+    return _unbuildable(other, explain=False) is None and check_follower(other, limits).ok
 
 
 def smallest_base_radius_for(cam, limits: Limits | None = None, tol: float = 1e-6) -> float:
