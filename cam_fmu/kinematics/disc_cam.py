@@ -7,7 +7,8 @@ Conventions (docs/cam_design.md draws them):
   (seen from +Z) by theta, the existing "forward" cam angle.
 - r_b [m] is the prime-circle radius: from the cam axis to the roller centre
   at zero lift, so the roller centre is at (s0 + s, -e), s0 = sqrt(r_b^2 - e^2),
-  and the base circle of the cam contour has radius r_b - r_r.
+  and the base circle of the cam contour has radius r_b - r_r.  r_r = 0 is a knife edge (the contour is
+  the pitch curve).
 - e [m] is the offset (eccentricity).  e > 0 lowers the pressure angle on the
   rise and raises it on the return:  tan(alpha) = (s' - e) / (s0 + s).
 - Cam frame: fixed to the cam, equal to the fixed frame at theta = 0.  The
