@@ -12,8 +12,9 @@
   (None: 0); the contact's extent along the face (translating: offsets -s' from the axis, width
   max s' - min s'; oscillating: distances from the pivot).  The pressure angle is 0.
 - `smallest_base_radius_for`: the smallest r_b [m] that can be built and passes the checks; the translating
-  roller's is design_checks.smallest_base_radius, the others' a scan of 64 radii over the range their
-  parameters allow, the first passing one refined by bisection to ``tol``.
+  roller's is design_checks.smallest_base_radius, the others' a scan of the range their parameters allow (an
+  arm's or an oscillating face's: 64 radii in geometric steps; a translating face's: doubling from 1 um), the
+  first passing radius refined by bisection to ``tol``.
 
 Extremes on design_checks' grid (7200 angles and both sides of every breakpoint), refined by golden section.
 """
