@@ -2,7 +2,8 @@
 (radius of curvature, the face the contact needs) and the smallest base radius that passes.
 
 - Refused (ValueError naming the parameter and the limit), by `refuse_unbuildable`, before anything is drawn:
-  an oscillating roller whose pressure angle reaches 90 deg (delta0 + lift_angle >= 180 deg); an oscillating
+  an oscillating roller whose pressure angle reaches 90 deg (delta0 + lift_angle >= 180 deg) or whose cam
+  sweeps over the pivot (its contour reaches d from the axis); an oscillating
   flat face whose contact runs off to infinity (psi' >= 1) or behind the pivot (delta0 + lift_angle >= 90
   deg); a flat face whose contour's radius of curvature rho is <= 0 somewhere (a cusp: translating,
   rho = r_b + s + s''); the message gives the smallest base radius that keeps rho > 0.  (The arm that cannot
@@ -109,6 +110,12 @@ def _unbuildable(cam, explain: bool = True) -> str | None:
                     f"(delta0 + lift_angle), where the pressure angle reaches 90 deg: lift_angle must be < "
                     f"180 deg - delta0 = {math.degrees(top):.6g} deg (delta0 = {math.degrees(cam.delta0):.6g} deg, "
                     f"the angle at the pivot between the cam axis and the roller at zero lift)")
+        grid = _grid(cam.program)
+        reach, at = _extreme(lambda t: np.hypot(*cam.contour(t)), grid)
+        if reach >= cam.pivot_distance:
+            return (f"pivot_distance d = {cam.pivot_distance * 1e3:.6g} mm: the cam's contour reaches "
+                    f"{reach * 1e3:.6g} mm from its axis (at theta = {math.degrees(at):.6g} deg) and would sweep "
+                    f"over the pivot; d must be > {reach * 1e3:.6g} mm")
         return None
     if isinstance(cam, DiscCam):
         return None

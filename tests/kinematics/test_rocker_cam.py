@@ -4,6 +4,7 @@ relative instant centre of cam and arm, an eccentric circle cam whose arm motion
 two circles, the curvature from finite differences; the refused geometries; the smallest base radius."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -151,8 +152,11 @@ def test_pressure_angle_at_90_degrees_is_refused():
     assert "pressure angle reaches 90 deg" in str(exc.value)
     assert f"{math.degrees(math.pi - delta0):.6g} deg" in str(exc.value)
     just_below = OscillatingRollerCam(PROG, 0.05, 0.01, 0.08, 0.1, math.pi - delta0 - 1e-3)
-    refuse_unbuildable(just_below)
     assert np.abs(just_below.pressure_angle(TH)).max() < 0.5 * math.pi
+    # an arm turned that far puts the roller beyond the pivot (r -> d + L): the cam sweeps over the pivot,
+    # the next refusal
+    with pytest.raises(ValueError, match="would sweep over the pivot"):
+        refuse_unbuildable(just_below)
 
 
 def _max_alpha_triangle(r_b, L, d, lift):
@@ -178,3 +182,19 @@ def test_smallest_base_radius_is_tight(L, d):
     assert _max_alpha_triangle(r - 2e-5, L, d, lift) > limit
     assert check_follower(make_cam(PROG, r, "oscillating_roller", r_roller=0.008, arm_length=L, pivot_distance=d,
                                    lift_angle=lift), Limits(limit)).ok
+
+
+def test_a_cam_that_sweeps_over_the_pivot_is_refused():
+    # L = 30 mm, d = 60 mm, r_b = 40 mm: the roller stays clear, but the contour's top (the prime circle plus
+    # the lift, less the roller) comes past 60 mm from the axis
+    cam = OscillatingRollerCam(PROG, 0.04, 0.005, 0.03, 0.06, math.radians(60))
+    th = np.linspace(0.0, 2 * math.pi, 200001)
+    reach = np.hypot(*cam.contour(th)).max()
+    assert reach > 0.06
+    with pytest.raises(ValueError) as exc:
+        refuse_unbuildable(cam)
+    assert "would sweep over the pivot" in str(exc.value)
+    told = re.search(r"d must be > ([0-9.]+) mm", str(exc.value))
+    assert told and float(told.group(1)) == pytest.approx(reach * 1e3, abs=1e-3)
+    # the roller centre's own path reaches further still: the check is on the contour, not the pitch curve
+    assert np.hypot(*cam.pitch(th)).max() == pytest.approx(reach + 0.005, abs=1e-9)
