@@ -203,7 +203,20 @@ def test_oscillating_roller_json(capsys):
     assert d["offset_mm"] is None and d["arm_length_mm"] == 150.0 and d["lift_angle_deg"] == pytest.approx(25.0)
     assert math.hypot(*d["pivot_mm"]) == pytest.approx(180.0, rel=1e-12)
     assert d["speed"]["peak_arm_rate_rad_s"] == pytest.approx(lift * 2 / math.radians(120) * 2 * math.pi, rel=1e-9)
-    assert {w["check"] for w in d["warnings"]} == {"pressure_angle"}
+    (warning,) = d["warnings"]
+    assert warning["check"] == "pressure_angle" and "raise the base radius or move the pivot" in warning["message"]
+    assert "advice" not in warning
+    # at this pivot and arm no base radius meets 30 deg: the least max |alpha| over the radii the triangle
+    # allows, by the closed form, is above it
+    assert d["smallest_base_radius_mm"] is None
+    assert "no base radius in (30, 195) mm" in d["smallest_base_radius_error"]
+    th = np.linspace(0.0, 2 * math.pi, 20001)
+    s, s1, _, _ = CYC_PROG.evaluate(th)
+    psi, psi1 = lift * s / CYC_PROG.lift, lift * s1 / CYC_PROG.lift
+    least = min(np.degrees(np.abs(np.arctan((dd * np.cos(dl) - L * (1 - psi1)) / (dd * np.sin(dl))))).max()
+                for r in np.linspace(0.0301, 0.1949, 400)
+                for dl in [math.acos((dd * dd + L * L - r * r) / (2 * dd * L)) + psi])
+    assert 30.5 < least < 35.0
     rc, out, _ = run(capsys, *CYC, *ROCKER, "--max-pressure-angle-deg", "35")
     assert rc == 0 and "oscillating: L = 150 mm, d = 180 mm" in out and "warning" not in out
 
