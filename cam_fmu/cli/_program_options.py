@@ -7,6 +7,8 @@ from __future__ import annotations
 import argparse
 import math
 
+LIFT_MM_DEFAULT = 1.5 * math.pi * 35.0      # the paper's lift [mm]
+
 
 def add_law_options(p: argparse.ArgumentParser) -> None:
     """--preset NAME | --T T1..T6 (the rise law)."""
@@ -23,7 +25,7 @@ def add_program_options(p: argparse.ArgumentParser, title: str) -> argparse._Arg
     ret.add_argument("--return-preset", metavar="NAME", help="return law preset (default: the rise law)")
     ret.add_argument("--return-T", nargs=6, type=float, metavar=("T1", "T2", "T3", "T4", "T5", "T6"),
                      help="return law split points")
-    g.add_argument("--lift-mm", type=float, default=1.5 * math.pi * 35.0,
+    g.add_argument("--lift-mm", type=float, default=LIFT_MM_DEFAULT,
                    help="lift h [mm] (default 3*pi*35/2 = 164.93, the paper's)")
     g.add_argument("--rise-deg", type=float, default=180.0, help="rise angle [deg] (default 180)")
     g.add_argument("--upper-dwell-deg", type=float, default=0.0, help="upper dwell [deg] (default 0)")

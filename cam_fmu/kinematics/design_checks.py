@@ -91,7 +91,7 @@ class CheckReport:
 
     base_radius: float
     roller_radius: float
-    offset: float
+    offset: float | None                 # None: an oscillating follower (no offset)
     max_pressure_angle: float
     max_pressure_angle_at: float
     min_pitch_radius: float              # smallest rho_p on convex parts
@@ -202,7 +202,8 @@ def _ranges(grid: np.ndarray, mask: np.ndarray, g) -> tuple[tuple[float, float],
 
 
 def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
-    """Run the checks on `cam` and return the values, where they occur and the warnings."""
+    """Run the checks on `cam` (a DiscCam, or any roller follower's cam with its interface: an
+    OscillatingRollerCam) and return the values, where they occur and the warnings."""
     limits = limits or Limits()
     r_r = cam.roller_radius
     grid = _grid(cam.program)
@@ -215,7 +216,7 @@ def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
     rho_min = 1.0 / k_max                                               # k_max > 0: a closed curve bulges somewhere
     kc_max, kc_at = _refined_max(lambda t: -cam.pitch_curvature(t), grid, -kappa)
     concave = kc_max > 0.0
-    inv_r = 1.0 / r_r
+    inv_r = 1.0 / r_r if r_r > 0.0 else math.inf     # a knife edge (r_r = 0) cannot undercut
     under = _ranges(grid, kappa > inv_r, lambda t: cam.pitch_curvature(t) - inv_r)
     if limits.groove:
         groove = _ranges(grid, kappa < -inv_r, lambda t: -cam.pitch_curvature(t) - inv_r)
@@ -224,12 +225,15 @@ def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
 
     warnings = []
     if a_max > limits.max_pressure_angle:
-        advice = pressure_angle_advice(cam, limits.max_pressure_angle)
+        if isinstance(cam, DiscCam):
+            advice = pressure_angle_advice(cam, limits.max_pressure_angle)
+            text = _pressure_angle_text(cam, a_max, a_at, advice, limits.max_pressure_angle)
+        else:   # an arm: a larger base radius or another pivot (follower_checks.smallest_base_radius_for)
+            advice, text = None, "raise the base radius or move the pivot"
         warnings.append(DesignWarning(
             "pressure_angle",
             f"max pressure angle {math.degrees(a_max):.4g} deg at theta = {math.degrees(a_at):.5g} deg "
-            f"exceeds the limit {math.degrees(limits.max_pressure_angle):.4g} deg "
-            f"({_pressure_angle_text(cam, a_max, a_at, advice, limits.max_pressure_angle)})", (a_at,), advice))
+            f"exceeds the limit {math.degrees(limits.max_pressure_angle):.4g} deg ({text})", (a_at,), advice))
     rho_c = rho_min - r_r
     rho_lim = _min_radius(limits, r_r)
     if under:
@@ -253,7 +257,7 @@ def check_design(cam: DiscCam, limits: Limits | None = None) -> CheckReport:
             f"below the roller radius {r_r * 1e3:.4g} mm, at theta = {spans}",
             tuple(x for ab in groove for x in ab)))
     return CheckReport(
-        base_radius=cam.base_radius, roller_radius=r_r, offset=cam.offset,
+        base_radius=cam.base_radius, roller_radius=r_r, offset=getattr(cam, "offset", None),
         max_pressure_angle=a_max, max_pressure_angle_at=a_at,
         min_pitch_radius=rho_min, min_radius_of_curvature=rho_c, min_radius_at=k_at,
         min_concave_radius=(1.0 / kc_max) if concave else None,

@@ -7,7 +7,8 @@ Conventions (docs/cam_design.md draws them):
   (seen from +Z) by theta, the existing "forward" cam angle.
 - r_b [m] is the prime-circle radius: from the cam axis to the roller centre
   at zero lift, so the roller centre is at (s0 + s, -e), s0 = sqrt(r_b^2 - e^2),
-  and the base circle of the cam contour has radius r_b - r_r.
+  and the base circle of the cam contour has radius r_b - r_r.  r_r = 0 is a knife edge (the contour is
+  the pitch curve).
 - e [m] is the offset (eccentricity).  e > 0 lowers the pressure angle on the
   rise and raises it on the return:  tan(alpha) = (s' - e) / (s0 + s).
 - Cam frame: fixed to the cam, equal to the fixed frame at theta = 0.  The
@@ -34,7 +35,7 @@ from typing import Protocol
 
 import numpy as np
 
-__all__ = ["DiscCam", "Program"]
+__all__ = ["DiscCam", "Program", "RollerCurves", "roller_radius_value"]
 
 
 class Program(Protocol):
@@ -52,13 +53,60 @@ def _positive(name: str, value: float, unit: str = "m") -> float:
     return value
 
 
-class DiscCam:
-    """A cam program on a disc: prime-circle radius r_b, roller radius r_r, offset e [m]."""
+def roller_radius_value(value: float) -> float:
+    """The roller radius r_r [m] checked: finite and >= 0 (0: a knife edge)."""
+    value = float(value)
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ValueError(f"roller_radius r_r must be a finite number >= 0 [m] (0: a knife edge), got {value!r}")
+    return value
+
+
+class RollerCurves:
+    """What every roller follower's cam derives from its pitch curve, its outward normal and the pitch
+    curve's signed curvature (``pitch``, ``normal``, ``pitch_curvature`` of the class): the contours, their
+    radii of curvature and the contour's base circle.  Needs ``base_radius`` and ``roller_radius`` [m]."""
+
+    base_radius: float
+    roller_radius: float
+
+    @property
+    def base_circle_radius(self) -> float:
+        """Radius of the cam contour's base circle, r_b - r_r [m]."""
+        return self.base_radius - self.roller_radius
+
+    def contour(self, theta, side: str = "inner"):
+        """Cam contour (x, y) [m]: 'inner' (plate cam surface, groove inner wall)
+        or 'outer' (groove outer wall), the pitch curve moved r_r along the normal."""
+        sign = _side_sign(side)
+        x, y = self.pitch(theta)
+        nx, ny = self.normal(theta)
+        return x + sign * self.roller_radius * nx, y + sign * self.roller_radius * ny
+
+    def pitch_radius_of_curvature(self, theta):
+        """Signed radius of curvature of the pitch curve rho_p [m] (inf where straight)."""
+        k = self.pitch_curvature(theta)
+        with np.errstate(divide="ignore"):
+            return np.divide(1.0, k) if np.ndim(k) else (math.inf if k == 0.0 else 1.0 / k)
+
+    def contour_radius_of_curvature(self, theta, side: str = "inner"):
+        """Signed radius of curvature of a contour [m]: rho_p - r_r (inner), rho_p + r_r (outer)."""
+        return self.pitch_radius_of_curvature(theta) + _side_sign(side) * self.roller_radius
+
+
+def _side_sign(side: str) -> float:
+    sign = {"inner": -1.0, "outer": 1.0}.get(side)
+    if sign is None:
+        raise ValueError(f"side must be 'inner' or 'outer', got {side!r}")
+    return sign
+
+
+class DiscCam(RollerCurves):
+    """A cam program on a disc: prime-circle radius r_b, roller radius r_r (0: a knife edge), offset e [m]."""
 
     def __init__(self, program: Program, base_radius: float, roller_radius: float,
                  offset: float = 0.0) -> None:
         r_b = _positive("base_radius (prime-circle radius r_b)", base_radius)
-        r_r = _positive("roller_radius r_r", roller_radius)
+        r_r = roller_radius_value(roller_radius)
         e = float(offset)
         if not math.isfinite(e) or abs(e) >= r_b:
             raise ValueError(f"offset e must satisfy |e| < r_b = {r_b * 1e3:.6g} mm, "
@@ -77,11 +125,6 @@ class DiscCam:
     def __repr__(self):
         return (f"DiscCam({self.program!r}, base_radius={self.base_radius!r}, "
                 f"roller_radius={self.roller_radius!r}, offset={self.offset!r})")
-
-    @property
-    def base_circle_radius(self) -> float:
-        """Radius of the cam contour's base circle, r_b - r_r [m]."""
-        return self.base_radius - self.roller_radius
 
     def _derivs(self, theta):
         if np.ndim(theta) == 0:
@@ -107,16 +150,6 @@ class DiscCam:
         c, sn = np.cos(theta), np.sin(theta)
         return nfx * c + nfy * sn, -nfx * sn + nfy * c
 
-    def contour(self, theta, side: str = "inner"):
-        """Cam contour (x, y) [m]: 'inner' (plate cam surface, groove inner wall)
-        or 'outer' (groove outer wall), the pitch curve moved r_r along the normal."""
-        sign = {"inner": -1.0, "outer": 1.0}.get(side)
-        if sign is None:
-            raise ValueError(f"side must be 'inner' or 'outer', got {side!r}")
-        x, y = self.pitch(theta)
-        nx, ny = self.normal(theta)
-        return x + sign * self.roller_radius * nx, y + sign * self.roller_radius * ny
-
     # -- curvature and pressure angle ------------------------------------------------
     def pitch_curvature(self, theta):
         """Signed curvature of the pitch curve [1/m]: > 0 convex, < 0 concave."""
@@ -125,19 +158,6 @@ class DiscCam:
         e = self.offset
         num = R * R + 2.0 * s1 * s1 - 3.0 * e * s1 + e * e - R * s2
         return num / ((s1 - e) ** 2 + R * R) ** 1.5
-
-    def pitch_radius_of_curvature(self, theta):
-        """Signed radius of curvature of the pitch curve rho_p [m] (inf where straight)."""
-        k = self.pitch_curvature(theta)
-        with np.errstate(divide="ignore"):
-            return np.divide(1.0, k) if np.ndim(k) else (math.inf if k == 0.0 else 1.0 / k)
-
-    def contour_radius_of_curvature(self, theta, side: str = "inner"):
-        """Signed radius of curvature of a contour [m]: rho_p - r_r (inner), rho_p + r_r (outer)."""
-        sign = {"inner": -1.0, "outer": 1.0}.get(side)
-        if sign is None:
-            raise ValueError(f"side must be 'inner' or 'outer', got {side!r}")
-        return self.pitch_radius_of_curvature(theta) + sign * self.roller_radius
 
     def pressure_angle(self, theta):
         """Signed pressure angle [rad]: between the contact normal and the follower

@@ -1,7 +1,8 @@
 """Export of a disc cam for manufacturing: contour points as CSV, curves as DXF.
 
-Coordinates: the cam frame at theta = 0 (origin on the cam axis, the follower
-along +X at theta = 0; see disc_cam), in mm.  Points at n equally spaced cam
+The cam is any follower type's (follower_types.make_cam: DiscCam, OscillatingRollerCam, TranslatingFlatCam,
+OscillatingFlatCam).  Coordinates: the cam frame at theta = 0 (origin on the cam axis, the follower's
+reference at zero lift on +X at theta = 0; see disc_cam), in mm.  Points at n equally spaced cam
 angles theta_k = 2 pi k / n, in the order of increasing theta (clockwise
 around the cam).
 
@@ -9,7 +10,8 @@ around the cam).
   the end (a closed polygon).
 - DXF (ezdxf, R2010, $INSUNITS = mm): one closed LWPOLYLINE (n vertices, no
   repeated point) on each layer CONTOUR (the inner contour, the plate cam's
-  surface), PITCH (the roller-centre path) and BASE_CIRCLE (radius r_b - r_r),
+  surface), PITCH (the roller-centre path; a flat face's reference point's) and BASE_CIRCLE (radius
+  r_b - r_r; a flat face's r_b),
   and with ``groove=True`` also CONTOUR_OUTER (the groove's outer wall).
 """
 

@@ -60,6 +60,18 @@ class FollowerPeaks:
                 "peak_jerk_at_deg": None if self.jerk_at is None else deg(self.jerk_at),
                 "jerk_unbounded": self.jerk_unbounded}
 
+    def arm_json_dict(self, scale: float) -> dict:
+        """The same peaks for an oscillating follower's arm, psi = scale * s (scale = lift_angle / lift
+        [rad/m]): rate [rad/s], angular acceleration [rad/s^2] and jerk [rad/s^3]."""
+        deg = math.degrees
+        return {"rpm": self.rpm, "omega_rad_s": self.omega,
+                "peak_arm_rate_rad_s": self.velocity * scale, "peak_arm_rate_at_deg": deg(self.velocity_at),
+                "peak_arm_acceleration_rad_s2": self.acceleration * scale,
+                "peak_arm_acceleration_at_deg": deg(self.acceleration_at),
+                "peak_arm_jerk_rad_s3": None if self.jerk is None else self.jerk * scale,
+                "peak_arm_jerk_at_deg": None if self.jerk_at is None else deg(self.jerk_at),
+                "jerk_unbounded": self.jerk_unbounded}
+
 
 def _best(cands):
     """(value, angle) of the largest value; ties -> the smallest angle."""

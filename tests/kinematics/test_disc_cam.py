@@ -144,7 +144,7 @@ def test_zero_lift_is_the_prime_circle_and_the_contour_base_circle():
 
 @pytest.mark.parametrize("kw, fragment", [
     (dict(base_radius=0.05, roller_radius=0.05), "roller_radius r_r = 50 mm must be < r_b = 50 mm"),
-    (dict(base_radius=0.05, roller_radius=0.0), "roller_radius r_r must be a finite number > 0"),
+    (dict(base_radius=0.05, roller_radius=-0.001), "roller_radius r_r must be a finite number >= 0"),
     (dict(base_radius=-1.0, roller_radius=0.01), "base_radius"),
     (dict(base_radius=0.05, roller_radius=0.01, offset=0.05), "|e| < r_b = 50 mm"),
     (dict(base_radius=0.05, roller_radius=0.01, offset=math.nan), "offset"),
@@ -155,3 +155,15 @@ def test_errors_name_the_parameter_and_the_range(kw, fragment):
     assert fragment in str(exc.value)
     with pytest.raises(ValueError, match="side must be 'inner' or 'outer'"):
         DiscCam(paper_program(), 0.1, 0.01).contour(0.0, "left")
+
+
+def test_a_knife_edge_is_a_roller_of_radius_zero():
+    """r_r = 0: the contour is the pitch curve, its radius of curvature the pitch curve's, nothing undercuts."""
+    from cam_fmu.kinematics.design_checks import check_design
+
+    cam = DiscCam(paper_program(), 0.1, 0.0, 0.01)
+    th = np.linspace(0.0, 2 * math.pi, 721)
+    assert np.array_equal(np.array(cam.contour(th)), np.array(cam.pitch(th)))
+    assert np.array_equal(cam.contour_radius_of_curvature(th), cam.pitch_radius_of_curvature(th))
+    rep = check_design(cam)
+    assert not rep.undercut and rep.min_radius_of_curvature == rep.min_pitch_radius > 0.0
