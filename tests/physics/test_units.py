@@ -1,0 +1,45 @@
+"""physics/units.py, the one table of units: every unit a value may be given in converts by the closed conversion
+(tests/display_units.py's table, written from the units' definitions), and the parser's refusals name the reason."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from cam_fmu.physics import units
+from display_units import CLOSED
+
+
+def test_every_alternative_unit_converts_by_its_closed_factor():
+    seen = set()
+    for unit, spec in units.UNITS.items():
+        for name, _factor, _offset in spec.alternatives:
+            si, factor = CLOSED[name]
+            assert si == unit
+            for text in (f"2.5{name}", f" 2.5 {name} ", f"25e-1{name}", f"-2.5{name}"):
+                sign = -1.0 if text.strip().startswith("-") else 1.0
+                assert math.isclose(units.to_si("x", unit, text), sign * 2.5 / factor, rel_tol=1e-15), text
+            seen.add(name)
+        if unit != "1":
+            assert units.to_si("x", unit, f"2.5{unit}") == 2.5  # the SI unit itself
+    assert seen == set(CLOSED)
+
+
+def test_a_plain_number_is_si_and_text_without_a_number_is_refused():
+    assert units.to_si("c", "m", "1e-3") == 1e-3 and units.to_si("c", "m", "-0.5") == -0.5
+    for text in ("mm", "", "1.2.3mm", "--1mm"):
+        with pytest.raises(ValueError):
+            units.to_si("c", "m", text)
+
+
+def test_display_units_are_rpm_deg_and_mm():
+    assert units.display_unit("rad/s") == ("rpm", 60.0 / (2.0 * math.pi), 0.0)
+    assert units.display_unit("rad") == ("deg", 180.0 / math.pi, 0.0)
+    assert units.display_unit("m") == ("mm", 1000.0, 0.0)
+    assert {u for u in units.UNITS if units.display_unit(u)} == {"rad/s", "rad", "m"}
+
+
+def test_quantity_type_names_are_distinct():
+    names = [spec.type_name for spec in units.UNITS.values()]
+    assert len(set(names)) == len(names) and units.UNITS["rad/s"].type_name == "AngularVelocity"
+
