@@ -323,16 +323,18 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
 
 
 def markdown_table() -> str:
-    """The table of every FMU variable in docs/fmu.md: name, causality, type, unit, default, allowed range."""
-    lines = ["| name | causality | type | unit | default | allowed | description |",
-             "|---|---|---|---|---|---|---|"]
+    """The table of every FMU variable in docs/fmu.md: name, causality, type, unit, display unit, default, allowed
+    range."""
+    lines = ["| name | causality | type | unit | shown in | default | allowed | description |",
+             "|---|---|---|---|---|---|---|---|"]
     for row in variable_rows():
         default = "" if row["start"] is None else _fmt(row["start"] if row["type"] != "Real" else float(row["start"]))
         if row["type"] == "Real" and row["start"] is not None:
             default = f"{float(row['start']):.6g}"
-        lines.append("| `{name}` | {causality} | {type} | {unit} | {default} | {allowed} | {description} |".format(
+        shown = display_unit(row["unit"]) if row["type"] == "Real" else None
+        lines.append("| `{name}` | {causality} | {type} | {unit} | {shown} | {default} | {allowed} | {description} |".format(
             name=row["name"], causality=row["causality"], type=row["type"], unit=row["unit"] or "",
-            default=default, allowed=row["allowed"].replace("|", "\\|"),
+            shown=shown[0] if shown else "", default=default, allowed=row["allowed"].replace("|", "\\|"),
             description=row["description"].replace("|", "\\|")))
     return "\n".join(lines)
 

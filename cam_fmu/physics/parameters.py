@@ -83,10 +83,19 @@ class ParameterSpec:
         if self.zero_ok and number == 0.0:
             return 0.0
         if not math.isfinite(number) or too_low or number > self.high:
-            given = f" (given {value!r})" if isinstance(value, str) and value.strip() != repr(number) else ""
+            given = f" (given {value!r})" if isinstance(value, str) and not _plain_number(value) else ""
             raise ParameterError(f"parameter {self.name!r} = {number!r} [{self.unit}]{given} is outside the allowed "
                                  f"range {self.allowed()}")
         return number
+
+
+def _plain_number(text: str) -> bool:
+    """True where ``text`` is a number without a unit."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table

@@ -109,3 +109,13 @@ def to_si(name: str, unit: str, text: str) -> float:
     article = "an" if spec.quantity[:1] in "aeiou" else "a"
     raise UnitError(f"{name} is {article} {spec.quantity} in {unit}; give {', '.join(accepted(unit))} "
                     f"(not {given!r})")
+
+
+def markdown_table() -> str:
+    """The docs' table of units (docs/scenes.md): SI unit, quantity, the other units a value may be given in, the
+    display unit FMI tools show."""
+    lines = ["| unit | quantity | a value may also be given in | FMI tools show it in |", "|---|---|---|---|"]
+    for unit, spec in UNITS.items():
+        others = ", ".join(f"`{alt[0]}`" for alt in spec.alternatives) or ("a plain number only" if unit == "1" else "-")
+        lines.append(f"| `{unit}` | {spec.quantity} | {others} | `{spec.display or unit}` |")
+    return "\n".join(lines)

@@ -43,3 +43,11 @@ def test_quantity_type_names_are_distinct():
     names = [spec.type_name for spec in units.UNITS.values()]
     assert len(set(names)) == len(names) and units.UNITS["rad/s"].type_name == "AngularVelocity"
 
+
+
+def test_docs_units_table_is_the_generated_one():
+    """docs/scenes.md's table of units is ``units.markdown_table()``: it cannot drift from the code."""
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "scenes.md").read_text(encoding="utf-8")
+    assert units.markdown_table().strip() in doc
