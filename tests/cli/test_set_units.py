@@ -24,7 +24,7 @@ C_REFUSED = "c is a length in m; give m, mm, cm, um (not 'rpm')"
     (["jump", "spring_jump", "--set", "c=3rpm"], "jump"),
     (["cosim", "--set", "cam.c=3rpm", "--no-plot"], "cosim"),
     (["sweep", "paper_fig6", "--vary", "c=0:3rpm:3"], "sweep"),
-])
+], ids=["simulate", "bode", "reflect", "jump", "cosim", "sweep"])
 def test_every_command_refuses_a_unit_of_another_quantity_naming_the_parameters_unit(args, command, tmp_path):
     proc = subprocess.run(["cam-fmu", *args, "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2, proc.stderr
@@ -76,7 +76,7 @@ def test_set_converts_to_the_parameters_unit_as_a_plain_number_would_be_taken():
     ("c=500mm", "'c' = 0.5 [m] (given '500mm') is outside the allowed range [0, 0.1] m"),
     ("c=mm", "'c' = 'mm' is not a number"),
     ("rise_law=3mm", "allowed one of"),
-])
+], ids=["dimensionless", "unknown-unit", "angle-in-rpm", "out-of-range", "no-number", "text-parameter"])
 def test_set_refuses_with_the_reason(text, message):
     from cam_fmu.cli.simulate import apply_sets
 

@@ -49,7 +49,7 @@ def test_pi_speed_fmu_shows_its_speeds_in_rpm(pi_speed_fmu_path):
     (lambda xml: xml.replace(b'displayUnit="rpm" min=', b'displayUnit="furlong" min=', 1), "display unit"),
     (lambda xml: xml.replace(b'<DisplayUnit name="mm" factor="1000.0"/>', b"", 1), "display unit"),
     (lambda xml: xml.replace(b'<DisplayUnit name="deg"', b'<DisplayUnit nom="deg"', 1), "nom"),
-])
+], ids=["undefined-display-unit", "display-unit-removed", "attribute-not-in-schema"])
 def test_the_validation_catches_a_broken_display_unit(cam_fmu_path, tmp_path, change, problem):
     """The checks above can fail: fmpy's validation (its XSD and unit rules) reports a display unit that is not
     defined, and the schema an attribute it does not know."""
