@@ -51,3 +51,63 @@ def test_docs_units_table_is_the_generated_one():
 
     doc = (Path(__file__).resolve().parents[2] / "docs" / "scenes.md").read_text(encoding="utf-8")
     assert units.markdown_table().strip() in doc
+
+
+# The SI definitions of the symbols the units are written with (N = kg m / s2, V = W / A, Ohm = V / A, H = Wb / A).
+SYMBOLS = {"kg": {"kg": 1}, "m": {"m": 1}, "s": {"s": 1}, "A": {"A": 1}, "rad": {"rad": 1},
+           "N": {"kg": 1, "m": 1, "s": -2}, "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
+           "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2}, "H": {"kg": 1, "m": 2, "s": -2, "A": -2}}
+
+
+def _exponents(text: str) -> dict[str, int]:
+    """Base-unit exponents of a unit written as in the table: products '.', quotients '/', powers 'm2', '(...)'."""
+    import re
+
+    tokens = re.findall(r"[A-Za-z]+\d*|[./()]", text)
+    pos = 0
+
+    def factor() -> dict[str, int]:
+        nonlocal pos
+        if tokens[pos] == "(":
+            pos += 1
+            inner = expr()
+            assert tokens[pos] == ")"
+            pos += 1
+            return inner
+        name, power = re.fullmatch(r"([A-Za-z]+)(\d*)", tokens[pos]).groups()
+        pos += 1
+        return {k: v * int(power or 1) for k, v in SYMBOLS[name].items()}
+
+    def combine(a: dict[str, int], b: dict[str, int], sign: int) -> dict[str, int]:
+        out = dict(a)
+        for k, v in b.items():
+            out[k] = out.get(k, 0) + sign * v
+        return {k: v for k, v in out.items() if v}
+
+    def term() -> dict[str, int]:
+        nonlocal pos
+        result = factor()
+        while pos < len(tokens) and tokens[pos] == ".":
+            pos += 1
+            result = combine(result, factor(), 1)
+        return result
+
+    def expr() -> dict[str, int]:
+        nonlocal pos
+        result = term()
+        while pos < len(tokens) and tokens[pos] == "/":
+            pos += 1
+            result = combine(result, term(), -1)
+        return result
+
+    found = expr()
+    assert pos == len(tokens), text
+    return found
+
+
+def test_every_units_base_exponents_follow_from_its_name():
+    """The table's BaseUnit exponents (what an FMI tool converts with) against the unit's name read with the SI
+    definitions of its symbols: N.m.s/rad = kg m2 s-1 rad-1, V/(rad/s) = kg m2 s-2 A-1 rad-1, ..."""
+    for unit, spec in units.UNITS.items():
+        expected = {} if unit == "1" else _exponents(unit)
+        assert dict(spec.base) == expected, unit
