@@ -39,7 +39,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p = subparsers.add_parser("bode", help="frequency response from the motor voltage to the motor and cam speed",
                               description="Small-signal frequency response of a scene's drive around an operating point.")
     p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. compliant_shaft) or a scene file (.toml)")
-    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="override a parameter (repeatable); a value may carry its unit, "
+                   "e.g. --set k_shaft=50 --set c=0.5mm")
     point = p.add_mutually_exclusive_group()
     point.add_argument("--theta", type=float, metavar="DEG", help="freeze the cam at this angle [deg] (default 0)")
     point.add_argument("--u0", type=float, metavar="V", help="let the cam turn under this constant voltage [V]")

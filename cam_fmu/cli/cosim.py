@@ -33,7 +33,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--step-size", type=float, default=None, metavar="H",
                    help="override the SSP's communication step [s]")
     p.add_argument("--set", action="append", default=[], metavar="COMP.NAME=VALUE",
-                   help="parameter value for a component (repeatable), e.g. controller.kp=5 or cam.m=0.6")
+                   help="parameter value for a component (repeatable), e.g. controller.kp=5 or cam.m=0.6; a value "
+                        "may carry its unit, e.g. controller.omega_set=600rpm")
     p.add_argument("--gains", metavar="KP:KI,...", default=None,
                    help="run once per controller gain pair, e.g. 1:10,2:20,5:50 [V/(rad/s)]:[V/rad]")
     p.add_argument("--feedforward", choices=("off", "on", "both"), default=None,

@@ -36,7 +36,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                                           "'spring') at constant speed.")
     p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. spring_jump) or a scene file (.toml)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a parameter (repeatable), e.g. --set k_spring=3000")
+                   help="override a parameter (repeatable), e.g. --set k_spring=3000; a value may carry its unit, "
+                        "e.g. --set k_spring=3N/mm")
     p.add_argument("--rpm", type=float, default=None, help="cam speed [1/min] at which to report the margin")
     p.add_argument("--target-rpm", type=float, default=None,
                    help="cam speed [1/min] the spring must hold: the preload and rate it needs")

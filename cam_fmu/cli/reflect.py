@@ -29,7 +29,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                               description="The reflected-load map of a scene's cam drive at a constant cam speed.")
     p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. paper_fig6) or a scene file (.toml)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a parameter (repeatable), e.g. --set m=0.6")
+                   help="override a parameter (repeatable), e.g. --set m=0.6; a value may carry its unit, "
+                        "e.g. --set m=600g")
     p.add_argument("--rpm", type=float, default=60.0, help="cam speed [1/min] (default 60)")
     p.add_argument("--points", type=int, default=3600, help="angles over the turn (default 3600)")
     p.add_argument("--json", action="store_true", help="print the extremes as JSON")

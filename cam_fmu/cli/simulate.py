@@ -5,7 +5,8 @@ further run) and DIR/<scene>.png (the scene's figure). CSV columns: time, then
 theta, omega, s, i, M, J, then the remaining outputs of physics.variables.OUTPUTS, all in
 SI units, named in the header: ``time [s],theta [rad],omega [rad/s],...``
 (experiments.columns; the units come from physics.variables.UNITS).
-``--set NAME=VALUE`` (repeatable) overrides a parameter in every run of the scene.
+``--set NAME=VALUE`` (repeatable) overrides a parameter in every run of the scene; a value may carry a unit of
+the parameter's quantity (``omega0=600rpm``, ``c=0.5mm``: physics/units.py, through ParameterSpec.check).
 
 Progress: a bar on stderr (experiments.progress.ProgressBar), per run on the
 reference engine and per communication step on the FMU, drawn only when stderr
@@ -36,7 +37,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("--fmu", metavar="FILE.fmu", default=None, help="FMU to run with --engine fmu (default: models/cam.fmu in a checkout, else a user cache)")
     p.add_argument("--stop-time", type=float, default=None, metavar="T", help="override the scene's stop_time [s]")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="override a parameter in every run (repeatable), e.g. --set m=0.6 --set rise_law=cycloidal")
+                   help="override a parameter in every run (repeatable), e.g. --set m=0.6 --set rise_law=cycloidal; "
+                        "a value may carry its unit, e.g. --set omega0=600rpm --set c=0.5mm")
     p.add_argument("--no-plot", action="store_true", help="write the CSV files only")
     return p
 

@@ -41,7 +41,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     p.add_argument("scene", metavar="SCENE", help="a shipped scene's name (e.g. paper_fig6) or a scene file (.toml)")
     p.add_argument("--vary", action="append", required=True, metavar="NAME=START:STOP:N|NAME=LOW:HIGH|NAME=a,b,c",
                    help="a parameter and its values (repeatable): N values from START to STOP (a grid), a range "
-                        "LOW:HIGH (--sample, --sensitivity), or a list (categorical)")
+                        "LOW:HIGH (--sample, --sensitivity), or a list (categorical); values may carry their unit, "
+                        "e.g. c=0mm:0.5mm:6")
     design = p.add_mutually_exclusive_group()
     design.add_argument("--sample", metavar="KIND:N", default=None,
                         help="N cases sampled over the ranges: lhs:N (Latin hypercube), sobol:N (scrambled Sobol), "

@@ -61,7 +61,7 @@ class Run:
     """One simulation of a scene: its label and its parameters."""
 
     label: str
-    overrides: dict[str, Any]  # scene [parameters] + drive + this run's overrides, as written
+    overrides: dict[str, Any]  # scene [parameters] + drive + this run's overrides, checked (SI units)
     params: dict[str, Any]  # every parameter, resolved and checked
 
     def start_values(self) -> dict[str, Any]:
@@ -201,7 +201,8 @@ def _run(label: str, overrides: dict[str, Any], where: str, ctx: str) -> Run:
         resolved = _parameters.resolve(overrides)
     except _parameters.ParameterError as exc:
         raise SceneError(f"{where}: {ctx}: {exc}") from None
-    return Run(label=label, overrides=dict(overrides), params=resolved)
+    # a value written with a unit (c = "0.5 mm") is kept as the checked SI value: every run reads numbers
+    return Run(label=label, overrides={name: resolved[name] for name in overrides}, params=resolved)
 
 
 def check_drive_inputs(drive: str, u: Signal | None, omega_ref: Signal | None, where: str) -> None:

@@ -20,6 +20,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 
 from ..physics import parameters as _parameters
+from ..physics.units import UnitError, to_si
 from .limits import MAX_CASES
 
 SAMPLERS = ("lhs", "sobol", "random")
@@ -62,7 +63,9 @@ def parse_vary(text: str) -> Vary:
             parts = spec.split(":")
             if len(parts) == 2:
                 try:
-                    low, high = float(parts[0]), float(parts[1])
+                    low, high = _number(pspec, parts[0]), _number(pspec, parts[1])
+                except _parameters.ParameterError:
+                    raise
                 except ValueError:
                     raise SweepError(f"--vary {text!r}: expected NAME=LOW:HIGH with numbers LOW < HIGH") from None
                 if not low < high:
@@ -71,9 +74,11 @@ def parse_vary(text: str) -> Vary:
                 pspec.check(low), pspec.check(high)
                 return Vary(name, low=low, high=high, kind="range", text=text)
             try:
-                start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
+                start, stop, n = _number(pspec, parts[0]), _number(pspec, parts[1]), int(parts[2])
                 if len(parts) != 3:
                     raise ValueError
+            except _parameters.ParameterError:
+                raise
             except (ValueError, IndexError):
                 raise SweepError(f"--vary {text!r}: expected NAME=START:STOP:N with numbers START, STOP "
                                  "and an integer N >= 1, or NAME=LOW:HIGH") from None
@@ -85,6 +90,15 @@ def parse_vary(text: str) -> Vary:
         return Vary(name, tuple(pspec.check(v.strip()) for v in spec.split(",")), kind="list", text=text)
     except _parameters.ParameterError as exc:
         raise SweepError(f"--vary {text!r}: {exc}") from None
+
+
+def _number(pspec: _parameters.ParameterSpec, text: str) -> float:
+    """A --vary bound in the parameter's SI unit: a number, or a number with a unit of its quantity ('0.5mm');
+    ValueError where it is no number, ParameterError naming the parameter's unit where the unit does not fit."""
+    try:
+        return to_si(pspec.name, pspec.unit, text)
+    except UnitError as exc:
+        raise _parameters.ParameterError(f"parameter {pspec.name!r} = {text.strip()!r}: {exc}") from None
 
 
 def parse_sample(text: str) -> tuple[str, int]:

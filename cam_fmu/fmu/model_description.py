@@ -5,8 +5,9 @@ Outputs list, but no units, no min/max, no InitialUnknowns and Real starts with
 only 16 significant digits. ``postprocess`` adds what the Reference FMUs have:
 
 - a model description, the DefaultExperiment of the paper's fig. 6 scene;
-- ``<UnitDefinitions>`` (with SI base-unit exponents where known) and ``unit=``
-  on every Real that has a unit;
+- ``<UnitDefinitions>`` (SI base-unit exponents and the display units of each unit, physics/units.py),
+  ``<TypeDefinitions>`` (one type per quantity) and ``declaredType``/``unit``/``displayUnit``
+  on every Real that has a unit (angles shown in deg, angular velocities in rpm, lengths in mm);
 - explicit causality, variability and initial on every variable (FMI 2.0 forbids
   ``initial`` on inputs, so inputs carry causality, variability and start);
 - ``min``/``max`` on parameters with finite bounds, exact (repr) start values;
@@ -23,36 +24,62 @@ from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 from ..physics import parameters
+from ..physics.units import BASE_UNIT_ORDER, UNITS, display_unit
 from ..physics.variables import (EVENT_INDICATORS, FEEDTHROUGH, FEEDTHROUGH_INPUTS, INPUT_RANGES, INPUTS, OUTPUTS,
                                  STATES)
 
-# SI base-unit exponents of the units used by the model (FMI 2.0 BaseUnit attributes).
-BASE_UNITS: Dict[str, Dict[str, int]] = {
-    "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
-    "A": {"A": 1},
-    "Ohm": {"kg": 1, "m": 2, "s": -3, "A": -2},
-    "H": {"kg": 1, "m": 2, "s": -2, "A": -2},
-    "V/(rad/s)": {"kg": 1, "m": 2, "s": -2, "A": -1, "rad": -1},
-    "V/rad": {"kg": 1, "m": 2, "s": -3, "A": -1, "rad": -1},
-    "N.m/A": {"kg": 1, "m": 2, "s": -2, "A": -1},
-    "kg.m2": {"kg": 1, "m": 2},
-    "N.m": {"kg": 1, "m": 2, "s": -2},
-    "N.m/rad": {"kg": 1, "m": 2, "s": -2, "rad": -1},
-    "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
-    "N": {"kg": 1, "m": 1, "s": -2},
-    "N/m": {"kg": 1, "s": -2},
-    "kg": {"kg": 1},
-    "m": {"m": 1},
-    "m/s": {"m": 1, "s": -1},
-    "m/s2": {"m": 1, "s": -2},
-    "s": {"s": 1},
-    "rad": {"rad": 1},
-    "rad/s": {"rad": 1, "s": -1},
-    "rad/s2": {"rad": 1, "s": -2},
-    "A/s": {"A": 1, "s": -1},
-    "1": {},
-}
-BASE_UNIT_ORDER = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+
+def unit_definitions(units: List[str]) -> ET.Element:
+    """<UnitDefinitions> of the SI ``units`` (physics.units.UNITS, FMI 2.0 and 3.0 alike): each with its base-unit
+    exponents and, as <DisplayUnit>s, every unit a value of it may be given in (display = factor * SI + offset)."""
+    element = ET.Element("UnitDefinitions")
+    for unit in sorted(units):
+        if unit not in UNITS:
+            raise ValueError(f"unit {unit!r} has no entry in physics.units.UNITS (its SI base-unit exponents)")
+        spec = UNITS[unit]
+        node = ET.SubElement(element, "Unit", name=unit)
+        exponents = dict(spec.base)
+        if exponents:
+            ET.SubElement(node, "BaseUnit", {k: str(exponents[k]) for k in BASE_UNIT_ORDER if k in exponents})
+        for name, factor, offset in spec.alternatives:
+            attrs = {"name": name, "factor": repr(factor)}
+            if offset:
+                attrs["offset"] = repr(offset)
+            ET.SubElement(node, "DisplayUnit", attrs)
+    return element
+
+
+def typed_units(units: List[str]) -> List[str]:
+    """The units that get a declared type (their quantity): every one of UNITS but the dimensionless '1'."""
+    return sorted(unit for unit in units if unit in UNITS and unit != "1")
+
+
+def type_definitions(units: List[str], fmi3: bool = False) -> ET.Element:
+    """<TypeDefinitions>: one real type per quantity of ``units`` (typed_units) with its quantity, unit and display
+    unit (FMI 2.0 <SimpleType><Real .../>, FMI 3.0 <Float64Type .../>)."""
+    element = ET.Element("TypeDefinitions")
+    for unit in typed_units(units):
+        spec = UNITS[unit]
+        attrs = {"quantity": spec.quantity, "unit": unit}
+        if display_unit(unit) is not None:
+            attrs["displayUnit"] = spec.display
+        if fmi3:
+            ET.SubElement(element, "Float64Type", {"name": spec.type_name, **attrs})
+        else:
+            ET.SubElement(ET.SubElement(element, "SimpleType", name=spec.type_name), "Real", attrs)
+    return element
+
+
+def unit_attributes(unit: str) -> Dict[str, str]:
+    """A Real variable's declaredType, unit and displayUnit (FMI 2.0 and 3.0) for its SI ``unit`` ('' : none)."""
+    if not unit:
+        return {}
+    attrs = {"unit": unit}
+    if unit in UNITS and unit != "1":
+        attrs["declaredType"] = UNITS[unit].type_name
+    if display_unit(unit) is not None:
+        attrs["displayUnit"] = UNITS[unit].display
+    return attrs
 
 
 def variable_rows() -> List[Dict[str, Any]]:
@@ -154,21 +181,15 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
         root.set("description", description)
     rows = {row["name"]: row for row in (variable_rows() if rows is None else rows)}
 
-    # UnitDefinitions right after CoSimulation (schema order).
-    for old in root.findall("UnitDefinitions"):
+    # UnitDefinitions and TypeDefinitions right after CoSimulation (schema order).
+    for old in root.findall("UnitDefinitions") + root.findall("TypeDefinitions"):
         root.remove(old)
     units = sorted({row["unit"] for row in rows.values() if row["type"] == "Real" and row["unit"]})
-    unit_defs = ET.Element("UnitDefinitions")
-    for unit in units:
-        node = ET.SubElement(unit_defs, "Unit", name=unit)
-        if unit not in BASE_UNITS:
-            raise ValueError(f"unit {unit!r} has no entry in BASE_UNITS (its SI base-unit exponents)")
-        exps = BASE_UNITS[unit]
-        if exps:
-            ET.SubElement(node, "BaseUnit", {k: str(exps[k]) for k in BASE_UNIT_ORDER if k in exps})
     children = list(root)
     cosim_index = next(i for i, c in enumerate(children) if c.tag == "CoSimulation")
-    root.insert(cosim_index + 1, unit_defs)
+    root.insert(cosim_index + 1, unit_definitions(units))
+    if typed_units(units):
+        root.insert(cosim_index + 2, type_definitions(units))
 
     # DefaultExperiment before ModelVariables.
     for old in root.findall("DefaultExperiment"):
@@ -196,8 +217,9 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
         if typed is None:
             raise ValueError(f"FMU variable {name!r} is not of type {row['type']}")
         typed.attrib.clear()
-        if row["type"] == "Real" and row["unit"]:
-            typed.set("unit", row["unit"])
+        if row["type"] == "Real":
+            for key, value in unit_attributes(row["unit"]).items():
+                typed.set(key, value)
         if row["min"] is not None:
             typed.set("min", _fmt(float(row["min"])))
         if row["max"] is not None:
@@ -301,16 +323,18 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
 
 
 def markdown_table() -> str:
-    """The table of every FMU variable in docs/fmu.md: name, causality, type, unit, default, allowed range."""
-    lines = ["| name | causality | type | unit | default | allowed | description |",
-             "|---|---|---|---|---|---|---|"]
+    """The table of every FMU variable in docs/fmu.md: name, causality, type, unit, display unit, default, allowed
+    range."""
+    lines = ["| name | causality | type | unit | shown in | default | allowed | description |",
+             "|---|---|---|---|---|---|---|---|"]
     for row in variable_rows():
         default = "" if row["start"] is None else _fmt(row["start"] if row["type"] != "Real" else float(row["start"]))
         if row["type"] == "Real" and row["start"] is not None:
             default = f"{float(row['start']):.6g}"
-        lines.append("| `{name}` | {causality} | {type} | {unit} | {default} | {allowed} | {description} |".format(
+        shown = display_unit(row["unit"]) if row["type"] == "Real" else None
+        lines.append("| `{name}` | {causality} | {type} | {unit} | {shown} | {default} | {allowed} | {description} |".format(
             name=row["name"], causality=row["causality"], type=row["type"], unit=row["unit"] or "",
-            default=default, allowed=row["allowed"].replace("|", "\\|"),
+            shown=shown[0] if shown else "", default=default, allowed=row["allowed"].replace("|", "\\|"),
             description=row["description"].replace("|", "\\|")))
     return "\n".join(lines)
 

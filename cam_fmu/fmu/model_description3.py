@@ -2,22 +2,21 @@
 
 Build time only. One source for names, value references, units, ranges and defaults
 (``model_description.variable_rows``, generated from physics/parameters.py and variables.py), the
-same unit definitions, log categories and default experiment; what FMI 3.0 adds is used where it
-helps a user: display units (rpm for rad/s, deg for rad) that a tool can show instead of SI, and the
-instantiation token checked by the binary. No event mode, no early return, no clocks, no arrays:
+same unit and type definitions (display units: rpm for rad/s, deg for rad, mm for m; physics/units.py), log
+categories and default experiment; what FMI 3.0 adds is used where it helps a user: the instantiation token checked
+by the binary. No event mode, no early return, no clocks, no arrays:
 the drive is a fixed set of scalars stepped synchronously (docs/fmu.md, "cam3.fmu").
 """
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, List
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
-from .model_description import BASE_UNIT_ORDER, BASE_UNITS, LOG_CATEGORIES, experiment_element
+from .model_description import (LOG_CATEGORIES, experiment_element, type_definitions, typed_units, unit_attributes,
+                                unit_definitions)
 
-# Display units: (name, factor) with display value = factor * SI value.
-DISPLAY_UNITS: Dict[str, Tuple[str, float]] = {"rad/s": ("rpm", 60.0 / (2.0 * math.pi)), "rad": ("deg", 180.0 / math.pi)}
 TYPES = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}
 
 
@@ -38,15 +37,10 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
                   providesAdjointDerivatives="false", hasEventMode="false",
                   canReturnEarlyAfterIntermediateUpdate="false", providesIntermediateUpdate="false",
                   needsCompletedIntegratorStep="false", maxOutputDerivativeOrder="0")
-    units = ET.SubElement(root, "UnitDefinitions")
-    for unit in sorted({row["unit"] for row in rows if row["unit"]}):
-        element = ET.SubElement(units, "Unit", name=unit)
-        exponents = BASE_UNITS.get(unit)
-        if exponents is not None:
-            ET.SubElement(element, "BaseUnit", {k: str(exponents[k]) for k in BASE_UNIT_ORDER if exponents.get(k)})
-        if unit in DISPLAY_UNITS:
-            name, factor = DISPLAY_UNITS[unit]
-            ET.SubElement(element, "DisplayUnit", name=name, factor=repr(factor))
+    units = sorted({row["unit"] for row in rows if row["unit"]} | {"s"})  # 's': the variable 'time'
+    root.append(unit_definitions(units))
+    if typed_units(units):
+        root.append(type_definitions(units, fmi3=True))
     categories = ET.SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES:
         ET.SubElement(categories, "Category", name=name, description=text.replace("fmi2", "fmi3"))
@@ -54,7 +48,7 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
     variables = ET.SubElement(root, "ModelVariables")
     # the independent variable FMI 3.0 asks for, after the whole table (value reference TIME_VR)
     ET.SubElement(variables, "Float64", name="time", valueReference=str(time_vr), causality="independent",
-                  variability="continuous", unit="s", description="simulation time")
+                  variability="continuous", description="simulation time", **unit_attributes("s"))
     for vr, row in enumerate(rows):
         variables.append(_variable(vr, row))
     structure = ET.SubElement(root, "ModelStructure")
@@ -73,10 +67,7 @@ def _variable(vr: int, row: Dict[str, Any]) -> ET.Element:
         attrs["initial"] = row["initial"]
     kind = TYPES[row["type"]]
     if kind == "Float64":
-        if row["unit"]:
-            attrs["unit"] = row["unit"]
-            if row["unit"] in DISPLAY_UNITS:
-                attrs["displayUnit"] = DISPLAY_UNITS[row["unit"]][0]
+        attrs.update(unit_attributes(row["unit"]))
         for key in ("min", "max"):
             if row[key] is not None and math.isfinite(row[key]):
                 attrs[key] = repr(float(row[key]))
@@ -93,4 +84,4 @@ def _variable(vr: int, row: Dict[str, Any]) -> ET.Element:
     return element
 
 
-__all__ = ["DISPLAY_UNITS", "model_description"]
+__all__ = ["model_description"]

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping
 
 from ..kinematics.presets import PRESETS
+from .units import UnitError, to_si
 
 KGF = 9.80665  # N per kgf: the paper's c_m = 0.015 is in kgf m/A (docs/model.md section 3)
 PAPER_A = 0.035  # m, the paper's profile constant A
@@ -57,7 +58,8 @@ class ParameterSpec:
         return f"{zero}{left}{self.low:g}, {self.high:g}]" + (f" {self.unit}" if self.unit not in ("", "1") else "")
 
     def check(self, value: Any) -> Any:
-        """Return the value converted to its kind, or raise ParameterError."""
+        """Return the value converted to its kind, or raise ParameterError. A real given as text may carry a unit of
+        its quantity ('600rpm', '0.5 mm': physics/units.py); it is returned in the parameter's SI unit."""
         if self.kind == "boolean":
             if isinstance(value, str):
                 if value.lower() in ("true", "1", "yes", "on"):
@@ -72,15 +74,28 @@ class ParameterSpec:
                 raise ParameterError(f"parameter {self.name!r} = {value!r}: allowed {self.allowed()}")
             return text
         try:
-            number = float(value)
+            number = to_si(self.name, self.unit, value) if isinstance(value, str) else float(value)
+        except UnitError as exc:
+            raise ParameterError(f"parameter {self.name!r} = {value!r}: {exc}") from None
         except (TypeError, ValueError):
             raise ParameterError(f"parameter {self.name!r} = {value!r} is not a number: allowed {self.allowed()}") from None
         too_low = number <= self.low if self.low_open else number < self.low
         if self.zero_ok and number == 0.0:
             return 0.0
         if not math.isfinite(number) or too_low or number > self.high:
-            raise ParameterError(f"parameter {self.name!r} = {number!r} [{self.unit}] is outside the allowed range {self.allowed()}")
+            given = f" (given {value!r})" if isinstance(value, str) and not _plain_number(value) else ""
+            raise ParameterError(f"parameter {self.name!r} = {number!r} [{self.unit}]{given} is outside the allowed "
+                                 f"range {self.allowed()}")
         return number
+
+
+def _plain_number(text: str) -> bool:
+    """True where ``text`` is a number without a unit."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table

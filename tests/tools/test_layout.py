@@ -6,11 +6,11 @@ import re
 from pathlib import Path
 
 from cam_fmu.engine.solvers import SOLVERS
-from cam_fmu.fmu.model_description import BASE_UNITS
 from cam_fmu.kinematics.presets import PRESETS
 from cam_fmu.physics import parameters
 from cam_fmu.physics.formulations import FORMULATIONS
-from cam_fmu.physics.variables import INPUTS, OUTPUTS
+from cam_fmu.physics.units import UNITS
+from cam_fmu.physics.variables import INPUTS, OUTPUTS, STATES
 
 PACKAGE = Path(__file__).resolve().parents[2] / "cam_fmu"
 MODULES = sorted(p for p in PACKAGE.rglob("*.py") if "__pycache__" not in p.parts)
@@ -30,9 +30,12 @@ def test_every_formulation_has_a_reference():
 
 
 def test_every_unit_in_use_has_base_units():
-    units = {p.unit for p in parameters.PARAMETERS if p.kind == "real"}
-    units |= {row[1] for row in INPUTS} | {row[1] for row in OUTPUTS}
-    assert units - set(BASE_UNITS) == set()
+    from cam_fmu.control import pi
+
+    units = {p.unit for p in (*parameters.PARAMETERS, *pi.PARAMETERS) if p.kind == "real"}
+    units |= {row[1] for row in (*INPUTS, *OUTPUTS, *pi.INPUTS, *pi.OUTPUTS)}
+    units |= {row[k] for row in STATES for k in (1, 2)}
+    assert units - set(UNITS) == set()
 
 
 def test_no_module_over_400_lines():
