@@ -30,37 +30,37 @@ from __future__ import annotations
 
 import math
 
-from .drive import solve_guide_friction
-from .follower import Impact, closing_force, impact
-from .speed_follower import ZENO_HEIGHT
+from .drive import sign as sgn, solve_guide_friction
+from .follower import FlankFollower, Impact, closing_force, impact
+from .modes import Mode, Shaft
 from .variables import output_record
 
 
-def sgn(x: float) -> float:
-    """+1, -1 or 0."""
-    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
-
-
-class VoltageFollower:
+class VoltageFollower(FlankFollower):
     """The hybrid system of a follower of its own on a voltage-driven cam (``contact`` +1, -1 on a flank, 0 off).
 
     The state y is (theta, omega, i, s, v), with (phi, omega_m) after it on a compliant shaft (``size`` 7).
     """
 
     def __init__(self, model) -> None:
-        self.model = model
-        self.program = model.program
-        self.motor = model.motor
-        self.m, self.k, self.F0, self.F_gx = model.m, model.k_spring, model.F_spring0, model.F_gx
-        self.J_0, self.M_f, self.e = model.J_0, model.M_f, model.restitution
+        super().__init__(model)
+        self.motor, self.J_0, self.M_f = model.motor, model.J_0, model.M_f
         self.has_current = model.L > 0.0
-        self.two_sided = model.closure == "form"
-        self.c = model.c if self.two_sided else 0.0
-        self.mu, self.G_y, self.N_g = model.mu, model.G_y, model.N_g
-        self.f0 = self.mu * (abs(self.G_y) + self.N_g)  # N, the guide's friction at no contact force
         self.compliant = model.compliant
         self.size = 7 if self.compliant else 5
-        self.heading = 1.0  # the shaft's direction at omega = 0: where it starts (+1, -1), 0 while it is stuck
+        self.mode = Mode()  # the run's mode: its shaft and direction are what ``heading`` reads
+
+    @property
+    def heading(self) -> float:
+        """The shaft's direction, held over a piece (at omega = 0 where it starts: +1, -1), 0 while it is stuck."""
+        return self.mode.heading
+
+    @heading.setter
+    def heading(self, value: float) -> None:
+        if value == 0.0:
+            self.mode.shaft = Shaft.STUCK
+        else:
+            self.mode.shaft, self.mode.direction = Shaft.TURNING, value
 
     def motor_speed(self, y) -> float:
         """rad/s, the rotor's speed: omega_m on a compliant shaft, else the cam's."""
@@ -130,20 +130,6 @@ class VoltageFollower:
             forward, backward = self.torque(at_rest, u, 1.0) / self.J_0, -self.torque(at_rest, u, -1.0) / self.J_0
         return (forward, 1.0) if forward >= backward else (backward, -1.0)
 
-    def direction(self, y) -> float:
-        """The sign of the flying follower's velocity over the next piece: sgn(v), or at a halt the way the net force
-        pushes it beyond the guide's static friction (0: held)."""
-        if y[4] != 0.0:
-            return sgn(y[4])
-        net = -closing_force(y[3], self.k, self.F0, self.F_gx)
-        return sgn(net) if abs(net) > self.f0 else 0.0
-
-    def free_acceleration(self, s: float, sigma: float) -> float:
-        """m/s2, the flying follower's acceleration, (-F_close(s) - sigma f0) / m (sigma = 0: held, 0)."""
-        if sigma == 0.0:
-            return 0.0
-        return (-closing_force(s, self.k, self.F0, self.F_gx) - sigma * self.f0) / self.m
-
     def rates(self, y, u: float, contact: float, sigma: float = 0.0) -> list[float]:
         """dy/dt; on the flank s and v follow the cam (their rates are the cam's); in flight the friction's
         direction is -sigma (``direction``, held over a piece)."""
@@ -184,15 +170,6 @@ class VoltageFollower:
             return contact * self.static_force(y[0], contact)
         return contact * self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
 
-    def flank(self, theta: float, contact: float) -> tuple[float, float]:
-        """(s [m], s' [m/rad]) of the follower on the flank ``contact`` at theta [rad]."""
-        s, s1, _, _ = self.program.derivatives(theta)
-        return s - contact * self.c, s1
-
-    def gap(self, y, contact: float = 1.0) -> float:
-        """m, the follower's distance from the flank ``contact`` (>= 0 in flight)."""
-        return contact * (y[3] - self.flank(y[0], contact)[0])
-
     def acceleration_scale(self, y, u: float) -> float:
         """m/s2, a bound of the follower's acceleration relative to the flank near y."""
         theta, omega = y[0], y[1]
@@ -205,11 +182,11 @@ class VoltageFollower:
         inertia J_0 taking -s' P; a rebound rising less than ZENO_HEIGHT (w^2 < 2 A ZENO_HEIGHT) is plastic, and the
         follower stays on the flank where it holds it (P >= 0). A compliant shaft's rotor is not in the impact."""
         theta, omega, i, _, v = y[:5]
-        s, s1 = self.flank(theta, contact)
+        s, s1, _, _ = self.flank(theta, contact)
         hit = impact(self.J_0, self.m, s1, omega, v, self.e)
         self.unstick(hit.omega)
         w = hit.v - s1 * hit.omega
-        if w * w >= 2.0 * self.acceleration_scale(y, u) * ZENO_HEIGHT:
+        if self.rebounds(w, self.acceleration_scale(y, u)):
             return 0.0, [theta, hit.omega, i, s, hit.v, *y[5:]], hit
         hit = impact(self.J_0, self.m, s1, omega, v, 0.0)
         self.unstick(hit.omega)
@@ -250,7 +227,7 @@ class VoltageFollower:
             N = P * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: P / cos(alpha), signed as contact
             s, v = s_cam - contact * self.c, s1 * omega
         else:
-            a, M, J, N = self.free_acceleration(s, self.direction(y)), shaft, self.J_0, 0.0
+            a, M, J, N = self.free_acceleration(s, self.direction(s, v)), shaft, self.J_0, 0.0
         theta_m, omega_m = (theta + y[5], y[6]) if self.compliant else (theta, omega)
         record = output_record(omega=omega, theta=theta, s=s, i=self.current(y, u), M=M,
                                J=J + (model.J_m if self.compliant else 0.0), v=v, a=a, alpha=math.atan(tan_a),
