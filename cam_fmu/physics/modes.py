@@ -1,8 +1,9 @@
 """The named modes and events of the drive's hybrid system (docs/model.md sections 10 and 13.7).
 
-Every drive and closure the reference integrates is in one ``Mode``: where the follower is (``Follower``) and what
-the shaft does (``Shaft``, with its direction). The events that change it are the members of ``Event``; each
-reference run applies them through one table of transitions (reference/hybrid.py). ``math`` only.
+A follower of its own is in one ``Mode``: where the follower is (``Follower``) and what the shaft does (``Shaft``,
+with its direction); the rigid drive's mode (formulations/consistent.py, the engine's CamMode) names its state in the
+same two. The events that change a mode are the members of ``Event``; each reference run applies them through its
+one table of transitions (reference/hybrid.py). Standard library only.
 """
 from __future__ import annotations
 
@@ -35,8 +36,8 @@ class Follower(enum.Enum):
 
 
 class Shaft(enum.Enum):
-    """What the cam's shaft does: turning (``Mode.direction`` its sense), stopped (the imposed speed is 0, or the
-    instant of a stop before the break-away rule decides), stuck (held by its static friction)."""
+    """What the cam's shaft does: turning (``Mode.direction`` its sense), stopped (the speed drive's imposed speed is
+    0), stuck (held by its static friction; a voltage drive's stop leads here or, by the break-away rule, on)."""
 
     TURNING = "turning"
     STOPPED = "stopped"

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from .drive import sign, solve_guide_friction
-from .follower import Flight, FlankFollower, Impact, closing_force, contact_sign, impact, required_force
+from .follower import FlankFollower, Impact, closing_force, contact_sign, impact, required_force
 from .variables import output_record
 
 
@@ -18,18 +18,11 @@ class SpeedFollower(FlankFollower):
     on the flank ``contact`` (+1, -1; FlankFollower) or off them (0). The cam's speed is imposed, so an impact leaves
     it unchanged (J_0 = inf in ``impact``)."""
 
-    def __init__(self, model) -> None:
-        super().__init__(model)
-        self.flight = Flight(self.m, self.k, self.F0, self.F_gx, self.f0) if self.m > 0.0 else None
-
-    def push(self, theta: float, omega: float, omega_dot: float, contact: float) -> float:
-        """N, contact_sign on the flank: the force along X the flank must give, friction at N = 0."""
-        s, s1, s2, _ = self.flank(theta, contact)
-        return contact_sign(self.m, s, s1, s2, omega, self.k, self.F0, self.F_gx, self.f0, omega_dot)
-
     def held(self, theta: float, omega: float, omega_dot: float, contact: float) -> float:
-        """> 0 while the flank ``contact`` holds the follower (its force points away from the flank)."""
-        return contact * self.push(theta, omega, omega_dot, contact)
+        """N, > 0 while the flank ``contact`` holds the follower: contact times the force along X the flank must give
+        (``contact_sign``, the friction at N = 0)."""
+        s, s1, s2, _ = self.flank(theta, contact)
+        return contact * contact_sign(self.m, s, s1, s2, omega, self.k, self.F0, self.F_gx, self.f0, omega_dot)
 
     def acceleration_scale(self, theta: float, omega: float, omega_dot: float) -> float:
         """m/s2, a bound of the follower's acceleration relative to the flank near theta (flight against cam)."""

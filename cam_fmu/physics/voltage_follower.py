@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from .drive import sign as sgn, solve_guide_friction
+from .drive import sign as sgn
 from .follower import FlankFollower, Impact, closing_force, impact
 from .modes import Mode, Shaft
 from .variables import output_record
@@ -80,12 +80,7 @@ class VoltageFollower(FlankFollower):
         """N m, what drives the cam side: the motor's c_m i (rigid) or the shaft's torque, less M_f sgn(omega)
         (``heading``: the direction the shaft moves in, at omega = 0 the one it starts in, 0 held)."""
         drive = self.shaft_torque(y) if self.compliant else self.model.c_m * self.current(y, u)
-        return drive - self.M_f * (self.moving(y[1]) if heading is None else heading)
-
-    def moving(self, omega: float) -> float:
-        """The shaft's direction ``heading``, held over a piece (a stop ends it; 0 stuck): sgn(omega) would turn
-        the friction in the integrator's trial steps past omega = 0."""
-        return self.heading
+        return drive - self.M_f * (self.heading if heading is None else heading)
 
     def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0,
                  heading: float | None = None) -> tuple[float, float, float]:
@@ -97,7 +92,7 @@ class VoltageFollower(FlankFollower):
         if self.mu == 0.0:
             omega_dot = (drive - (m * s2 * omega * omega + F) * s1) / (J_0 + m * s1 * s1)
             return omega_dot, m * (s2 * omega * omega + s1 * omega_dot) + F, 0.0
-        sigma = sgn(s1 * (self.moving(omega) if heading is None else heading))
+        sigma = sgn(s1 * (self.heading if heading is None else heading))
         tan_a = s1 / (self.model.r_b + s_cam)
         for side in (1.0, -1.0):  # the branch where the side force P tan(alpha) + G_y has the sign `side`
             slope = 1.0 - sigma * self.mu * side * tan_a  # dP/dP of P - sgn(v) f on this branch
@@ -216,7 +211,7 @@ class VoltageFollower(FlankFollower):
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
         drive = self.torque(y, u)
-        shaft = self.M_f * self.moving(omega)
+        shaft = self.M_f * self.heading
         if contact and self.heading == 0.0:  # stuck: the shaft's static friction takes the drive's torque
             P, a, M, J = self.static_force(theta, contact), 0.0, drive, self.J_0 + self.m * s1 * s1
             N = P * math.sqrt(1.0 + tan_a * tan_a)  # signed as the flank: < 0 on the upper flank (contact -1)

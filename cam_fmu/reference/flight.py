@@ -1,11 +1,10 @@
 """The reference of the follower as a body of its own on a cam at imposed speed (docs/model.md section 13).
 
-scipy's solve_ivp integrates the state (theta, s, v) at tight tolerances: theta under the imposed speed,
-the follower's (s, v) under spring, gravity along the stroke and guide friction while it flies. Terminal
-events stop it at each lift-off (the flank's force reaches 0: ``SpeedFollower.held``), touch-down (a gap
-reaches 0), halt in flight (v = 0, where the friction turns) and input break; the transition is applied at
-the located time and the integration restarts there. Rows are the speed drive's outputs with the
-follower's own s, v, a and N_contact [N] (0 in flight), plus contact (+1, -1, 0 in flight) and impacts (how
+The state (theta, s, v): theta under the imposed speed, the follower's (s, v) under spring, gravity along the stroke
+and guide friction while it flies, through the one hybrid loop (hybrid.py) with the events of docs/model.md 13.7:
+lift-off (the flank's force reaches 0: ``SpeedFollower.held``), touch-down (a gap reaches -TOUCH), halt in flight
+(v = 0, where the friction turns) and, at an input break, a step of omega_ref. Rows are the speed drive's outputs with
+the follower's own s, v, a and N_contact [N] (0 in flight), plus contact (+1, -1, 0 off the flanks) and impacts (how
 many so far).
 """
 from __future__ import annotations
@@ -107,11 +106,7 @@ class FollowerRun(HybridRun):
         omega, omega_dot = self._speed(t)
         after, v, _ = landed
         s, s1, _, _ = body.flank(y[0], flank)
-        w = v - s1 * omega
-        self.impacts.append((t, y[2] - s1 * omega, w))
-        if after == 0.0 and w != 0.0:
-            # the relative acceleration is at most A near here: the gap stays > 0 for about 2 |w| / A
-            self.rebound = abs(w) / (2.0 * body.acceleration_scale(y[0], omega, omega_dot))
+        self._impact(t, y[2] - s1 * omega, v - s1 * omega, after == 0.0, body.acceleration_scale(y[0], omega, omega_dot))
         y = [y[0], s, v]
         return Mode(Follower.flank(after) if after else flying(body, y), mode.shaft, mode.direction), y
 

@@ -17,6 +17,9 @@ from scipy.integrate import solve_ivp
 from ..physics.modes import Event
 from ..physics.signals import Signal
 
+# J: the energy integrals a voltage-driven run can carry after its state: E_in = int u i dt, E_copper = int R i^2 dt,
+# E_shaft = int M_f |omega| dt, E_guide = int f |v| dt, E_damp = int d_shaft (omega_m - omega)^2 dt.
+ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 # Events at one instant in a row before the run is refused (each transition changes the mode; a cycle means
 # a model error, never a hang).
 MAX_STALL = 1000
@@ -50,6 +53,11 @@ def piece_input(signal: Signal, end: float) -> Callable[[float], tuple[float, fl
             return signal.value(t), signal.slope(t)
         return signal.left_value(end), signal.left_slope(end)
     return at
+
+
+def collect(rows: list[dict[str, float]], grid: np.ndarray) -> dict[str, np.ndarray]:
+    """The rows on ``grid`` [s] as arrays by output name, with ``time``."""
+    return {"time": grid.copy(), **{name: np.array([row[name] for row in rows]) for name in rows[0]}}
 
 
 def event(kind: Event, fn: Callable) -> Callable:
@@ -95,9 +103,13 @@ class HybridRun:
             raise RuntimeError(f"{self.label}: {MAX_STALL} events at t = {t!r} s without end")
         self._t_last = t
 
-    def transition(self, t: float, y: list, mode, kind: Event):
-        """(mode, y) after the event ``kind`` at t: its entry in ``TRANSITIONS``."""
-        return self.TRANSITIONS[kind](self, t, y, mode, kind)
+    def _impact(self, t: float, before: float, after: float, rebounds: bool, scale: float) -> None:
+        """Count an impact at t [s] (the relative speeds before and after [m/s]); a rebound keeps the next piece
+        shorter than its bounce: the relative acceleration is at most ``scale`` A [m/s2] near here, so the gap stays
+        > 0 for about 2 |w| / A."""
+        self.impacts.append((t, before, after))
+        if rebounds and after != 0.0:
+            self.rebound = abs(after) / (2.0 * scale)
 
     def pieces(self, grid: np.ndarray, t: float, y: list, mode, breaks: list[float]) -> dict[str, np.ndarray]:
         """Rows on ``grid`` from (t, y, mode), stopping at each event and input break [s]."""
@@ -148,9 +160,17 @@ class HybridRun:
             if after_event:
                 fired = next(j for j, te in enumerate(sol.t_events) if len(te))
                 self._stall(t_new)
-                mode, y = self.transition(t_new, y, mode, events[fired].kind)
+                mode, y = self.TRANSITIONS[events[fired].kind](self, t_new, y, mode, events[fired].kind)
             t = t_new
-        result = {"time": grid.copy()}
-        for name in rows[0]:
-            result[name] = np.array([row[name] for row in rows])
-        return result
+        return collect(rows, grid)
+
+
+class VoltageRun(HybridRun):
+    """A run of a voltage-driven cam (the input u [V]): DOP853, or Radau with a fast electrical pole (L/R < 1 ms)
+    unless ``method`` says, with the energy integrals if ``energy``, stopping at the profile's breakpoints."""
+
+    def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
+        self.u, self.rtol, self.atol, self.energy = u, rtol, atol, energy
+        stiff = model.L > 0.0 and model.L / model.R < 1e-3
+        self.method = method or ("Radau" if stiff else "DOP853")
+        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [2.0 * math.pi]

@@ -19,22 +19,20 @@ import math
 from typing import Any, Mapping
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..physics.signals import Signal, constant
 from ..physics.contact import follower_along, rest_position, speed_engaged
 from ..physics.drive import DriveModel, sign
 from ..physics.formulations import formulation_name
 from ..physics.formulations.consistent import EVENT_NAME, EVENTS, HybridDrive
-from ..physics.modes import Event
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
+from ..physics.modes import Event
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
-from .hybrid import HybridRun, event, next_breakpoint, piece_input
+from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .voltage_flight import follower_voltage_reference
 
-ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 
 
 def simulate_reference(
@@ -67,27 +65,14 @@ def _grid(stop_time: float, output_interval: float) -> np.ndarray:
     return grid
 
 
-def _collect(rows: list[dict[str, float]], grid: np.ndarray) -> dict[str, np.ndarray]:
-    result = {"time": grid.copy()}
-    for name in rows[0]:
-        result[name] = np.array([row[name] for row in rows])
-    return result
-
-
-class _Consistent(HybridRun):
+class _Consistent(VoltageRun):
     """The rigid (and compliant) drive through the one hybrid loop: ``HybridDrive``'s events and transitions."""
 
     label = "reference integration"
 
     def __init__(self, model: DriveModel, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
-        self.model = model
-        self.hybrid = HybridDrive(model)
-        self.u = u
-        self.rtol, self.atol = rtol, atol
-        self.energy = energy
-        stiff = model.L > 0.0 and model.L / model.R < 1e-3
-        self.method = method or ("Radau" if stiff else "DOP853")
-        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [2.0 * math.pi]
+        super().__init__(model, u, rtol, atol, energy, method)
+        self.model, self.hybrid = model, HybridDrive(model)
         self.target = math.nan  # rad, the breakpoint ahead of the piece (none while stuck)
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
@@ -206,7 +191,7 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         for j in range(steps):
             scheme.step(h / steps, u.value(float(t0) + j * h / steps), int(p["max_steps"]))
         rows.append(scheme.outputs())
-    return _collect(rows, grid)
+    return collect(rows, grid)
 
 
 def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
@@ -240,7 +225,7 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged, sign(motion)))
         if omega_ref.value(t) == 0.0:  # at rest from t on (a stop): there from the next interval, as the FMU's input
             s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
-    return _collect(rows, grid)
+    return collect(rows, grid)
 
 
 # The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/tools/test_layout.py).

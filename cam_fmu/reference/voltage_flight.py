@@ -1,14 +1,13 @@
 """The reference of the follower of its own on a voltage-driven cam (docs/model.md section 13.6).
 
-scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = (theta, omega, i, s, v), and
-(phi, omega_m) on a compliant shaft, of ``physics.voltage_follower.VoltageFollower``, with the energy integrals
-E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide = int f |v| dt and
-E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lift-off (the contact force P reaches
-0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
-the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
-follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
-With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, and N_contact [N], plus contact (+1, -1, 0),
-impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
+y = (theta, omega, i, s, v), and (phi, omega_m) on a compliant shaft, of ``physics.voltage_follower.VoltageFollower``,
+with the energy integrals (hybrid.ENERGY), through the one hybrid loop (hybrid.py) with the events of docs/model.md
+13.7: lift-off (the contact force P reaches 0), touch-down (the gap reaches -TOUCH, as flight.py), halt in flight,
+the shaft's stop (stuck, or on the other way by the break-away rule with the follower's contact), the stuck shaft's
+break-away, the side force's kink and the profile's breakpoints. With the cam stuck the follower flies alone and lands
+on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a and
+N_contact [N], plus contact (+1, -1, 0), impacts (touch-downs so far) and, with energy, the integrals and E_impact
+(the impacts' losses so far) [J].
 """
 from __future__ import annotations
 
@@ -16,33 +15,28 @@ import math
 
 import numpy as np
 
+from ..physics.drive import sign as sgn
 from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.modes import Event, Follower, Mode, Shaft
 from ..physics.signals import Signal
-from ..physics.drive import sign as sgn
 from ..physics.voltage_follower import VoltageFollower
 from .flight import FLIGHT_ANGLE, flight_events, flying
-from .hybrid import HybridRun, event, next_breakpoint, piece_input
-
-ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
+from .hybrid import ENERGY, VoltageRun, event, next_breakpoint, piece_input
 
 
-class VoltageFollowerRun(HybridRun):
+
+class VoltageFollowerRun(VoltageRun):
     """One run of the voltage drive with a follower of its own; its mode is ``body.mode``, which the body's
     equations read (the shaft's direction, stuck) and the transitions change in place."""
 
     label = "voltage follower reference"
 
     def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
+        super().__init__(model, u, rtol, atol, energy, method)
         self.body = VoltageFollower(model)
-        self.u = u
-        self.rtol, self.atol, self.energy = rtol, atol, energy
-        stiff = model.L > 0.0 and model.L / model.R < 1e-3
-        self.method = method or ("Radau" if stiff else "DOP853")
         self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
         self.loss = 0.0  # J, the impacts' losses so far
         self.lift_offs: list[tuple[float, float, float]] = []  # (t [s], s [m], v [m/s]) where the follower left the cam
-        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [2.0 * math.pi]
         self.target = 0.0  # rad, the breakpoint the current piece stops at
 
     def _mode(self, contact: float, y: list) -> Mode:
@@ -151,10 +145,7 @@ class VoltageFollowerRun(HybridRun):
         w_before = y[4] - s1 * y[1]
         after, state, hit = body.land(y[:n], u_t, flank)
         self.loss += hit.loss
-        w = state[4] - s1 * state[1]
-        self.impacts.append((t, w_before, w))
-        if after == 0.0 and w != 0.0:
-            self.rebound = abs(w) / (2.0 * body.acceleration_scale(state, u_t))
+        self._impact(t, w_before, state[4] - s1 * state[1], after == 0.0, body.acceleration_scale(state, u_t))
         y = state + y[n:]
         return self._mode(after, y), y
 
