@@ -98,7 +98,6 @@ class FollowerRun(HybridRun):
         omega, omega_dot, flank = *self._speed(t), 1.0 if kind is Event.TOUCH_LOWER else -1.0
         return self._struck(t, y, mode, flank, self.body.land(y[0], omega, omega_dot, y[2], flank))
 
-    TRANSITIONS = {Event.LIFT_OFF: _lift_off, Event.HALT: _halt, Event.TOUCH_LOWER: _touch, Event.TOUCH_UPPER: _touch}
 
     def _struck(self, t: float, y: list, mode: Mode, flank: float, landed: tuple) -> tuple[Mode, list]:
         """The state after an impact on ``flank`` (``landed``: SpeedFollower.land's answer), counted."""
@@ -111,24 +110,31 @@ class FollowerRun(HybridRun):
         return Mode(Follower.flank(after) if after else flying(body, y), mode.shaft, mode.direction), y
 
     def _settle(self, t: float, y: list, mode: Mode, after_event: bool) -> tuple[Mode, list]:
-        """The shaft's mode from the input; on a flank a step of omega at once (the flank's speed jumped, the
-        follower's did not: a lift-off or an impact, SpeedFollower.speed_step) and a lift-off whose function is
-        already < 0 (s'' jumped at a breakpoint or the input did)."""
-        omega, omega_dot = self._speed(t)
-        shaft = Mode(mode.follower, Shaft.TURNING if omega else Shaft.STOPPED, -1.0 if omega < 0.0 else 1.0)
+        """At every restart: the shaft's mode from the input, the follower off the flanks in flight or halted, on a
+        flank the step of omega_ref's transition (none where omega did not jump)."""
+        omega = self._speed(t)[0]
+        mode = Mode(mode.follower, Shaft.TURNING if omega else Shaft.STOPPED, -1.0 if omega < 0.0 else 1.0)
         if not mode.follower.on_flank:
-            return Mode(flying(self.body, y), shaft.shaft, shaft.direction), y
-        contact = mode.contact
+            return Mode(flying(self.body, y), mode.shaft, mode.direction), y
+        return self._speed_step(t, y, mode, Event.SPEED_STEP)
+
+    def _speed_step(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        """The flank's speed jumped, the follower's did not: a lift-off or an impact (SpeedFollower.speed_step); then
+        a lift-off whose function is already < 0 (s'' jumped at a breakpoint or the input did)."""
+        (omega, omega_dot), contact = self._speed(t), mode.contact
         after, v, hit = self.body.speed_step(y[0], omega, omega_dot, y[2], contact)
         if hit is not None:
-            return self._struck(t, y, shaft, contact, (after, v, hit))
+            return self._struck(t, y, mode, contact, (after, v, hit))
         if after == 0.0:   # the flank moves away faster than the follower: it flies on with its speed
             y = [y[0], self.body.flank(y[0], contact)[0], v]
-            return Mode(flying(self.body, y), shaft.shaft, shaft.direction), y
+            return Mode(flying(self.body, y), mode.shaft, mode.direction), y
         if self.body.held(y[0], omega, omega_dot, contact) < 0.0:
-            return self._lift_off(t, y, shaft, Event.LIFT_OFF)
+            return self._lift_off(t, y, mode, Event.LIFT_OFF)
         s, s1, _, _ = self.body.flank(y[0], contact)
-        return shaft, [y[0], s, s1 * omega]
+        return mode, [y[0], s, s1 * omega]
+
+    TRANSITIONS = {Event.LIFT_OFF: _lift_off, Event.HALT: _halt, Event.TOUCH_LOWER: _touch, Event.TOUCH_UPPER: _touch,
+                   Event.SPEED_STEP: _speed_step}
 
     def _row(self, t: float, y, mode: Mode, left: bool) -> dict[str, float]:
         # at an input's kink or jump its left limit, the interval ending at t (docs/model.md 8.1); at 0 the first piece

@@ -70,13 +70,12 @@ def _table(heading: str) -> str:
 
 def test_the_event_table_of_the_docs_is_the_reference_s():
     """Every row of model.md 13.7's event table names a member of Event and every member has its row; every event
-    but the step of omega_ref (applied at a restart) has its transition in a run's one table, and the rigid drive's
-    events (section 10) are members too."""
+    has its transition in a run's one table, and the rigid drive's events (section 10) are members too."""
     section = _table("### 13.7 The modes and events of the follower of its own")
     named = set(re.findall(r"^\| [^|]*\(`([A-Z_]+)`\) \|", section, flags=re.M))
     assert named == {kind.name for kind in Event}
     handled = set(FollowerRun.TRANSITIONS) | set(VoltageFollowerRun.TRANSITIONS) | set(_Consistent.TRANSITIONS)
-    assert handled == set(Event) - {Event.SPEED_STEP}
+    assert handled == set(Event)
     assert set(EVENTS) == set(EVENT_NAMES) and set(EVENTS.values()) <= set(_Consistent.TRANSITIONS)
 
 
