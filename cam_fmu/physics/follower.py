@@ -266,3 +266,61 @@ def impact(J_0: float, m: float, s1: float, omega: float, v: float, e: float) ->
     impulse = -(1.0 + e) * m_eff * w
     omega_after = omega if math.isinf(J_0) else omega - s1 * impulse / J_0
     return Impact(omega_after, v + impulse / m, impulse, 0.5 * (1.0 - e * e) * m_eff * w * w)
+
+
+# ----------------------------------------------------------------------------- between the flanks
+# A rebound that would rise less than this above the flank [m] ends the bouncing: the follower stays on the flank
+# (a plastic impact). The bounces' heights fall as e^2n, so a sequence with e < 1 ends after finitely many (Zeno
+# guard); 1 nm lies far above the reference's resolution of positions (atol 1e-13) and far below any clearance.
+ZENO_HEIGHT = 1e-9
+
+
+class FlankFollower:
+    """The follower of its own on a cam's flanks (closures 'form' and 'spring'): what the speed drive's
+    (speed_follower.py) and the voltage drive's (voltage_follower.py) share. A flank is named by its sign: +1 pushes
+    along +X (a spring-closed cam's only flank; a groove's lower flank, at s = s_cam - c), -1 a groove's upper flank
+    (s = s_cam + c)."""
+
+    def __init__(self, model) -> None:
+        self.model, self.program = model, model.program
+        self.two_sided = model.closure == "form"
+        self.c = model.c if self.two_sided else 0.0
+        self.m, self.e = model.m, model.restitution
+        self.k, self.F0, self.F_gx = model.k_spring, model.F_spring0, model.F_gx  # no spring unless 'spring'
+        self.mu, self.G_y, self.N_g = model.mu, model.G_y, model.N_g
+        self.f0 = self.mu * (abs(self.G_y) + self.N_g)  # N, the guide's friction at no contact force (in flight)
+
+    def flank(self, theta: float, contact: float) -> tuple[float, float, float, float]:
+        """(s [m], s' [m/rad], s'' [m/rad2], s_cam [m]) of the follower on the flank ``contact`` at theta [rad]."""
+        s_cam, s1, s2, _ = self.program.derivatives(theta)
+        return s_cam - contact * self.c, s1, s2, s_cam
+
+    def gaps(self, theta: float, s: float) -> tuple[float, float]:
+        """(gap to the +1 flank, gap to the -1 flank) [m], both >= 0 in flight (inf: no such flank)."""
+        s_cam = self.program.derivatives(theta)[0]
+        return s - (s_cam - self.c), ((s_cam + self.c) - s) if self.two_sided else math.inf
+
+    def free_acceleration(self, s: float, sigma: float) -> float:
+        """m/s2, the flying follower's acceleration (-F_close(s) - sigma f0) / m with the friction's direction
+        -sigma = -sgn(v); sigma = 0 at a halt, where the guide's static friction holds the follower while the net
+        force is within f0 (then 0), else it starts the way that force pushes."""
+        net = -closing_force(s, self.k, self.F0, self.F_gx)
+        if sigma == 0.0:
+            if abs(net) <= self.f0:
+                return 0.0
+            sigma = 1.0 if net > 0.0 else -1.0
+        return (net - sigma * self.f0) / self.m
+
+    def direction(self, s: float, v: float) -> float:
+        """The sign of the flying follower's velocity v [m/s] at s [m] over the next piece: sgn(v), or at a halt the
+        way the net force pushes it beyond the guide's static friction (0: held)."""
+        if v != 0.0:
+            return 1.0 if v > 0.0 else -1.0
+        net = -closing_force(s, self.k, self.F0, self.F_gx)
+        return (1.0 if net > 0.0 else -1.0) if abs(net) > self.f0 else 0.0
+
+    @staticmethod
+    def rebounds(w: float, scale: float) -> bool:
+        """Does the relative speed w [m/s] off a flank rise ZENO_HEIGHT or more at the acceleration ``scale``
+        [m/s2] (w^2 >= 2 A ZENO_HEIGHT)? Below it an impact is plastic (the Zeno guard)."""
+        return w * w >= 2.0 * scale * ZENO_HEIGHT

@@ -9,66 +9,20 @@ from __future__ import annotations
 import math
 
 from .drive import sign, solve_guide_friction
-from .follower import Flight, Impact, closing_force, contact_sign, impact, required_force
+from .follower import FlankFollower, Impact, closing_force, contact_sign, impact, required_force
 from .variables import output_record
 
-# A rebound that would rise less than this above the flank [m] ends the bouncing: the follower stays on the flank
-# (a plastic impact). The bounces' heights fall as e^2n, so a sequence with e < 1 ends after finitely many (Zeno
-# guard); 1 nm lies far above the reference's resolution of positions (atol 1e-13) and far below any clearance.
-ZENO_HEIGHT = 1e-9
 
-
-class SpeedFollower:
-    """The follower as a body of its own on a cam at imposed speed (drive 'speed', closures 'form' and 'spring').
-
-    ``contact`` is +1 on the flank that pushes along +X (a spring-closed cam's only flank; the groove's lower
-    flank, at s = s_cam - c), -1 on the groove's upper flank (s = s_cam + c), 0 in flight. The cam's speed is
-    imposed, so an impact leaves it unchanged (J_0 = inf in ``impact``).
-    """
-
-    def __init__(self, model) -> None:
-        self._sign, self._solve = sign, solve_guide_friction
-        self.model = model
-        self.program = model.program
-        spring = model.closure == "spring"
-        self.k = model.k_spring if spring else 0.0
-        self.F0 = model.F_spring0 if spring else 0.0
-        self.c = 0.0 if spring else model.c
-        self.two_sided = not spring
-        self.e = model.restitution
-        self.m = model.m
-        self.f0 = model.mu * (abs(model.G_y) + model.N_g)  # N, guide friction at N = 0 (in flight)
-        self.flight = Flight(self.m, self.k, self.F0, model.F_gx, self.f0) if self.m > 0.0 else None
-
-    def flank(self, theta: float, contact: float) -> tuple[float, float, float, float]:
-        """(s, s', s'', s_cam) of the follower on the flank ``contact`` (+1 or -1) at theta [rad]."""
-        s_cam, s1, s2, _ = self.program.derivatives(theta)
-        return s_cam - contact * self.c, s1, s2, s_cam
-
-    def push(self, theta: float, omega: float, omega_dot: float, contact: float) -> float:
-        """N, contact_sign on the flank: the force along X the flank must give, friction at N = 0."""
-        s, s1, s2, _ = self.flank(theta, contact)
-        return contact_sign(self.m, s, s1, s2, omega, self.k, self.F0, self.model.F_gx, self.f0, omega_dot)
+class SpeedFollower(FlankFollower):
+    """The follower as a body of its own on a cam at imposed speed (drive 'speed', closures 'form' and 'spring'),
+    on the flank ``contact`` (+1, -1; FlankFollower) or off them (0). The cam's speed is imposed, so an impact leaves
+    it unchanged (J_0 = inf in ``impact``)."""
 
     def held(self, theta: float, omega: float, omega_dot: float, contact: float) -> float:
-        """> 0 while the flank ``contact`` holds the follower (its force points away from the flank)."""
-        return contact * self.push(theta, omega, omega_dot, contact)
-
-    def free_acceleration(self, s: float, sigma: float) -> float:
-        """m/s2, the follower's acceleration in flight with the friction's direction -sigma = -sgn(v):
-        (-(F0 + k s) + F_gx - sigma f0) / m; sigma = 0 at a halt, where the guide's static friction holds the
-        follower while the net force is within f0 (then 0)."""
-        net = -closing_force(s, self.k, self.F0, self.model.F_gx)
-        if sigma == 0.0:
-            if abs(net) <= self.f0:
-                return 0.0
-            sigma = 1.0 if net > 0.0 else -1.0
-        return (net - sigma * self.f0) / self.m
-
-    def gaps(self, theta: float, s: float) -> tuple[float, float]:
-        """(gap to the +1 flank, gap to the -1 flank) [m], both >= 0 in flight (inf: no such flank)."""
-        s_cam = self.program.derivatives(theta)[0]
-        return s - (s_cam - self.c), ((s_cam + self.c) - s) if self.two_sided else math.inf
+        """N, > 0 while the flank ``contact`` holds the follower: contact times the force along X the flank must give
+        (``contact_sign``, the friction at N = 0)."""
+        s, s1, s2, _ = self.flank(theta, contact)
+        return contact * contact_sign(self.m, s, s1, s2, omega, self.k, self.F0, self.F_gx, self.f0, omega_dot)
 
     def acceleration_scale(self, theta: float, omega: float, omega_dot: float) -> float:
         """m/s2, a bound of the follower's acceleration relative to the flank near theta (flight against cam)."""
@@ -87,7 +41,7 @@ class SpeedFollower:
         s1 = self.program.derivatives(theta)[1]
         hit = impact(math.inf, self.m, s1, omega, v, self.e)
         w = hit.v - s1 * omega
-        if w * w >= 2.0 * self.acceleration_scale(theta, omega, omega_dot) * ZENO_HEIGHT:
+        if self.rebounds(w, self.acceleration_scale(theta, omega, omega_dot)):
             return 0.0, hit.v, hit
         stay = contact if self.held(theta, omega, omega_dot, contact) >= 0.0 else 0.0  # a tie: the events decide
         return stay, s1 * omega, impact(math.inf, self.m, s1, omega, v, 0.0)
@@ -105,7 +59,7 @@ class SpeedFollower:
         """
         s1 = self.program.derivatives(theta)[1]
         w = v - s1 * omega
-        if w * w < 2.0 * self.acceleration_scale(theta, omega, omega_dot) * ZENO_HEIGHT:
+        if not self.rebounds(w, self.acceleration_scale(theta, omega, omega_dot)):
             return contact, s1 * omega, None
         if contact * w > 0.0:
             return 0.0, v, None
@@ -118,15 +72,15 @@ class SpeedFollower:
         model = self.model
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
-        direction = self._sign(omega) if direction is None else direction
+        direction = sign(omega) if direction is None else direction
         shaft = model.M_f * direction
 
         def load(angle: float) -> tuple[float, float, float]:  # (M, J, force along X) with the follower on the flank
             sf, d1, d2, _ = self.flank(angle, contact)
             push = required_force(self.m, d2, omega, d1, omega_dot) + closing_force(sf, self.k, self.F0, model.F_gx)
             t_a = d1 / (model.r_b + self.program.derivatives(angle)[0])
-            sigma = self._sign(d1 * direction)
-            f = self._solve(push * t_a + model.G_y, t_a, sigma, model.mu, model.N_g, 0.0)
+            sigma = sign(d1 * direction)
+            f = solve_guide_friction(push * t_a + model.G_y, t_a, sigma, model.mu, model.N_g, 0.0)
             force = push + sigma * f
             return shaft + force * d1, model.J_0 + self.m * d1 * d1, force
 
@@ -137,7 +91,7 @@ class SpeedFollower:
             N = force * math.sqrt(1.0 + tan_a * tan_a)  # N, along the normal: force along X / cos(alpha), signed
         else:
             M, J, N = shaft, model.J_0, 0.0
-            a = self.free_acceleration(s, self._sign(v)) if self.m > 0.0 else 0.0
+            a = self.free_acceleration(s, sign(v)) if self.m > 0.0 else 0.0
         i = (model.J_0 * omega_dot + M) / model.c_m
         voltage = model.motor.voltage(i, omega)
         if model.L > 0.0 and omega != 0.0 and contact != 0.0:  # di/dt = omega dM/dtheta at constant speed

@@ -30,37 +30,37 @@ from __future__ import annotations
 
 import math
 
-from .drive import solve_guide_friction
-from .follower import Impact, closing_force, impact
-from .speed_follower import ZENO_HEIGHT
+from .drive import sign as sgn
+from .follower import FlankFollower, Impact, closing_force, impact
+from .modes import Mode, Shaft
 from .variables import output_record
 
 
-def sgn(x: float) -> float:
-    """+1, -1 or 0."""
-    return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
-
-
-class VoltageFollower:
+class VoltageFollower(FlankFollower):
     """The hybrid system of a follower of its own on a voltage-driven cam (``contact`` +1, -1 on a flank, 0 off).
 
     The state y is (theta, omega, i, s, v), with (phi, omega_m) after it on a compliant shaft (``size`` 7).
     """
 
     def __init__(self, model) -> None:
-        self.model = model
-        self.program = model.program
-        self.motor = model.motor
-        self.m, self.k, self.F0, self.F_gx = model.m, model.k_spring, model.F_spring0, model.F_gx
-        self.J_0, self.M_f, self.e = model.J_0, model.M_f, model.restitution
+        super().__init__(model)
+        self.motor, self.J_0, self.M_f = model.motor, model.J_0, model.M_f
         self.has_current = model.L > 0.0
-        self.two_sided = model.closure == "form"
-        self.c = model.c if self.two_sided else 0.0
-        self.mu, self.G_y, self.N_g = model.mu, model.G_y, model.N_g
-        self.f0 = self.mu * (abs(self.G_y) + self.N_g)  # N, the guide's friction at no contact force
         self.compliant = model.compliant
         self.size = 7 if self.compliant else 5
-        self.heading = 1.0  # the shaft's direction at omega = 0: where it starts (+1, -1), 0 while it is stuck
+        self.mode = Mode()  # the run's mode: its shaft and direction are what ``heading`` reads
+
+    @property
+    def heading(self) -> float:
+        """The shaft's direction, held over a piece (at omega = 0 where it starts: +1, -1), 0 while it is stuck."""
+        return self.mode.heading
+
+    @heading.setter
+    def heading(self, value: float) -> None:
+        if value == 0.0:
+            self.mode.shaft = Shaft.STUCK
+        else:
+            self.mode.shaft, self.mode.direction = Shaft.TURNING, value
 
     def motor_speed(self, y) -> float:
         """rad/s, the rotor's speed: omega_m on a compliant shaft, else the cam's."""
@@ -80,12 +80,7 @@ class VoltageFollower:
         """N m, what drives the cam side: the motor's c_m i (rigid) or the shaft's torque, less M_f sgn(omega)
         (``heading``: the direction the shaft moves in, at omega = 0 the one it starts in, 0 held)."""
         drive = self.shaft_torque(y) if self.compliant else self.model.c_m * self.current(y, u)
-        return drive - self.M_f * (self.moving(y[1]) if heading is None else heading)
-
-    def moving(self, omega: float) -> float:
-        """The shaft's direction ``heading``, held over a piece (a stop ends it; 0 stuck): sgn(omega) would turn
-        the friction in the integrator's trial steps past omega = 0."""
-        return self.heading
+        return drive - self.M_f * (self.heading if heading is None else heading)
 
     def on_flank(self, theta: float, omega: float, drive: float, contact: float = 1.0,
                  heading: float | None = None) -> tuple[float, float, float]:
@@ -97,7 +92,7 @@ class VoltageFollower:
         if self.mu == 0.0:
             omega_dot = (drive - (m * s2 * omega * omega + F) * s1) / (J_0 + m * s1 * s1)
             return omega_dot, m * (s2 * omega * omega + s1 * omega_dot) + F, 0.0
-        sigma = sgn(s1 * (self.moving(omega) if heading is None else heading))
+        sigma = sgn(s1 * (self.heading if heading is None else heading))
         tan_a = s1 / (self.model.r_b + s_cam)
         for side in (1.0, -1.0):  # the branch where the side force P tan(alpha) + G_y has the sign `side`
             slope = 1.0 - sigma * self.mu * side * tan_a  # dP/dP of P - sgn(v) f on this branch
@@ -129,20 +124,6 @@ class VoltageFollower:
         else:
             forward, backward = self.torque(at_rest, u, 1.0) / self.J_0, -self.torque(at_rest, u, -1.0) / self.J_0
         return (forward, 1.0) if forward >= backward else (backward, -1.0)
-
-    def direction(self, y) -> float:
-        """The sign of the flying follower's velocity over the next piece: sgn(v), or at a halt the way the net force
-        pushes it beyond the guide's static friction (0: held)."""
-        if y[4] != 0.0:
-            return sgn(y[4])
-        net = -closing_force(y[3], self.k, self.F0, self.F_gx)
-        return sgn(net) if abs(net) > self.f0 else 0.0
-
-    def free_acceleration(self, s: float, sigma: float) -> float:
-        """m/s2, the flying follower's acceleration, (-F_close(s) - sigma f0) / m (sigma = 0: held, 0)."""
-        if sigma == 0.0:
-            return 0.0
-        return (-closing_force(s, self.k, self.F0, self.F_gx) - sigma * self.f0) / self.m
 
     def rates(self, y, u: float, contact: float, sigma: float = 0.0) -> list[float]:
         """dy/dt; on the flank s and v follow the cam (their rates are the cam's); in flight the friction's
@@ -184,15 +165,6 @@ class VoltageFollower:
             return contact * self.static_force(y[0], contact)
         return contact * self.on_flank(y[0], y[1], self.torque(y, u), contact)[1]
 
-    def flank(self, theta: float, contact: float) -> tuple[float, float]:
-        """(s [m], s' [m/rad]) of the follower on the flank ``contact`` at theta [rad]."""
-        s, s1, _, _ = self.program.derivatives(theta)
-        return s - contact * self.c, s1
-
-    def gap(self, y, contact: float = 1.0) -> float:
-        """m, the follower's distance from the flank ``contact`` (>= 0 in flight)."""
-        return contact * (y[3] - self.flank(y[0], contact)[0])
-
     def acceleration_scale(self, y, u: float) -> float:
         """m/s2, a bound of the follower's acceleration relative to the flank near y."""
         theta, omega = y[0], y[1]
@@ -205,11 +177,11 @@ class VoltageFollower:
         inertia J_0 taking -s' P; a rebound rising less than ZENO_HEIGHT (w^2 < 2 A ZENO_HEIGHT) is plastic, and the
         follower stays on the flank where it holds it (P >= 0). A compliant shaft's rotor is not in the impact."""
         theta, omega, i, _, v = y[:5]
-        s, s1 = self.flank(theta, contact)
+        s, s1, _, _ = self.flank(theta, contact)
         hit = impact(self.J_0, self.m, s1, omega, v, self.e)
         self.unstick(hit.omega)
         w = hit.v - s1 * hit.omega
-        if w * w >= 2.0 * self.acceleration_scale(y, u) * ZENO_HEIGHT:
+        if self.rebounds(w, self.acceleration_scale(y, u)):
             return 0.0, [theta, hit.omega, i, s, hit.v, *y[5:]], hit
         hit = impact(self.J_0, self.m, s1, omega, v, 0.0)
         self.unstick(hit.omega)
@@ -239,7 +211,7 @@ class VoltageFollower:
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (model.r_b + s_cam)
         drive = self.torque(y, u)
-        shaft = self.M_f * self.moving(omega)
+        shaft = self.M_f * self.heading
         if contact and self.heading == 0.0:  # stuck: the shaft's static friction takes the drive's torque
             P, a, M, J = self.static_force(theta, contact), 0.0, drive, self.J_0 + self.m * s1 * s1
             N = P * math.sqrt(1.0 + tan_a * tan_a)  # signed as the flank: < 0 on the upper flank (contact -1)
@@ -250,7 +222,7 @@ class VoltageFollower:
             N = P * math.sqrt(1.0 + tan_a * tan_a)  # along the normal: P / cos(alpha), signed as contact
             s, v = s_cam - contact * self.c, s1 * omega
         else:
-            a, M, J, N = self.free_acceleration(s, self.direction(y)), shaft, self.J_0, 0.0
+            a, M, J, N = self.free_acceleration(s, self.direction(s, v)), shaft, self.J_0, 0.0
         theta_m, omega_m = (theta + y[5], y[6]) if self.compliant else (theta, omega)
         record = output_record(omega=omega, theta=theta, s=s, i=self.current(y, u), M=M,
                                J=J + (model.J_m if self.compliant else 0.0), v=v, a=a, alpha=math.atan(tan_a),

@@ -19,20 +19,20 @@ import math
 from typing import Any, Mapping
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from ..physics.signals import Signal, constant
 from ..physics.contact import follower_along, rest_position, speed_engaged
 from ..physics.drive import DriveModel, sign
 from ..physics.formulations import formulation_name
-from ..physics.formulations.consistent import HybridDrive
+from ..physics.formulations.consistent import EVENT_NAME, EVENTS, HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
+from ..physics.modes import Event
 from ..physics.variables import INPUT_STARTS, OUTPUTS
-from .flight import follower_speed_reference, next_breakpoint, piece_input, speed_motion
+from .flight import follower_speed_reference, speed_motion
+from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .voltage_flight import follower_voltage_reference
 
-ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")
 
 
 def simulate_reference(
@@ -65,143 +65,87 @@ def _grid(stop_time: float, output_interval: float) -> np.ndarray:
     return grid
 
 
-def _collect(rows: list[dict[str, float]], grid: np.ndarray) -> dict[str, np.ndarray]:
-    result = {"time": grid.copy()}
-    for name in rows[0]:
-        result[name] = np.array([row[name] for row in rows])
-    return result
+class _Consistent(VoltageRun):
+    """The rigid (and compliant) drive through the one hybrid loop: ``HybridDrive``'s events and transitions."""
 
+    label = "reference integration"
 
-class _Consistent:
     def __init__(self, model: DriveModel, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
-        self.model = model
-        self.hybrid = HybridDrive(model)
-        self.u = u
-        self.rtol, self.atol = rtol, atol
-        self.energy = energy
-        stiff = model.L > 0.0 and model.L / model.R < 1e-3
-        self.method = method or ("Radau" if stiff else "DOP853")
-        two_pi = 2.0 * math.pi
-        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [two_pi]
-
-    def _next_breakpoint(self, theta: float, direction: float) -> float:
-        """The first profile breakpoint strictly ahead of theta in the direction of motion [rad]."""
-        return next_breakpoint(self.breakpoints, theta, direction)
+        super().__init__(model, u, rtol, atol, energy, method)
+        self.model, self.hybrid = model, HybridDrive(model)
+        self.target = math.nan  # rad, the breakpoint ahead of the piece (none while stuck)
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
-        model, hybrid, u = self.model, self.hybrid, self.u
-        p = model.params
-        y, mode = hybrid.initial(p["theta0"], p["omega0"], p["i0"])
+        p = self.model.params
+        y, mode = self.hybrid.initial(p["theta0"], p["omega0"], p["i0"])
         y = list(y) + ([0.0] * len(ENERGY) if self.energy else [])
-        n = hybrid.size
-        t, stop = 0.0, float(grid[-1])
-        rows: list[dict[str, float]] = []
-        k_out = 0
-        breaks = [b for b in u.breaks if 0.0 < b < stop] + [stop]
-        events_seen = 0
-        stalled, t_event_last = 0, -math.inf  # events at one instant in a row
-        input_changed = True  # at the start and at each input break: decide stick/slip anew
+        return self.pieces(grid, 0.0, y, mode, [b for b in self.u.breaks if 0.0 < b < float(grid[-1])])
+
+    def _near(self, t: float) -> float:
+        return 1e-12
+
+    def _inside(self, t: float) -> float:
+        return 1e-12 * max(1.0, t)
+
+    def _origin(self, y: list) -> float:
+        # theta is integrated relative to the last whole turn: rtol then acts on an angle below 4 pi, not on the
+        # unbounded theta (long runs keep their accuracy).
+        return 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
+
+    def _rows_first(self, t: float, after_event: bool) -> bool:
+        # Outputs due at an input's break: its left limit, the mode and the input before it (docs/model.md 8.1), as
+        # a co-simulation step that ends there; elsewhere the state after the restart's transitions.
+        return not after_event and t > 0.0 and t in self.u.breaks
+
+    def _settle(self, t: float, y: list, mode, after_event: bool):
+        """At the start and at an input's break the break-away rule and the friction branch (not after an event:
+        its transition settled the mode, and settling again at a located break-away, margin ~ -1e-17, re-sticks
+        it); then every event function already below zero (it jumped there, which solve_ivp's crossing search cannot
+        see: the side force N_r at a breakpoint where s'' jumps, every row of a motion table) fires now, as the C
+        engine's at a step's start."""
+        hybrid, u_now, n = self.hybrid, self.u.value(t), self.hybrid.size
+        if not after_event:
+            hybrid.settle(y, u_now, mode)
         while True:
-            u_now = u.value(t)
-            if input_changed and t in u.breaks and t > 0.0:
-                # Outputs due at an input's break: its left limit, the mode and the input before it (docs/model.md
-                # 8.1), as a co-simulation step that ends there.
-                while k_out < len(grid) and grid[k_out] <= t + 1e-12:
-                    rows.append(hybrid.outputs(y[:n], u.left_value(t), mode) | self._energy_row(y))
-                    k_out += 1
-            if input_changed:
-                # Not after an event: its transition has settled the mode already, and
-                # settling again at a located break-away (margin ~ -1e-17) re-sticks it.
-                hybrid.settle(y, u_now, mode)
-            # Outputs due at t (after any transition at t).
-            while k_out < len(grid) and grid[k_out] <= t + 1e-12:
-                rows.append(hybrid.outputs(y[:n], u.value(float(grid[k_out])), mode) | self._energy_row(y))
-                k_out += 1
-            if t >= stop - 1e-12:
-                break
-            t_end = next(b for b in breaks if b > t + 1e-12)
-            self.piece_end = t_end   # the piece's input up to t_end is its own (flight.piece_input)
-            # theta is integrated relative to the last whole turn: rtol then acts on
-            # an angle below 4 pi, not on the unbounded theta (long runs keep their accuracy).
-            base = 2.0 * math.pi * math.floor(y[0] / (2.0 * math.pi))
-            names = list(hybrid.event_names(mode))
-            due = self._due(y[:n], u_now, mode, names)
-            if due is not None:
-                # An event function below zero at the start: it jumped there, which solve_ivp's crossing
-                # search cannot see. The side force N_r does at a breakpoint where s'' jumps (every row of a
-                # motion table): its transition applies now, as the C engine's at a step's start.
-                stalled = stalled + 1 if t <= t_event_last else 0
-                t_event_last = t
-                if stalled > 1000:
-                    raise RuntimeError(f"reference integration: more than 1000 events at t = {t!r} s "
-                                       f"without progress (last mode {mode})")
-                events_seen += 1
-                hybrid.apply_event(y, u_now, mode, due)
-                input_changed = False
-                continue
-            funcs = [self._event(k, mode, base) for k in range(len(names))]
-            if not mode.stuck:
-                target = self._next_breakpoint(y[0], mode.direction)
-                funcs.append(self._breakpoint_event(target - base, mode.direction))
-                names.append("breakpoint")
-            for fn in funcs:
-                fn.terminal, fn.direction = True, -1
-            # A rejected trial step of an explicit method can overflow (u = 100 V):
-            # the error control discards it; numpy's warning about it is noise.
-            with np.errstate(over="ignore", invalid="ignore"):
-                sol = solve_ivp(
-                    self._rhs(mode, base), (t, t_end), [y[0] - base, *y[1:]], method=self.method, rtol=self.rtol,
-                    atol=self._atol(len(y)), events=funcs or None, dense_output=True,
-                )
-            if sol.status < 0:
-                raise RuntimeError(f"reference integration failed at t = {t}: {sol.message}")
-            t_stop = float(sol.t[-1])
-            while k_out < len(grid) and grid[k_out] < t_stop - 1e-12 * max(1.0, t_stop):
-                tk = float(grid[k_out])
-                yk = list(sol.sol(tk))
-                yk[0] += base
-                rows.append(hybrid.outputs(yk[:n], u.value(tk), mode) | self._energy_row(yk))
-                k_out += 1
-            y = list(sol.y[:, -1])
-            y[0] += base
-            t = t_stop
-            input_changed = sol.status != 1
-            if sol.status == 1:
-                stalled = stalled + 1 if t_stop <= t_event_last else 0
-                t_event_last = t_stop
-                if stalled > 1000:  # events at one instant without end (Zeno): never a hang
-                    raise RuntimeError(f"reference integration: more than 1000 events at t = {t_stop!r} s "
-                                       f"without progress (last mode {mode})")
-                fired = [k for k, te in enumerate(sol.t_events) if len(te)]
-                k = min(fired, key=lambda j: sol.t_events[j][0])
-                y = list(sol.y_events[k][0])
-                y[0] += base
-                events_seen += 1
-                if not mode.stuck and abs(target - y[0]) <= 1e-12 * max(1.0, abs(target)):
-                    # At the breakpoint: go on from just past it, as the C engine ends its step there. A root
-                    # located a rounding short of it lies where s'' is still the piece's before (the left
-                    # limit), and an event caused by the jump there (N_r's sign at a motion table's row)
-                    # would be applied on the wrong side of its cause.
-                    past = target + mode.direction * 1e-15 * max(1.0, abs(target))
-                    if mode.direction * (past - y[0]) > 0.0:
-                        y[0] = past
-                if names[k] != "breakpoint":
-                    hybrid.apply_event(y, u.value(t), mode, names[k])
-        self.events_seen = events_seen
-        return _collect(rows, grid)
+            names = hybrid.event_names(mode)
+            due = next((name for name, value in zip(names, hybrid.event_values(y[:n], u_now, mode)) if value < 0.0),
+                       None)
+            if due is None:
+                return mode, y
+            self._stall(t)
+            hybrid.apply_event(y, u_now, mode, due)
 
-    def _due(self, y, u: float, mode, names: list[str]) -> str | None:
-        """The first event whose function is already below zero at the state y (it jumped there), or None."""
-        for name, value in zip(names, self.hybrid.event_values(y, u, mode)):
-            if value < 0.0:
-                return name
-        return None
+    def _piece(self, t: float, y: list, mode):
+        hybrid, n, u_at = self.hybrid, self.hybrid.size, piece_input(self.u, self.piece_end)
+        base = self._origin(y)
 
-    def _atol(self, size: int) -> list[float]:
-        tol = [self.atol] * size
+        def value(k: int):
+            return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u_at(t)[0], mode)[k]
+        events = [event(EVENTS[name], value(k)) for k, name in enumerate(hybrid.event_names(mode))]
+        if not mode.stuck:
+            target, direction = next_breakpoint(self.breakpoints, y[0], mode.direction) - base, mode.direction
+            self.target = target + base
+            events.append(event(Event.BREAKPOINT, lambda t, y: direction * (target - y[0])))
+        atol = [self.atol] * len(y)
         if self.energy:
-            tol[-len(ENERGY):] = [self.atol * 1e-2] * len(ENERGY)
-        return tol
+            atol[-len(ENERGY):] = [self.atol * 1e-2] * len(ENERGY)
+        return events, self._rhs(mode, base), {"method": self.method, "atol": atol}
+
+    def _event(self, t: float, y: list, mode, kind: Event):
+        """Any event: at the breakpoint, on from just past it, as the C engine ends its step there (a root located
+        a rounding short of it lies where s'' is still the piece's before, and an event caused by the jump there,
+        N_r's sign at a motion table's row, would be applied on the wrong side of its cause); then HybridDrive's
+        transition."""
+        target = self.target
+        if not mode.stuck and abs(target - y[0]) <= 1e-12 * max(1.0, abs(target)):
+            past = target + mode.direction * 1e-15 * max(1.0, abs(target))
+            if mode.direction * (past - y[0]) > 0.0:
+                y[0] = past
+        if kind is not Event.BREAKPOINT:
+            self.hybrid.apply_event(y, self.u.value(t), mode, EVENT_NAME[kind])
+        return mode, y
+
+    TRANSITIONS = dict.fromkeys((*EVENTS.values(), Event.BREAKPOINT), _event)
 
     def _rhs(self, mode, base: float):
         hybrid, model, n = self.hybrid, self.model, self.hybrid.size
@@ -222,18 +166,10 @@ class _Consistent:
 
         return rhs
 
-    def _event(self, k: int, mode, base: float):
-        hybrid, n, u_at = self.hybrid, self.hybrid.size, piece_input(self.u, self.piece_end)
-        return lambda t, y: hybrid.event_values([y[0] + base, *y[1:n]], u_at(t)[0], mode)[k]
-
-    @staticmethod
-    def _breakpoint_event(target: float, direction: float):
-        return lambda t, y: direction * (target - y[0])
-
-    def _energy_row(self, y) -> dict[str, float]:
-        if not self.energy:
-            return {}
-        return dict(zip(ENERGY, y[-len(ENERGY):]))
+    def _row(self, t: float, y, mode, left: bool) -> dict[str, float]:
+        n = self.hybrid.size
+        row = self.hybrid.outputs(y[:n], self.u.left_value(t) if left else self.u.value(t), mode)
+        return row | (dict(zip(ENERGY, y[-len(ENERGY):])) if self.energy else {})
 
 
 def _consistent(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
@@ -255,7 +191,7 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         for j in range(steps):
             scheme.step(h / steps, u.value(float(t0) + j * h / steps), int(p["max_steps"]))
         rows.append(scheme.outputs())
-    return _collect(rows, grid)
+    return collect(rows, grid)
 
 
 def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
@@ -289,7 +225,7 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged, sign(motion)))
         if omega_ref.value(t) == 0.0:  # at rest from t on (a stop): there from the next interval, as the FMU's input
             s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
-    return _collect(rows, grid)
+    return collect(rows, grid)
 
 
 # The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/tools/test_layout.py).

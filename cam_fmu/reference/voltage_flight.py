@@ -1,14 +1,13 @@
 """The reference of the follower of its own on a voltage-driven cam (docs/model.md section 13.6).
 
-scipy's solve_ivp (DOP853, or Radau with a fast electrical pole) integrates y = (theta, omega, i, s, v), and
-(phi, omega_m) on a compliant shaft, of ``physics.voltage_follower.VoltageFollower``, with the energy integrals
-E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide = int f |v| dt and
-E_damp = int d_shaft (omega_m - omega)^2 dt. Terminal events stop it at each lift-off (the contact force P reaches
-0), touch-down (the gap reaches -TOUCH, as reference/flight.py), halt in flight (v = 0 under guide friction, where
-the friction turns), the shaft's stop (omega = 0: stuck, or on the other way, by the break-away rule with the
-follower's contact), the stuck shaft's break-away and input break; the transition is applied at the located time.
-With the cam stuck the follower flies alone and lands on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a, and N_contact [N], plus contact (+1, -1, 0),
-impacts (touch-downs so far) and, with energy, the integrals and E_impact (the impacts' losses so far) [J].
+y = (theta, omega, i, s, v), and (phi, omega_m) on a compliant shaft, of ``physics.voltage_follower.VoltageFollower``,
+with the energy integrals (hybrid.ENERGY), through the one hybrid loop (hybrid.py) with the events of docs/model.md
+13.7: lift-off (the contact force P reaches 0), touch-down (the gap reaches -TOUCH, as flight.py), halt in flight,
+the shaft's stop (stuck, or on the other way by the break-away rule with the follower's contact), the stuck shaft's
+break-away, the side force's kink and the profile's breakpoints. With the cam stuck the follower flies alone and lands
+on it (the impact turns the cam unless on a dwell). Rows are the drive's outputs with the follower's own s, v, a and
+N_contact [N], plus contact (+1, -1, 0), impacts (touch-downs so far) and, with energy, the integrals and E_impact
+(the impacts' losses so far) [J].
 """
 from __future__ import annotations
 
@@ -16,31 +15,35 @@ import math
 
 import numpy as np
 
+from ..physics.drive import sign as sgn
 from ..physics.formulations.consistent import SIDE_HYSTERESIS
+from ..physics.modes import Event, Follower, Mode, Shaft
 from ..physics.signals import Signal
-from ..physics.voltage_follower import VoltageFollower, sgn
-from .flight import FLIGHT_ANGLE, TOUCH, PieceRun, next_breakpoint, piece_input
+from ..physics.voltage_follower import VoltageFollower
+from .flight import FLIGHT_ANGLE, flight_events, flying
+from .hybrid import ENERGY, VoltageRun, event, next_breakpoint, piece_input
 
-ENERGY = ("E_in", "E_copper", "E_shaft", "E_guide", "E_damp")  # after the state: the energy integrals [J]
 
 
-class VoltageFollowerRun(PieceRun):
-    """One run of the voltage drive with a spring-closed follower of its own."""
+class VoltageFollowerRun(VoltageRun):
+    """One run of the voltage drive with a follower of its own; its mode is ``body.mode``, which the body's
+    equations read (the shaft's direction, stuck) and the transitions change in place."""
 
     label = "voltage follower reference"
 
     def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
+        super().__init__(model, u, rtol, atol, energy, method)
         self.body = VoltageFollower(model)
-        self.u = u
-        self.rtol, self.atol, self.energy = rtol, atol, energy
-        stiff = model.L > 0.0 and model.L / model.R < 1e-3
-        self.method = method or ("Radau" if stiff else "DOP853")
         self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
         self.loss = 0.0  # J, the impacts' losses so far
         self.lift_offs: list[tuple[float, float, float]] = []  # (t [s], s [m], v [m/s]) where the follower left the cam
-        self.rebound = 0.0  # s, shorter than the bounce the last rebound starts (reference/flight.py), or 0
-        self.breakpoints = sorted(set(model.program.breakpoints()) | {0.0}) + [2.0 * math.pi]
         self.target = 0.0  # rad, the breakpoint the current piece stops at
+
+    def _mode(self, contact: float, y: list) -> Mode:
+        """The body's mode with the follower on the flank ``contact`` (+1, -1), or off the flanks (0)."""
+        mode = self.body.mode
+        mode.follower = Follower.flank(contact) if contact else flying(self.body, y, 4)
+        return mode
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
         body, model = self.body, self.body.model
@@ -60,26 +63,40 @@ class VoltageFollowerRun(PieceRun):
                 contact, y = other, y_other
         if body.heading == 0.0:
             contact, y = self._rest(t, y, contact)
-        return self.pieces(grid, t, y, contact, sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
+        return self.pieces(grid, t, y, self._mode(contact, y),
+                           sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
 
-    def _piece(self, t: float, y: list, contact: float) -> tuple[list, object, dict]:
-        n = self.body.size
+    def _piece(self, t: float, y: list, mode: Mode) -> tuple[list, object, dict]:
+        body, n, contact = self.body, self.body.size, mode.contact
         options = {"method": self.method, "atol": [self.atol] * n + [self.atol * 1e-2] * len(ENERGY)}
-        if contact == 0.0 and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
+        if not contact and y[1] != 0.0:  # a flight without a spring is a polynomial: without a bound, one step
             options["max_step"] = FLIGHT_ANGLE / abs(y[1])  # could hold a gap's crossing and its return
-        elif contact == 0.0 and self.body.heading == 0.0 and self.body.c > 0.0:  # at a stuck cam: a tenth of the gap
-            c, scale = self.body.c, self.body.acceleration_scale(y[:self.body.size], self.u.value(t))
+        elif not contact and mode.shaft is Shaft.STUCK and body.c > 0.0:  # at a stuck cam: a tenth of the gap
+            c, scale = body.c, body.acceleration_scale(y[:n], self.u.value(t))
             options["max_step"] = 0.1 * min(math.sqrt(2.0 * c / scale), c / abs(y[4]) if y[4] else math.inf)
-        sigma = self.body.direction(y) if contact == 0.0 else 0.0  # the flight's friction direction, held
-        events = self._events(contact, sigma, t, y)
-        # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md 6.3): DOP853
-        # stepping over one with guide friction was 2.5e-7 rad/s off.
-        target = self.target = next_breakpoint(self.breakpoints, y[0], 1.0)
+        sigma = body.direction(y[3], y[4]) if mode.follower is Follower.FLIGHT else 0.0  # held over the piece
+        u_at = piece_input(self.u, self.piece_end)
 
-        def breakpoint(t, y):
-            return target - y[0]
-        breakpoint.terminal, breakpoint.direction, breakpoint.kind = True, -1, "breakpoint"
-        return events + [breakpoint], self._rhs(contact, sigma), options
+        def at(t: float) -> float:   # the piece's input, at its end (an input's break) the left limit
+            return u_at(t)[0]
+        if mode.shaft is Shaft.STUCK:  # until the torque on the held cam (a current, a shaft) starts it
+            events = [event(Event.BREAK_AWAY, lambda t, y: -body.start(y[:n], at(t), contact)[0])]
+        else:
+            heading = mode.heading
+            events = [event(Event.STOP, lambda t, y: heading * y[1])]
+        if contact and mode.shaft is not Shaft.STUCK:
+            events.append(event(Event.LIFT_OFF, lambda t, y: body.contact_force(y[:n], at(t), contact)))
+            side = sgn(body.side_force(y, self.u.value(t), contact)) if body.mu > 0.0 else 0.0
+            if side != 0.0:  # the piece ends just past the kink of |N_r| (by 1e-9 N, docs/model.md 10), no transition
+                events.append(event(Event.SIDE, lambda t, y: side * body.side_force(y[:n], at(t), contact)
+                                    + SIDE_HYSTERESIS))
+        elif not contact:
+            events += flight_events(body, lambda y: body.gaps(y[0], y[3]), 4, sigma)
+        # The piece ends at the profile's next breakpoint, where s'' or the third derivative jumps (docs/model.md
+        # 6.3): DOP853 stepping over one with guide friction was 2.5e-7 rad/s off.
+        target = self.target = next_breakpoint(self.breakpoints, y[0], 1.0)
+        events.append(event(Event.BREAKPOINT, lambda t, y: target - y[0]))
+        return events, self._rhs(contact, sigma), options
 
     def _rhs(self, contact: float, sigma: float):
         body, energy, n = self.body, self.energy, self.body.size
@@ -98,67 +115,51 @@ class VoltageFollowerRun(PieceRun):
                          d_shaft * slip * slip if body.compliant else 0.0]
         return rhs
 
-    def _events(self, contact: float, sigma: float, t0: float, y0: list) -> list:
-        body, u = self.body, self.u
-        piece = piece_input(u, self.piece_end)
+    # ------------------------------------------------------------- the transitions (docs/model.md 13.7)
+    def _at_rest(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        """A stop or a break-away: the rule at rest (``_rest``; at a located break-away it starts at once)."""
+        contact, y = self._rest(t, y, mode.contact, kind is Event.BREAK_AWAY)
+        return self._mode(contact, y), y
 
-        def u_at(t: float) -> float:   # the piece's input, at its end (an input's break) the left limit
-            return piece(t)[0]
-        events = []
+    def _lift_off(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        s, s1, _, _ = self.body.flank(y[0], mode.contact)
+        self.lift_offs.append((t, s, s1 * y[1]))
+        y = y[:3] + [s, s1 * y[1]] + y[5:]
+        return self._mode(0.0, y), y
 
-        def add(kind: str, fn) -> None:
-            fn.terminal, fn.direction, fn.kind = True, -1, kind
-            events.append(fn)
+    def _halt(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        y = y[:4] + [0.0] + y[5:]
+        return self._mode(0.0, y), y
 
-        heading = body.heading
-        if heading == 0.0:  # stuck: until the torque on the held cam (a current, a shaft) starts it
-            add("break-away", lambda t, y: -body.start(y[:body.size], u_at(t), contact)[0])
-            if contact:
-                return events
-        else:
-            add("stop", lambda t, y: heading * y[1])
-        if contact:
-            add("lift-off", lambda t, y: body.contact_force(y[:body.size], u_at(t), contact))
-            side = sgn(body.side_force(y0, u.value(t0), contact)) if body.mu > 0.0 else 0.0
-            if side != 0.0:  # the piece ends just past the kink of |N_r| (by 1e-9 N, docs/model.md 10), no transition
-                add("side", lambda t, y: side * body.side_force(y[:body.size], u_at(t), contact) + SIDE_HYSTERESIS)
-            return events
-        add("touch-down +1", lambda t, y: body.gap(y, 1.0) + TOUCH)
-        if body.two_sided:
-            add("touch-down -1", lambda t, y: body.gap(y, -1.0) + TOUCH)
-        if body.f0 > 0.0 and sigma != 0.0:  # the friction's direction turns where v does
-            add("halt", lambda t, y: sigma * y[4])
-        return events
+    def _side(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        return mode, y
 
-    def _transition(self, t: float, y: list, contact: float, kind: str) -> tuple[float, list]:
+    def _breakpoint(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        # on from just past it: a root a rounding short of it lies on the piece before
+        return mode, [max(y[0], self.target + 1e-15 * max(1.0, abs(self.target)))] + y[1:]
+
+    def _touch(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
         body, u_t, n = self.body, self.u.value(t), self.body.size
-        if kind in ("stop", "break-away"):
-            return self._rest(t, y, contact, kind == "break-away")
-        if kind == "lift-off":
-            s, s1 = body.flank(y[0], contact)
-            self.lift_offs.append((t, s, s1 * y[1]))
-            return 0.0, y[:3] + [s, s1 * y[1]] + y[5:]
-        if kind == "halt":
-            return 0.0, y[:4] + [0.0] + y[5:]
-        if kind == "side":
-            return contact, y
-        if kind == "breakpoint":  # on from just past it: a root a rounding short of it lies on the piece before
-            return contact, [max(y[0], self.target + 1e-15 * max(1.0, abs(self.target)))] + y[1:]
+        flank = 1.0 if kind is Event.TOUCH_LOWER else -1.0
         s1 = body.program.derivatives(y[0])[1]
         w_before = y[4] - s1 * y[1]
-        after, state, hit = body.land(y[:n], u_t, 1.0 if kind == "touch-down +1" else -1.0)
+        after, state, hit = body.land(y[:n], u_t, flank)
         self.loss += hit.loss
-        w = state[4] - s1 * state[1]
-        self.impacts.append((t, w_before, w))
-        if after == 0.0 and w != 0.0:
-            self.rebound = abs(w) / (2.0 * body.acceleration_scale(state, u_t))
-        return after, state + y[n:]
+        self._impact(t, w_before, state[4] - s1 * state[1], after == 0.0, body.acceleration_scale(state, u_t))
+        y = state + y[n:]
+        return self._mode(after, y), y
 
-    def _settle(self, t: float, y: list, contact: float) -> tuple[float, list]:
+    TRANSITIONS = {Event.STOP: _at_rest, Event.BREAK_AWAY: _at_rest, Event.LIFT_OFF: _lift_off, Event.HALT: _halt,
+                   Event.SIDE: _side, Event.BREAKPOINT: _breakpoint,
+                   Event.TOUCH_LOWER: _touch, Event.TOUCH_UPPER: _touch}
+
+    def _settle(self, t: float, y: list, mode: Mode, after_event: bool) -> tuple[Mode, list]:
         """Before each piece: ``_rest`` while the shaft is stuck (the input may start it), else ``_hold``."""
-        if self.body.heading == 0.0:
-            return self._rest(t, y, contact)
-        return self._hold(t, y, contact)
+        if mode.shaft is Shaft.STUCK:
+            contact, y = self._rest(t, y, mode.contact)
+        else:
+            contact, y = self._hold(t, y, mode.contact)
+        return self._mode(contact, y), y
 
     def _rest(self, t: float, y: list, contact: float, at_threshold: bool = False) -> tuple[float, list]:
         """The shaft at rest (the start, an input, a stop, a break-away): stuck with the follower at rest on its flank,
@@ -177,17 +178,17 @@ class VoltageFollowerRun(PieceRun):
     def _hold(self, t: float, y: list, contact: float) -> tuple[float, list]:
         """On the flank: the follower set on it, or lifted off at once where P is already < 0 (a jump of s'')."""
         if contact:
-            s, s1 = self.body.flank(y[0], contact)
+            s, s1, _, _ = self.body.flank(y[0], contact)
             y = y[:3] + [s, s1 * y[1]] + y[5:]
             if self.body.contact_force(y[:self.body.size], self.u.value(t), contact) < 0.0:
                 self.lift_offs.append((t, y[3], y[4]))
                 return 0.0, y
         return contact, y
 
-    def _row(self, t: float, y, contact: float) -> dict[str, float]:
+    def _row(self, t: float, y, mode: Mode, left: bool) -> dict[str, float]:
         n = self.body.size
         u = self.u.left_value(t) if t > 0.0 else self.u.value(t)   # at a break its left limit (docs/model.md 8.1)
-        row = self.body.outputs([float(x) for x in y[:n]], u, contact)
+        row = self.body.outputs([float(x) for x in y[:n]], u, mode.contact)
         row["impacts"] = float(len(self.impacts))
         if self.energy:
             row.update({name: float(value) for name, value in zip(ENERGY, y[n:])}, E_impact=self.loss)

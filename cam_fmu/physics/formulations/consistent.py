@@ -21,12 +21,18 @@ import math
 from dataclasses import dataclass
 
 from ..drive import DriveModel
+from ..modes import Event, Follower, Shaft
 from ..variables import output_record
 
 THETA, OMEGA, CURRENT, TWIST, OMEGA_M = 0, 1, 2, 3, 4  # slots of the continuous state y
 # The events of the hybrid system (docs/model.md section 10); an engine's event codes index this tuple.
 EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
 STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES
+# Each of them in the one enumeration of the reference's events (physics/modes.py): the contact loss is the groove's
+# lift-off, an engagement a touch-down (plastic here).
+EVENTS = dict(zip(EVENT_NAMES, (Event.STOP, Event.LIFT_OFF, Event.TOUCH_LOWER, Event.TOUCH_UPPER, Event.BREAK_AWAY,
+                                Event.SIDE)))
+EVENT_NAME = {kind: name for name, kind in EVENTS.items()}
 # N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
 # exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch
 # back and forth at one instant (it did: the reference looped at a break-away from theta = 0).
@@ -42,6 +48,16 @@ class Mode:
     contact: int = 1
     s_free: float = 0.0  # m, follower position while contact == 0
     side: float = 1.0  # sign of the guide's side force N_r (the friction branch) while engaged and moving
+
+    @property
+    def follower(self) -> Follower:
+        """The named mode of the follower: on a flank (contact +1, -1; always without backlash), else in flight."""
+        return Follower.flank(self.contact)
+
+    @property
+    def shaft(self) -> Shaft:
+        """The named mode of the shaft: stuck or turning (``direction``)."""
+        return Shaft.STUCK if self.stuck else Shaft.TURNING
 
     def copy(self) -> "Mode":
         return Mode(self.stuck, self.direction, self.contact, self.s_free, self.side)
