@@ -79,7 +79,25 @@ def apply_sets(scene, sets: list[str]):
         for entry in raw.get("runs", []):
             entry.pop(name, None)
     raw["parameters"] = params
+    raw["runs"] = _distinct_runs(raw.get("runs", []), sets)
     return scene_from_dict(raw, name=scene.name, path=scene.path)
+
+
+def _distinct_runs(runs: list[dict], sets: list[str]) -> list[dict]:
+    """The runs that still differ once ``--set`` has taken their own values: a run that only repeats an
+    earlier one would be written under a label that no longer says what it ran (backlash's ``c_0`` run at
+    ``--set c=0.5mm``), so it is left out, with a note on stderr."""
+    kept: list[dict] = []
+    seen: dict[str, str] = {}
+    for entry in runs:
+        key = repr(sorted((k, repr(v)) for k, v in entry.items() if k != "label"))
+        if key in seen:
+            print(f"note: run {entry.get('label')!r} is the same as run {seen[key]!r} under "
+                  f"{' '.join('--set ' + s for s in sets)}; it is not run", file=sys.stderr)
+            continue
+        seen[key] = str(entry.get("label"))
+        kept.append(entry)
+    return kept
 
 
 def csv_path(out: Path, scene_name: str, label: str | None) -> Path:

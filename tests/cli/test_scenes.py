@@ -75,6 +75,24 @@ def test_runs_inherit_the_scene_and_override_it():
 
 
 # ------------------------------------------------------------------- the CLI
+def test_set_leaves_out_a_run_it_makes_a_copy_of(capsys):
+    """backlash compares c = 0.5 mm with a run labelled c_0; ``--set c=...`` takes every run's own c, so the
+    second run would repeat the first under a label that says c = 0: it is left out, with a note."""
+    from cam_fmu.cli.simulate import apply_sets
+    from cam_fmu.experiments.scenes import find_scene
+
+    scene = find_scene("backlash")
+    assert [run.label for run in scene.runs] == ["c_0.5mm", "c_0"]
+    assert scene.runs[1].params["c"] == 0.0
+    changed = apply_sets(scene, ["c=0.2mm"])
+    assert [run.label for run in changed.runs] == ["c_0.5mm"]
+    assert changed.primary.params["c"] == pytest.approx(2e-4, rel=1e-15)
+    assert "run 'c_0' is the same as run 'c_0.5mm'" in capsys.readouterr().err
+    other = apply_sets(scene, ["mu=0.1"])  # a parameter no run sets: both runs stay, each with its own c
+    assert [(run.label, run.params["c"], run.params["mu"]) for run in other.runs] == [
+        ("c_0.5mm", 5e-4, 0.1), ("c_0", 0.0, 0.1)]
+
+
 def _read_csv(path: Path) -> tuple[list[str], np.ndarray]:
     with path.open() as fh:
         header = [name.split(" [", 1)[0] for name in next(csv.reader(fh))]  # 'omega [rad/s]' -> 'omega'
