@@ -33,7 +33,9 @@ for _folder in (Path(__file__).resolve().parent, *sorted(p for p in Path(__file_
                                                          if p.is_dir() and any(p.glob("test_*.py")))):
     sys.path.insert(0, str(_folder))
 
-from markers import DURATIONS, DurationRecorder, is_external, is_slow, load  # noqa: E402 - after sys.path
+from markers import (DURATIONS, DurationRecorder, XdistDurations, is_external, is_slow, load,  # noqa: E402
+                     longest_modules_first)
+from session_share import once, shared_folder  # noqa: E402 - after sys.path
 
 RECORDED = load()
 
@@ -47,10 +49,15 @@ def pytest_addoption(parser):
 def pytest_configure(config):
     path = config.getoption("record_durations")
     if path is not None:
-        config.pluginmanager.register(DurationRecorder(path), "cam_fmu_durations")
+        recorder = DurationRecorder(path, config)
+        config.pluginmanager.register(recorder, "cam_fmu_durations")
+        if config.pluginmanager.hasplugin("xdist") and not hasattr(config, "workerinput"):
+            config.pluginmanager.register(XdistDurations(recorder), "cam_fmu_durations_xdist")
 
 
 def pytest_collection_modifyitems(config, items):
+    if hasattr(config, "workerinput"):  # a pytest-xdist worker: the longest modules are handed out first
+        items[:] = longest_modules_first(items, RECORDED)
     for item in items:
         if is_external(item.nodeid):
             item.add_marker(pytest.mark.external)
@@ -79,33 +86,37 @@ def _build_fmu(dest: Path, model: str = "cam", host_only: bool = False) -> Path:
 def cam_fmu_path(tmp_path_factory, request) -> Path:
     """cam.fmu built once per test session from this checkout (into a temporary folder). It is C: loading it
     into the pytest process is safe."""
-    return _build_fmu(tmp_path_factory.mktemp("cam_fmu_build") / "cam.fmu", host_only=_fast_loop(request.config))
+    return once(tmp_path_factory, "cam_fmu_build",
+                lambda folder: _build_fmu(folder / "cam.fmu", host_only=_fast_loop(request.config)))
 
 
 @pytest.fixture(scope="session")
 def pi_speed_fmu_path(tmp_path_factory, request) -> Path:
     """pi_speed.fmu built once per test session (build_fmu.py --model pi_speed): the PI controller in C."""
-    return _build_fmu(tmp_path_factory.mktemp("pi_speed_build") / "pi_speed.fmu", "pi_speed",
-                      host_only=_fast_loop(request.config))
+    return once(tmp_path_factory, "pi_speed_build",
+                lambda folder: _build_fmu(folder / "pi_speed.fmu", "pi_speed", host_only=_fast_loop(request.config)))
 
 
 @pytest.fixture(scope="session")
 def cam3_fmu_path(tmp_path_factory, request) -> Path:
     """cam3.fmu (the drive as FMI 3.0 co-simulation) built once per test session (build_fmu.py --model cam3):
     every test of it reads this one build (six modules built their own, 8-9 minutes of zig in a full run)."""
-    return _build_fmu(tmp_path_factory.mktemp("cam3_build") / "cam3.fmu", "cam3", host_only=_fast_loop(request.config))
+    return once(tmp_path_factory, "cam3_build",
+                lambda folder: _build_fmu(folder / "cam3.fmu", "cam3", host_only=_fast_loop(request.config)))
 
 
 @pytest.fixture(scope="session")
 def wheels_folder(tmp_path_factory) -> Path:
     """Every platform's wheel built once per test session (build_fmu.py --wheels): the wheel tests install them,
     the reproducibility test builds them once more and compares the bytes."""
-    folder = tmp_path_factory.mktemp("wheels")
-    proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--wheels", str(folder)], capture_output=True,
-                          text=True, cwd=ROOT, timeout=3600)
-    if proc.returncode != 0:
-        pytest.fail(f"build_fmu.py --wheels failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
-    return folder
+    def build(folder: Path) -> Path:
+        proc = subprocess.run([sys.executable, str(ROOT / "build_fmu.py"), "--wheels", str(folder)],
+                              capture_output=True, text=True, cwd=ROOT, timeout=3600)
+        if proc.returncode != 0:
+            pytest.fail(f"build_fmu.py --wheels failed (exit {proc.returncode}):\n{proc.stderr[-3000:]}")
+        return folder
+
+    return once(tmp_path_factory, "wheels", build)
 
 
 @pytest.fixture(scope="session")
@@ -116,12 +127,13 @@ def engine_fmu_path(cam_fmu_path) -> Path:
 
 
 @pytest.fixture(scope="session")
-def reference_runs():
+def reference_runs(tmp_path_factory):
     """The scipy reference's runs, each integrated once per session (reference_runs.py): the modules that compare
-    against the same scene share its runs."""
+    against the same scene share its runs, across pytest-xdist's workers too (kept in the session's shared
+    folder)."""
     from reference_runs import ReferenceRuns
 
-    return ReferenceRuns()
+    return ReferenceRuns(shared_folder(tmp_path_factory) / "reference_runs")
 
 
 @pytest.fixture(autouse=True)

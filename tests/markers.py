@@ -75,12 +75,43 @@ def fast_loop_bound(recorded: dict) -> tuple[float, int]:
     return sum(fast.values()) + fixtures, len(fast)
 
 
+def module_seconds(recorded: dict) -> dict[str, float]:
+    """Each test file's recorded seconds: its tests' own times and its module fixtures' set-ups."""
+    total: dict[str, float] = defaultdict(float)
+    for table in ("tests", "fixtures"):
+        for key, seconds in recorded[table].items():
+            total[key.split("::")[0]] += seconds
+    return total
+
+
+def longest_modules_first(items: list, recorded: dict) -> list:
+    """``items`` (pytest's collected tests) with their modules in the order of their recorded seconds, longest
+    first (a module not recorded last), each module's tests in their own order: pytest-xdist's loadscope hands
+    whole modules to the workers in this order, so the longest start at once and the short ones fill the end."""
+    seconds = module_seconds(recorded)
+    first = {}
+    for index, item in enumerate(items):
+        first.setdefault(item.nodeid.split("::")[0], index)
+    return sorted(items, key=lambda item: (-seconds.get(item.nodeid.split("::")[0], 0.0),
+                                           first[item.nodeid.split("::")[0]]))
+
+
+WORKER_OUTPUT = "cam_fmu_durations"  # the key a pytest-xdist worker sends its record under
+
+
 class DurationRecorder:
     """``--record-durations PATH``: every test's own seconds and its shared fixtures' set-ups, written at the
-    end of the session (a full run: `python -m pytest -q --record-durations tests/durations.json`)."""
+    end of the session (a full run: `python -m pytest -q -n 2 --record-durations tests/durations.json`).
 
-    def __init__(self, path: Path) -> None:
+    Under pytest-xdist every worker records the tests it ran and sends its record to the controlling process
+    at its end (``config.workeroutput``, which xdist carries to ``pytest_testnodedown``); the controller writes
+    the file from all of them. A module fixture or session fixture set up in more than one worker keeps its
+    longest set-up (a session fixture's waiting for another worker's build is no test's cost)."""
+
+    def __init__(self, path: Path, config=None) -> None:
         self.path = path
+        self.config = config
+        self.workers: list[dict] = []  # the records the xdist workers sent (in the controller)
         self.tests: dict[str, float] = defaultdict(float)
         self.shared: dict[str, float] = defaultdict(float)  # per test: its shared fixtures' set-ups
         self.fixtures: dict[str, float] = defaultdict(float)
@@ -122,17 +153,44 @@ class DurationRecorder:
             self.fixtures[fixture_key(self.item_id, fixturedef.argname)] += own
 
     def pytest_runtest_logreport(self, report) -> None:
-        self.tests[report.nodeid] += report.duration
+        if self.item_id is not None:  # a test this process runs (xdist's controller sees the workers' reports)
+            self.tests[report.nodeid] += report.duration
+
+    def own(self) -> dict[str, dict[str, float]]:
+        """This process's record: ``tests`` (own seconds), ``fixtures`` and ``session`` (set-up seconds)."""
+        return {"tests": {n: round(max(s - self.shared[n], 0.0), 3) for n, s in self.tests.items()},
+                "fixtures": {k: round(s, 3) for k, s in self.fixtures.items()},
+                "session": {k: round(s, 3) for k, s in self.session.items()}}
 
     def pytest_sessionfinish(self, session, exitstatus) -> None:
         """Write the record: a test or fixture that ran replaces its entry, the others keep theirs (a run of some
         modules updates those; a full run updates all, and a test no longer collected keeps its entry, which
-        only over-counts the fast loop's bound)."""
+        only over-counts the fast loop's bound). An xdist worker sends its record to the controller instead."""
+        config = self.config
+        if config is not None and hasattr(config, "workerinput"):
+            config.workeroutput[WORKER_OUTPUT] = self.own()
+            return
         record = load(self.path)
-        record["command"] = ".venv/bin/python -m pytest -q --record-durations tests/durations.json"
-        record["tests"].update({n: round(max(s - self.shared[n], 0.0), 3) for n, s in self.tests.items()})
-        record["fixtures"].update({k: round(s, 3) for k, s in self.fixtures.items()})
-        record["session"].update({k: round(s, 3) for k, s in self.session.items()})
+        record["command"] = ".venv/bin/python -m pytest -q -n 2 --record-durations tests/durations.json"
+        merged = self.own()
+        for worker in self.workers:
+            for table in ("tests", "fixtures", "session"):
+                for key, seconds in worker[table].items():
+                    merged[table][key] = max(seconds, merged[table].get(key, 0.0))
+        for table in ("tests", "fixtures", "session"):
+            record[table].update(merged[table])
         for table in ("tests", "fixtures", "session"):
             record[table] = dict(sorted(record[table].items()))
         self.path.write_text(json.dumps(record, indent=0) + "\n", encoding="utf-8")
+
+
+class XdistDurations:
+    """The controller's half of ``DurationRecorder`` under pytest-xdist: each worker's record as it ends."""
+
+    def __init__(self, recorder: DurationRecorder) -> None:
+        self.recorder = recorder
+
+    def pytest_testnodedown(self, node, error) -> None:
+        record = getattr(node, "workeroutput", {}).get(WORKER_OUTPUT)
+        if record is not None:
+            self.recorder.workers.append(record)

@@ -30,7 +30,7 @@ from typing import Callable, List, Sequence
 from xml.etree import ElementTree as ET
 
 from ..engine import reproducible, targets
-from . import binaries, engine_fmu, ssp
+from . import binaries, build_lock, engine_fmu, ssp
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]  # this cam_fmu
 # every FMU the project builds: name -> (its C model, FMI version)
@@ -126,9 +126,17 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
     path = default_model_path(model)
     if path == shipped_path(model) or not is_stale(path, model=model):
         return path  # a wheel's prebuilt FMU is its own: never rebuilt (it needs no compiler)
+    with build_lock.building(path.parent):  # another process building it: wait, then it is up to date
+        if not is_stale(path, model=model):
+            return path
+        _build_into(path, model, log)
+    return path
+
+
+def _build_into(path: Path, model: str, log: Callable[[str], None] | None) -> None:
+    """Build ``model`` into ``path`` (ensure_fmu, holding the folder's build lock)."""
     if log is not None:
         log(f"# building {path} (missing or older than its sources)")
-    path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="cam_fmu_build_", dir=path.parent) as tmp:
         dest = Path(tmp) / f"{model}.fmu"
         # a checkout's models/ get every platform (zig); the user cache of an installed package, this machine's
@@ -139,7 +147,6 @@ def ensure_fmu(path: str | Path | None = None, log: Callable[[str], None] | None
         if proc.returncode != 0 or not dest.is_file():
             raise FmuFileError(f"building {path} failed (exit {proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
         os.replace(dest, path)  # atomic: a process reading the old file keeps it
-    return path
 
 
 def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None = None) -> Path:
@@ -160,11 +167,12 @@ def ensure_ssp(path: str | Path | None = None, log: Callable[[str], None] | None
         return path  # a wheel's prebuilt SSP, with its prebuilt FMUs
     fmus = {model: ensure_fmu(None, log, model) for model in ("cam", "pi_speed")}  # the loop's two FMUs
     inputs = [*fmus.values(), Path(ssp.__file__)]
-    if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in inputs):
-        return path
-    if log is not None:
-        log(f"# writing {path}")
-    return build_ssp(path, fmus["cam"], fmus["pi_speed"], name)
+    with build_lock.building(path.parent):  # one writer; a second finds it written
+        if path.is_file() and all(path.stat().st_mtime >= f.stat().st_mtime for f in inputs):
+            return path
+        if log is not None:
+            log(f"# writing {path}")
+        return build_ssp(path, fmus["cam"], fmus["pi_speed"], name)
 
 
 def fmi_version(path: str | Path) -> str:

@@ -33,6 +33,7 @@ Standard library only (and the scene files' numbers, ``scene_data``).
 """
 from __future__ import annotations
 
+import os
 import shutil
 import zipfile
 from dataclasses import dataclass, field
@@ -199,7 +200,7 @@ def write_ssp(system: System, fmus: Mapping[str, str | Path], dest: str | Path) 
     value equal to the FMU's own default is not written (module docstring)."""
     dest = Path(dest)
     dest.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dest.with_name(dest.name + ".tmp")
+    tmp = dest.with_name(f"{dest.name}.{os.getpid()}.tmp")  # its own: two writers never share one
     defaults = {comp.name: fmu_defaults(fmus[comp.name]) for comp in system.components.values()}
     entries: dict[str, bytes | Path] = {"SystemStructure.ssd": system_xml(without_defaults(system, defaults))}
     for comp in system.components.values():

@@ -5,7 +5,6 @@ the earlier layout still read and moved on --resume.
 Sweeps run on the C engine in child processes (`cam-fmu sweep`), as users run them."""
 from __future__ import annotations
 
-import csv
 import json
 import os
 import re
@@ -21,27 +20,10 @@ import pytest
 from cam_fmu.experiments.sweep_cases import SweepError
 from cam_fmu.experiments.sweep_lock import hold
 from cam_fmu.experiments.sweep_store import iter_rows, parts, repair
+from cli_run import cli, csv_rows, env
 
-ROOT = Path(__file__).resolve().parents[2]
 SMALL = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:12", "--metric", "peak_M,final_omega", "--stop-time", "0.2",
          "--serial", "--batch-size", "4", "--no-plot"]
-
-
-def _env() -> dict:
-    return {**os.environ, "PYTHONPATH": str(ROOT), "CAM_FMU_PROGRESS": "0"}
-
-
-def _cli(*args: str, cwd: Path, check: int | None = 0) -> subprocess.CompletedProcess:
-    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *args], capture_output=True, text=True, env=_env(),
-                          cwd=cwd, timeout=900)
-    if check is not None:
-        assert proc.returncode == check, proc.stdout[-3000:] + proc.stderr[-3000:]
-    return proc
-
-
-def _csv(path: Path) -> list[list[str]]:
-    with open(path, newline="") as fh:
-        return list(csv.reader(fh))
 
 
 def _names(folder: Path) -> list[str]:
@@ -58,7 +40,7 @@ def _one_line(proc: subprocess.CompletedProcess) -> str:
 def small(tmp_path_factory) -> Path:
     """A finished sweep of 12 cases in parts of 4 (its output folder); tests copy it."""
     out = tmp_path_factory.mktemp("small") / "out"
-    _cli(*SMALL, "--out", str(out), cwd=out.parent)
+    cli(*SMALL, "--out", str(out), cwd=out.parent)
     return out
 
 
@@ -84,7 +66,7 @@ def test_the_dataset_folder_holds_part_files_only_and_reads_as_one_table(small):
     assert spec["cases"] == 12 and spec["batch_size"] == 4 and spec["command"] == "sweep"
     table = pq.read_table(folder).sort_by("case")
     frame = pandas.read_parquet(folder).sort_values("case")
-    rows = _csv(small / "paper_fig6_sweep.csv")
+    rows = csv_rows(small / "paper_fig6_sweep.csv")
     assert rows[0] == ["case", "m [kg]", "peak_M [N.m]", "final_omega [rad/s]", "status", "message"]
     assert table.column_names == rows[0] and list(frame.columns) == rows[0]
     assert table["case"].to_pylist() == list(frame["case"]) == [int(r[0]) for r in rows[1:]] == list(range(1, 13))
@@ -105,9 +87,9 @@ def test_a_folder_of_the_earlier_layout_is_read_and_resumed_with_its_specificati
     assert [r["case"] for r in iter_rows(folder)] == list(range(1, 9))
     with pytest.raises(Exception, match="sweep.json"):
         pq.read_table(folder)
-    fresh = _cli(*SMALL, "--out", str(out), cwd=tmp_path, check=2)
+    fresh = cli(*SMALL, "--out", str(out), cwd=tmp_path, check=2)
     assert "holds an earlier sweep" in _one_line(fresh)
-    again = _cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
+    again = cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
     assert "12 cases (4 to run)" in again.stderr
     assert _names(folder) == [f"part-{a:010d}-{a + 4:010d}.parquet" for a in (0, 4, 8)]
     assert json.loads((out / "paper_fig6_sweep.json").read_text())["cases"] == 12
@@ -149,13 +131,13 @@ def test_a_held_lock_refuses_a_second_sweep_naming_its_holder_and_changes_nothin
     with hold(lock, folder):
         info = json.loads(lock.read_text())
         for option in ("--resume", "--overwrite"):
-            line = _one_line(_cli(*SMALL, "--out", str(out), option, cwd=tmp_path, check=2))
+            line = _one_line(cli(*SMALL, "--out", str(out), option, cwd=tmp_path, check=2))
             assert line == (f"cam-fmu sweep: error: --out: {folder} is being written by another sweep, pid "
                             f"{os.getpid()} on host {socket.gethostname()} since {info['started']} (lock {lock}): "
                             "one sweep writes a folder at a time; wait for it to end or stop it")
             assert _names(folder) == before
     assert not lock.exists()
-    again = _cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
+    again = cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
     assert "12 cases (4 to run)" in again.stderr and not lock.exists()
     assert (out / "paper_fig6_sweep.csv").read_text() == (small / "paper_fig6_sweep.csv").read_text()
 
@@ -173,7 +155,7 @@ def test_a_lock_file_no_process_holds_does_not_stop_a_sweep(small, tmp_path):
         (out / "paper_fig6_sweep.parquet" / "part-0000000000-0000000004.parquet").unlink()
         lock = out / "paper_fig6_sweep.lock"
         lock.write_text(json.dumps({"pid": pid, "host": socket.gethostname(), "started": "2026-01-01T00:00:00Z"}))
-        again = _cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
+        again = cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
         assert "12 cases (4 to run)" in again.stderr and not lock.exists()
         assert (out / "paper_fig6_sweep.csv").read_text() == (small / "paper_fig6_sweep.csv").read_text()
 
@@ -209,7 +191,7 @@ def test_a_stray_part_that_repeats_cases_with_the_same_bits_is_removed_by_resume
     with pytest.raises(SweepError, match=r"holds cases 5 to 6 twice, in part-0000000004-0000000006.parquet and "
                                          r"part-0000000004-0000000008.parquet"):
         list(iter_rows(folder))
-    again = _cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
+    again = cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path)
     assert ("# paper_fig6: removed part-0000000004-0000000006.parquet: its cases 5 to 6 are in "
             "part-0000000004-0000000008.parquet with the same bits") in again.stderr
     assert "12 cases (0 to run)" in again.stderr and "12 of 12 on disk" in again.stderr
@@ -260,7 +242,7 @@ def test_overlapping_or_foreign_files_are_refused_and_nothing_is_removed(small, 
         (folder / "notes.txt").write_text("mine\n")
         words = "holds notes.txt, not a part file"
     before = _names(folder)
-    line = _one_line(_cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path, check=2))
+    line = _one_line(cli(*SMALL, "--out", str(out), "--resume", cwd=tmp_path, check=2))
     assert line.startswith("cam-fmu sweep: error: --resume: ") and words in line, line
     assert _names(folder) == before
 
@@ -277,12 +259,12 @@ def test_a_resume_started_while_a_sweep_runs_is_refused_and_the_folder_never_hol
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:120", "--metric", "peak_M,final_omega", "--stop-time", "2",
             "--serial", "--batch-size", "25", "--no-plot"]
     whole = tmp_path / "whole"
-    _cli(*args, "--out", str(whole), cwd=tmp_path)
+    cli(*args, "--out", str(whole), cwd=tmp_path)
     out = tmp_path / "out"
     folder = out / "paper_fig6_sweep.parquet"
     err = tmp_path / "first.err"
     with open(err, "w") as fh:
-        first = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], env=_env(),
+        first = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], env=env(),
                                  cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=fh, start_new_session=True)
     try:
         while first.poll() is None and len(list(folder.glob("part-*.parquet"))) < 2:
@@ -290,7 +272,7 @@ def test_a_resume_started_while_a_sweep_runs_is_refused_and_the_folder_never_hol
         os.killpg(first.pid, signal.SIGSTOP)
         assert first.poll() is None, err.read_text()  # still running: 50 of 120 cases on disk at least
         before = _names(folder)
-        second = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path, check=2)
+        second = cli(*args, "--out", str(out), "--resume", cwd=tmp_path, check=2)
         line = _one_line(second)
         started = re.search(r"since (\S+) \(lock", line)
         assert f"is being written by another sweep, pid {first.pid} on host {socket.gethostname()}" in line, line
@@ -305,7 +287,7 @@ def test_a_resume_started_while_a_sweep_runs_is_refused_and_the_folder_never_hol
             first.wait()
     kept = int(err.read_text().strip().splitlines()[-1].split("interrupted: ")[1].split(" of ")[0])
     assert 50 <= kept < 120 and not (out / "paper_fig6_sweep.lock").exists()
-    last = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
+    last = cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
     assert f"120 cases ({120 - kept} to run)" in last.stderr and "120 of 120 on disk" in last.stderr
     held = [(a, b) for a, b, _ in parts(folder, 120)]  # disjoint, or parts() refuses
     assert sum(b - a for a, b in held) == 120 and held[0][0] == 0 and held[-1][1] == 120

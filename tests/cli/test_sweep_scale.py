@@ -17,25 +17,8 @@ import numpy as np
 import pytest
 
 from cam_fmu.experiments.sweep import Design, SweepError, parse_sample, parse_vary
+from cli_run import cli, csv_rows, env
 
-ROOT = Path(__file__).resolve().parents[2]
-
-
-def _env(**extra: str) -> dict:
-    return {**os.environ, "PYTHONPATH": str(ROOT), "CAM_FMU_PROGRESS": "0", **extra}
-
-
-def _cli(*args: str, cwd: Path, check: int | None = 0, **env: str) -> subprocess.CompletedProcess:
-    proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *args], capture_output=True, text=True,
-                          env=_env(**env), cwd=cwd, timeout=900)
-    if check is not None:
-        assert proc.returncode == check, proc.stdout[-3000:] + proc.stderr[-3000:]
-    return proc
-
-
-def _rows(path: Path) -> list[list[str]]:
-    with open(path, newline="") as fh:
-        return list(csv.reader(fh))
 
 
 def _parquet_rows(folder: Path) -> list[dict]:
@@ -52,16 +35,16 @@ SAMPLE = ["paper_fig6", "--vary", "m=0.2:0.8", "--vary", "rise_law=paper,cycloid
 def test_the_engine_in_process_and_cam_fmu_give_the_same_bits(cam_fmu_path, tmp_path):
     """A random sample of 8 cases (every metric) and a failing case, on the engine and through fmpy on cam.fmu:
     every number equal; a failed case fails on both, the FMU's message carrying the engine's."""
-    engine = _cli("sweep", *SAMPLE, "--serial", "--out", str(tmp_path / "engine"), cwd=tmp_path)
-    fmu = _cli("sweep", *SAMPLE, "--serial", "--fmu", str(cam_fmu_path), "--out", str(tmp_path / "fmu"), cwd=tmp_path)
+    engine = cli("sweep", *SAMPLE, "--serial", "--out", str(tmp_path / "engine"), cwd=tmp_path)
+    fmu = cli("sweep", *SAMPLE, "--serial", "--fmu", str(cam_fmu_path), "--out", str(tmp_path / "fmu"), cwd=tmp_path)
     assert "engine engine" in engine.stderr and "engine fmu" in fmu.stderr
-    a, b = _rows(tmp_path / "engine" / "paper_fig6_sweep.csv"), _rows(tmp_path / "fmu" / "paper_fig6_sweep.csv")
+    a, b = csv_rows(tmp_path / "engine" / "paper_fig6_sweep.csv"), csv_rows(tmp_path / "fmu" / "paper_fig6_sweep.csv")
     assert a == b and len(a) == 9 and all(r[-2] == "ok" for r in a[1:])
     failing = ["paper_fig6", "--vary", "max_steps=10000,1", "--metric", "final_omega", "--stop-time", "0.05",
                "--serial", "--no-plot"]
-    _cli("sweep", *failing, "--out", str(tmp_path / "fe"), cwd=tmp_path, check=1)
-    _cli("sweep", *failing, "--fmu", str(cam_fmu_path), "--out", str(tmp_path / "ff"), cwd=tmp_path, check=1)
-    fa, fb = _rows(tmp_path / "fe" / "paper_fig6_sweep.csv"), _rows(tmp_path / "ff" / "paper_fig6_sweep.csv")
+    cli("sweep", *failing, "--out", str(tmp_path / "fe"), cwd=tmp_path, check=1)
+    cli("sweep", *failing, "--fmu", str(cam_fmu_path), "--out", str(tmp_path / "ff"), cwd=tmp_path, check=1)
+    fa, fb = csv_rows(tmp_path / "fe" / "paper_fig6_sweep.csv"), csv_rows(tmp_path / "ff" / "paper_fig6_sweep.csv")
     assert [r[:4] for r in fa] == [r[:4] for r in fb] and [r[3] for r in fa[1:]] == ["ok", "failed"]
     assert "max_steps = 1 internal steps" in fa[2][4] and fa[2][4] in fb[2][4]
 
@@ -69,7 +52,7 @@ def test_the_engine_in_process_and_cam_fmu_give_the_same_bits(cam_fmu_path, tmp_
 def test_sizing_metrics_equal_numpy_on_a_simulate_run(tmp_path):
     """rms_M, rms_i (second half), peak_accel (d omega_m/dt) and energy_per_turn (voltage x i over the second
     half per cam turn) of the scene's own run, from `simulate`'s CSV with numpy (12 digits written)."""
-    _cli("simulate", "paper_fig6", "--engine", "fmu", "--stop-time", "1", "--no-plot", "--out", str(tmp_path / "sim"),
+    cli("simulate", "paper_fig6", "--engine", "fmu", "--stop-time", "1", "--no-plot", "--out", str(tmp_path / "sim"),
          cwd=tmp_path)
     data = np.genfromtxt(tmp_path / "sim" / "paper_fig6.csv", delimiter=",", names=True)
     t, i, m_load = data["time_s"], data["i_A"], data["M_Nm"]
@@ -84,9 +67,9 @@ def test_sizing_metrics_equal_numpy_on_a_simulate_run(tmp_path):
     from cam_fmu.experiments.scenes import find_scene
 
     mass = find_scene("paper_fig6").primary.params["m"]
-    _cli("sweep", "paper_fig6", "--vary", f"m={mass}:{mass}:1", "--metric", ",".join(expected), "--stop-time", "1",
+    cli("sweep", "paper_fig6", "--vary", f"m={mass}:{mass}:1", "--metric", ",".join(expected), "--stop-time", "1",
          "--serial", "--no-plot", "--out", str(tmp_path / "sw"), cwd=tmp_path)
-    rows = _rows(tmp_path / "sw" / "paper_fig6_sweep.csv")
+    rows = csv_rows(tmp_path / "sw" / "paper_fig6_sweep.csv")
     assert rows[0][2:6] == ["rms_M [N.m]", "rms_i [A]", "peak_accel [rad/s2]", "energy_per_turn [J]"]
     for name, value in zip(expected, rows[1][2:6]):
         assert float(value) == pytest.approx(expected[name], rel=1e-6), name
@@ -98,11 +81,11 @@ def test_a_driver_killed_by_sigkill_resumes_to_the_same_table(tmp_path):
     the table equals an uninterrupted run's bit for bit, and the Parquet dataset holds every case once."""
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:30", "--metric", "peak_M,final_omega,rms_i",
             "--stop-time", "3", "--serial", "--batch-size", "3", "--no-plot"]
-    whole = _cli(*args, "--out", str(tmp_path / "whole"), cwd=tmp_path)
+    whole = cli(*args, "--out", str(tmp_path / "whole"), cwd=tmp_path)
     assert whole.returncode == 0
     out = tmp_path / "cut"
     folder = out / "paper_fig6_sweep.parquet"
-    proc = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], env=_env(), cwd=tmp_path,
+    proc = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], env=env(), cwd=tmp_path,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         while proc.poll() is None and len(list(folder.glob("part-*.parquet"))) < 2:
@@ -115,7 +98,7 @@ def test_a_driver_killed_by_sigkill_resumes_to_the_same_table(tmp_path):
     assert 2 <= kept < 10 and not (out / "paper_fig6_sweep.csv").exists()
     lock = out / "paper_fig6_sweep.lock"  # left behind by the killed driver, naming it: no longer held
     assert json.loads(lock.read_text())["pid"] == proc.pid
-    again = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
+    again = cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
     assert not lock.exists()
     assert f"({30 - 3 * kept} to run)" in again.stderr or f"({30 - 3 * kept - 3} to run)" in again.stderr
     assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "whole" / "paper_fig6_sweep.csv").read_text()
@@ -127,23 +110,23 @@ def test_a_driver_killed_by_sigkill_resumes_to_the_same_table(tmp_path):
 def test_resume_refuses_another_sweep_and_a_fresh_run_keeps_an_earlier_one(tmp_path):
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:2", "--metric", "peak_M", "--stop-time", "0.05",
             "--serial", "--no-plot", "--out", str(tmp_path / "out")]
-    _cli(*args, cwd=tmp_path)
+    cli(*args, cwd=tmp_path)
     folder = tmp_path / "out" / "paper_fig6_sweep.parquet"
-    other = _cli(*args[:3], "m=0.2:0.8:3", *args[4:], "--resume", cwd=tmp_path, check=2)
+    other = cli(*args[:3], "m=0.2:0.8:3", *args[4:], "--resume", cwd=tmp_path, check=2)
     assert "--resume" in other.stderr and "vary" in other.stderr and len(other.stderr.strip().splitlines()) == 1
-    metric = _cli(*args[:5], "peak_i", *args[6:], "--resume", cwd=tmp_path, check=2)
+    metric = cli(*args[:5], "peak_i", *args[6:], "--resume", cwd=tmp_path, check=2)
     assert "metrics" in metric.stderr
-    fresh = _cli(*args, cwd=tmp_path, check=2)
+    fresh = cli(*args, cwd=tmp_path, check=2)
     assert "--resume continues it, --overwrite starts again" in fresh.stderr
-    _cli(*args, "--overwrite", cwd=tmp_path)
+    cli(*args, "--overwrite", cwd=tmp_path)
     spec_file = tmp_path / "out" / "paper_fig6_sweep.json"  # beside the dataset, which holds part files only
     assert all(p.name.startswith("part-") and p.suffix == ".parquet" for p in folder.iterdir())
     spec = json.loads(spec_file.read_text())
     spec["command"] = "cosim"
     spec_file.write_text(json.dumps(spec))
-    command = _cli(*args, "--resume", cwd=tmp_path, check=2)
+    command = cli(*args, "--resume", cwd=tmp_path, check=2)
     assert "made by the command 'cosim'" in command.stderr
-    nothing = _cli(*args[:-1], str(tmp_path / "empty"), "--resume", cwd=tmp_path, check=2)
+    nothing = cli(*args[:-1], str(tmp_path / "empty"), "--resume", cwd=tmp_path, check=2)
     assert "nothing to continue" in nothing.stderr
 
 
@@ -159,7 +142,7 @@ def test_resume_refuses_another_sweep_and_a_fresh_run_keeps_an_earlier_one(tmp_p
     (["--vary", "m=0.2:0.8:3", "--batch-size", "0"], "--batch-size 0: allowed >= 1"),
 ])
 def test_bad_input_is_refused_before_any_case_runs(tmp_path, args, words):
-    proc = _cli("sweep", "paper_fig6", *args, "--serial", "--out", str(tmp_path / "out"), cwd=tmp_path, check=2)
+    proc = cli("sweep", "paper_fig6", *args, "--serial", "--out", str(tmp_path / "out"), cwd=tmp_path, check=2)
     assert words in proc.stderr and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert not (tmp_path / "out").exists()
 
@@ -221,7 +204,7 @@ def test_sensitivity_on_the_drive_ranks_as_a_one_at_a_time_sweep(tmp_path):
     when each moves alone over its range (the others mid-range); the CSV, table and chart are written."""
     ranges = {"m": (0.2, 0.8), "mu": (0.0, 0.3), "J_m": (1e-5, 2e-5)}
     vary = [x for name, (lo, hi) in ranges.items() for x in ("--vary", f"{name}={lo}:{hi}")]
-    proc = _cli("sweep", "paper_fig6", *vary, "--sensitivity", "32", "--metric", "peak_M", "--stop-time", "0.5",
+    proc = cli("sweep", "paper_fig6", *vary, "--sensitivity", "32", "--metric", "peak_M", "--stop-time", "0.5",
                 "--serial", "--out", str(tmp_path / "s"), cwd=tmp_path)
     with open(tmp_path / "s" / "paper_fig6_sensitivity.csv", newline="") as fh:
         table = list(csv.DictReader(fh))
@@ -232,15 +215,15 @@ def test_sensitivity_on_the_drive_ranks_as_a_one_at_a_time_sweep(tmp_path):
     spread = {}
     for name, (lo, hi) in ranges.items():
         others = [x for o, (l2, h2) in ranges.items() if o != name for x in ("--vary", f"{o}={(l2 + h2) / 2}:{(l2 + h2) / 2}:1")]
-        _cli("sweep", "paper_fig6", "--vary", f"{name}={lo}:{hi}:5", *others, "--metric", "peak_M", "--stop-time",
+        cli("sweep", "paper_fig6", "--vary", f"{name}={lo}:{hi}:5", *others, "--metric", "peak_M", "--stop-time",
              "0.5", "--serial", "--no-plot", "--out", str(tmp_path / name), cwd=tmp_path)
-        values = [float(r[4]) for r in _rows(tmp_path / name / "paper_fig6_sweep.csv")[1:]]
+        values = [float(r[4]) for r in csv_rows(tmp_path / name / "paper_fig6_sweep.csv")[1:]]
         spread[name] = max(values) - min(values)
     assert by_st == sorted(ranges, key=lambda n: -spread[n]), (table, spread)
 
 
 def test_progress_names_rate_and_failures_and_a_summary_line_ends_the_sweep(tmp_path):
-    proc = _cli("sweep", "paper_fig6", "--vary", "max_steps=10000,1,5000", "--metric", "final_omega",
+    proc = cli("sweep", "paper_fig6", "--vary", "max_steps=10000,1,5000", "--metric", "final_omega",
                 "--stop-time", "0.05", "--serial", "--no-plot", "--out", str(tmp_path / "out"), cwd=tmp_path, check=1,
                 CAM_FMU_PROGRESS="1")
     assert "3/3" in proc.stderr and "/s, 1 failed" in proc.stderr
@@ -256,7 +239,7 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
 
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:40", "--metric", "peak_M,final_omega", "--stop-time", "4",
             "--batch-size", "1", "--no-plot"]
-    serial = _cli(*args, "--serial", "--out", str(tmp_path / "serial"), cwd=tmp_path)
+    serial = cli(*args, "--serial", "--out", str(tmp_path / "serial"), cwd=tmp_path)
     assert serial.returncode == 0
     out = tmp_path / "dist"
     folder = out / "paper_fig6_sweep.parquet"
@@ -264,7 +247,7 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
         pids = client.run(os.getpid)
         assert len(pids) == 2
         sweep = subprocess.Popen([sys.executable, "-m", "cam_fmu.cli", *args, "--scheduler", address, "--out",
-                                  str(out)], env=_env(), cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                  str(out)], env=env(), cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                  text=True)
         while sweep.poll() is None and len(list(folder.glob("part-*.parquet"))) < 3:
             time.sleep(0.005)
@@ -284,15 +267,15 @@ def test_an_interrupted_serial_sweep_keeps_its_partial_batch_and_resumes_to_the_
 
     args = ["sweep", "paper_fig6", "--vary", "m=0.2:0.8:120", "--metric", "peak_M,rms_M", "--stop-time", "2",
             "--serial", "--batch-size", "50", "--no-plot"]
-    _cli(*args, "--out", str(tmp_path / "whole"), cwd=tmp_path)
+    cli(*args, "--out", str(tmp_path / "whole"), cwd=tmp_path)
     out = tmp_path / "cut"
     status, stderr = interrupt_after_progress([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], 10,
-                                              tmp_path, _env())
+                                              tmp_path, env())
     assert status == 130, stderr[-3000:]
     kept = int(stderr.strip().splitlines()[-1].split("interrupted: ")[1].split(" of ")[0])
     assert 10 <= kept < 120
     assert [r["case"] for r in _parquet_rows(out / "paper_fig6_sweep.parquet")] == list(range(1, kept + 1))
-    again = _cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
+    again = cli(*args, "--out", str(out), "--resume", cwd=tmp_path)
     assert f"({120 - kept} to run)" in again.stderr
     assert (out / "paper_fig6_sweep.csv").read_text() == (tmp_path / "whole" / "paper_fig6_sweep.csv").read_text()
 

@@ -157,3 +157,55 @@ def test_every_fmu_the_project_builds_declares_the_engines_tolerance(cam_fmu_pat
         with zipfile.ZipFile(fmu) as z:
             exp = ET.fromstring(z.read("modelDescription.xml")).find("DefaultExperiment")
         assert exp is not None and float(exp.get("tolerance")) == parameters.BY_NAME["rtol"].default, fmu.name
+
+
+HOLDER = r"""
+import sys, time
+from pathlib import Path
+from cam_fmu.fmu.build_lock import building
+folder, log = Path(sys.argv[1]), Path(sys.argv[2])
+with building(folder):
+    log.write_text("first in\n")
+    print("holding", flush=True)
+    time.sleep(0.5)
+    with open(log, "a") as fh:
+        fh.write("first out\n")
+"""
+
+
+def test_a_second_builder_waits_for_the_first(tmp_path):
+    """ensure_fmu and ensure_ssp build under their folder's lock (fmu/build_lock.py): a process that asks while
+    another builds enters only once the first has let go (then finds the file up to date: ensure_fmu)."""
+    from cam_fmu.fmu.build_lock import LOCK_NAME, building
+
+    log = tmp_path / "log.txt"
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER, str(tmp_path), str(log)], stdout=subprocess.PIPE,
+                              text=True, cwd=ROOT)
+    try:
+        assert holder.stdout.readline().strip() == "holding"
+        with building(tmp_path):
+            with open(log, "a") as fh:
+                fh.write("second in\n")
+    finally:
+        holder.wait(timeout=60)
+    assert holder.returncode == 0
+    assert log.read_text().splitlines() == ["first in", "first out", "second in"]
+    assert (tmp_path / LOCK_NAME).is_file() and (tmp_path / LOCK_NAME).stat().st_size == 0
+
+
+def test_two_writers_of_one_ssp_use_temporary_files_of_their_own(tmp_path, monkeypatch):
+    """write_ssp wrote every SSP through `<name>.ssp.tmp`: two processes writing one SSP at once (two commands in
+    a fresh checkout) shared that file. Its temporary file now carries the writer's pid."""
+    from cam_fmu.engine import reproducible
+    from cam_fmu.fmu import ssp
+
+    seen = []
+    real = reproducible.write_zip
+    monkeypatch.setattr(reproducible, "write_zip", lambda path, entries: (seen.append(Path(path)), real(path, entries)))
+    for name in ("cam.fmu", "pi.fmu"):
+        with zipfile.ZipFile(tmp_path / name, "w") as z:
+            z.writestr("modelDescription.xml", "<fmiModelDescription/>")
+    dest = ssp.write_ssp(ssp.speed_loop_system(), {"cam": tmp_path / "cam.fmu", "controller": tmp_path / "pi.fmu"},
+                         tmp_path / "loop.ssp")
+    assert seen == [tmp_path / f"loop.ssp.{os.getpid()}.tmp"]
+    assert dest.is_file() and not seen[0].exists()

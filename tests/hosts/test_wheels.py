@@ -84,9 +84,11 @@ def test_auditwheel_accepts_the_linux_wheels(wheels):
 README_BLOCK = re.search(r"## From Python.*?```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S).group(1)
 
 
-def _source_build(tmp_path: Path) -> dict[str, object]:
-    """The source build's numbers: this checkout's package (models/cam.fmu) run the same way."""
-    out = tmp_path / "source"
+@pytest.fixture(scope="module")
+def source_build(tmp_path_factory) -> dict[str, object]:
+    """The source build's numbers: this checkout's package (models/cam.fmu) run the same way; once for the
+    three Pythons' wheels (each compared with it), not once each."""
+    out = tmp_path_factory.mktemp("source")
     for args in (["simulate", "paper_fig6", "--engine", "fmu", "--no-plot"], ["cosim", "speed_loop", "--no-plot"]):
         proc = subprocess.run([sys.executable, "-m", "cam_fmu.cli", *args, "--out", str(out)], capture_output=True,
                               text=True, cwd=ROOT, timeout=600)
@@ -104,7 +106,7 @@ def _columns(path: Path) -> dict[str, np.ndarray]:
 
 
 @pytest.mark.parametrize("version", OTHER_PYTHONS)
-def test_the_wheel_runs_on_another_python_without_a_compiler(wheels, version, tmp_path):
+def test_the_wheel_runs_on_another_python_without_a_compiler(wheels, source_build, version, tmp_path):
     pythons = sorted(PYENV.glob(f"{version}.*/bin/python{version}"))
     if not pythons:
         pytest.fail(f"no CPython {version} under {PYENV} (the machine's pyenv versions)")
@@ -132,7 +134,7 @@ def test_the_wheel_runs_on_another_python_without_a_compiler(wheels, version, tm
                             cwd=work, env=env, timeout=600)
     assert readme.returncode == 0, readme.stderr[-3000:]
     assert not (tmp_path / "cache" / "cam_fmu").exists(), "the installed wheel built something at run time"
-    source = _source_build(tmp_path)
+    source = source_build
     assert readme.stdout == source["readme"]
     for name in ("paper_fig6.csv", "paper_fig6__paper.csv", "speed_loop.csv"):
         ours, theirs = _columns(work / "out" / name), _columns(source["csv"] / name)

@@ -2,6 +2,7 @@
 and the session's reference runs (tests/markers.py, tests/reference_runs.py, tests/README.md)."""
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -79,3 +80,61 @@ def test_the_sessions_reference_runs_are_the_runners_to_the_bit_and_each_callers
     for label, run in direct.items():
         assert set(second[label]) == set(run)
         assert all(np.array_equal(second[label][k], run[k]) for k in run), label
+
+
+def test_under_two_workers_every_worker_records_and_a_shared_build_runs_once(tmp_path):
+    """`pytest -n 2 --record-durations`: each xdist worker sends the durations of the tests it ran to the
+    controller, which writes them all (a worker's tests are not lost); a session fixture built with
+    session_share.once runs its build once for both workers, and both read its result."""
+    (tmp_path / "conftest.py").write_text(
+        f"import os, sys, time\nsys.path.insert(0, {str(ROOT / 'tests')!r})\nfrom pathlib import Path\nimport pytest\n"
+        "from markers import DurationRecorder, XdistDurations\nfrom session_share import once\n\n"
+        "def pytest_addoption(parser):\n    parser.addoption('--record-durations', type=Path)\n\n"
+        "def pytest_configure(config):\n"
+        "    rec = DurationRecorder(config.getoption('record_durations'), config)\n"
+        "    config.pluginmanager.register(rec, 'rec')\n"
+        "    if not hasattr(config, 'workerinput'):\n"
+        "        config.pluginmanager.register(XdistDurations(rec), 'rec_xdist')\n\n"
+        "@pytest.fixture(scope='session')\ndef built(tmp_path_factory):\n"
+        "    def build(folder):\n"
+        "        with open(Path(os.environ['BUILD_LOG']), 'a') as fh:\n"
+        "            fh.write(os.environ['PYTEST_XDIST_WORKER'] + '\\n')\n"
+        "        time.sleep(1.0)\n"
+        "        (folder / 'out.txt').write_text('built')\n"
+        "        return folder / 'out.txt'\n"
+        "    return once(tmp_path_factory, 'built', build)\n")
+    for module, sleep in (("a", 0.3), ("b", 0.0)):
+        (tmp_path / f"test_{module}.py").write_text(
+            "import os, time\nfrom pathlib import Path\n\n"
+            f"def test_{module}_first(built):\n    time.sleep({sleep})\n    assert built.read_text() == 'built'\n"
+            "    with open(Path(os.environ['WORKER_LOG']), 'a') as fh:\n"
+            "        fh.write(os.environ['PYTEST_XDIST_WORKER'] + '\\n')\n\n"
+            f"def test_{module}_second():\n    pass\n")
+    out, builds, workers = tmp_path / "durations.json", tmp_path / "builds.txt", tmp_path / "workers.txt"
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-n", "2", "--dist",
+                           "loadscope", "--record-durations", str(out), "test_a.py", "test_b.py"], cwd=tmp_path,
+                          capture_output=True, text=True,
+                          env={**os.environ, "BUILD_LOG": str(builds), "WORKER_LOG": str(workers)})
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert sorted(workers.read_text().split()) == ["gw0", "gw1"]  # one module on each worker
+    assert len(builds.read_text().split()) == 1  # built once for the two
+    recorded = markers.load(out)
+    assert set(recorded["tests"]) == {f"test_{m}.py::test_{m}_{k}" for m in "ab" for k in ("first", "second")}
+    assert 0.3 <= recorded["tests"]["test_a.py::test_a_first"] < 1.0  # its sleep, not the build's 1 s
+    assert recorded["session"]["built"] >= 1.0  # the builder's set-up (the other waited as long or longer)
+
+
+def test_a_worker_runs_the_longest_modules_first():
+    """markers.longest_modules_first: modules by recorded seconds, longest first, unrecorded ones last, each
+    module's tests in their order."""
+    class Item:
+        def __init__(self, nodeid):
+            self.nodeid = nodeid
+
+    recorded = {"tests": {"tests/a/test_x.py::t1": 1.0, "tests/a/test_x.py::t2": 1.0, "tests/b/test_y.py::t1": 0.5},
+                "fixtures": {"tests/b/test_y.py::big": 5.0}, "session": {}}
+    items = [Item(n) for n in ("tests/a/test_new.py::t", "tests/a/test_x.py::t1", "tests/a/test_x.py::t2",
+                               "tests/b/test_y.py::t1", "tests/b/test_y.py::t2")]
+    assert [i.nodeid for i in markers.longest_modules_first(items, recorded)] == [
+        "tests/b/test_y.py::t1", "tests/b/test_y.py::t2", "tests/a/test_x.py::t1", "tests/a/test_x.py::t2",
+        "tests/a/test_new.py::t"]
