@@ -47,6 +47,8 @@ typedef struct {
     int (*completed_step)(void *m, int *enter_event);
     /* The state as bytes (state_size long) with what Model Exchange books, the live books unchanged. */
     int (*save)(void *m, unsigned char *buffer, size_t size);
+    size_t n_states;       /* the continuous states' count (FMI 3.0's fmi3GetNumberOfContinuousStates) */
+    size_t n_indicators;   /* the event indicators' count (fmi3GetNumberOfEventIndicators) */
 } ModelExchangeOps;
 
 typedef struct {
