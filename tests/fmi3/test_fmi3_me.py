@@ -295,3 +295,14 @@ def test_a_co_simulation_instance_refuses_model_exchange_calls(cam3_fmu_path):
     assert cs.getFloat64([next(v.valueReference for v in md.modelVariables if v.name == "time")]) == [1e-3]
     cs.terminate()
     cs.freeInstance()
+
+
+def test_the_bench_measures_both_versions_on_the_same_calls_and_bits(cam3_fmu_path, engine_fmu_path):
+    """`cam-fmu bench fmi3_me`'s measurement: the same bits, the same FMI calls but FMI 2.0's fmi2SetupExperiment,
+    and a ratio of two positive wall times of the same run (its value is docs/performance.md's, not a bound)."""
+    from cam_fmu.tools.bench.fmi3_me import measure
+
+    r = measure(engine_fmu_path, cam3_fmu_path, rounds=1)
+    assert r["same_bits"] and r["calls"]["fmi2"] == r["calls"]["fmi3"] + 1 > 1000
+    assert all(0.0 < r["best_s"][k] < float("inf") for k in ("fmi2", "fmi3"))
+    assert r["ratio_best"] == r["best_s"]["fmi3"] / r["best_s"]["fmi2"]
