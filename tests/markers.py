@@ -33,6 +33,7 @@ FAST_LOOP_OVERHEAD_SECONDS = 20.0
 
 EXTERNAL = {  # outside hosts/: modules that need wine, qemu, valgrind, sanitizers or a C host
     "test_engine_c_host", "test_engine_sanitize", "test_engine_state_fuzz", "test_engine_fmu_me_host", "test_fmi3",
+    "test_fmi3_me_host",
     "test_bench_floors", "test_bench_memory",
 }
 

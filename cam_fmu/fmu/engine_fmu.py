@@ -8,7 +8,7 @@ every model. Steps:
 
 1. The GUID: a hash of the variable rows and of every source and generated file (``digest``).
 2. ``sources/``: the model's C, its generated tables, the FMI glue of the version (FMI 2.0: ``fmi2.c`` and
-   ``fmi2_me.c``, Model Exchange whole; FMI 3.0: ``fmi3_cs.c``; both over ``glue.c``), the official headers of
+   ``fmi2_me.c``, Model Exchange whole; FMI 3.0: ``fmi3_cs.c`` and ``fmi3_me.c``; both over ``glue.c``), the official headers of
    the version (vendored, ``csrc/fmi/headers``) and ``guid.h``. They compile as they are
    (``cc -shared -fPIC sources/*.c -lm``); FMI 2.0 lists them in the model description's
    ``<SourceFiles>``, FMI 3.0 in ``sources/buildDescription.xml``.
@@ -40,8 +40,8 @@ CONTROL_CSRC = PACKAGE_DIR / "control" / "csrc"
 # co-simulation); its official headers (vendored: engine_build.fmi_headers).
 SHARED_GLUE = (FMI / "glue.c", FMI / "checksum.c")
 GLUE = {2: (*SHARED_GLUE, FMI / "fmi2.c", FMI / "fmi2_me.c"),
-        3: (*SHARED_GLUE, FMI / "fmi3_cs.c")}
-GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h", FMI / "checksum.h")
+        3: (*SHARED_GLUE, FMI / "fmi3_cs.c", FMI / "fmi3_me.c")}
+GLUE_HEADERS = (FMI / "glue.h", FMI / "model.h", FMI / "fmi2_glue.h", FMI / "fmi3_glue.h", FMI / "checksum.h")
 HEADERS = {2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
            3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 # Only the FMI functions are exported (FMI2_Export in the official header sets their visibility).

@@ -1,11 +1,13 @@
-"""cam3.fmu's modelDescription.xml (FMI 3.0 co-simulation), from the same variable table as cam.fmu's.
+"""cam3.fmu's modelDescription.xml (FMI 3.0 co-simulation and Model Exchange), from the same variable table as
+cam.fmu's.
 
 Build time only. One source for names, value references, units, ranges and defaults
 (``model_description.variable_rows``, generated from physics/parameters.py and variables.py), the
 same unit and type definitions (display units: rpm for rad/s, deg for rad, mm for m; physics/units.py), log
 categories and default experiment; what FMI 3.0 adds is used where it helps a user: the instantiation token checked
-by the binary. No event mode, no early return, no clocks, no arrays:
-the drive is a fixed set of scalars stepped synchronously (docs/fmu.md, "cam3.fmu").
+by the binary; Model Exchange's continuous states, their derivatives and its event indicators (csrc/fmi/fmi3_me.c).
+No co-simulation event mode, no early return, no clocks, no arrays: the drive is a fixed set of scalars stepped
+synchronously (docs/fmu.md, "cam3.fmu").
 """
 from __future__ import annotations
 
@@ -14,30 +16,47 @@ from typing import Any, Dict, List
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
+from ..physics.variables import EVENT_INDICATORS
 from .model_description import (LOG_CATEGORIES, experiment_element, type_definitions, typed_units, unit_attributes,
                                 unit_definitions)
 
 TYPES = {"Real": "Float64", "Boolean": "Boolean", "String": "String"}
 
 
+def indicator_rows() -> List[Dict[str, Any]]:
+    """Model Exchange's event indicators as FMI 3.0 variables (csrc/fmi/exchange.h's slots): the mode's event
+    functions, then the angle to the profile's next breakpoint; each > 0 while nothing happens."""
+    rows = [dict(name=f"z_event_{k + 1}", unit="", description=f"event indicator {k + 1}: the drive mode's event "
+                 f"function {k + 1} (1 where the mode has fewer)") for k in range(EVENT_INDICATORS - 1)]
+    rows.append(dict(name="z_breakpoint", unit="rad", description="event indicator: the cam angle to the profile's "
+                     "next breakpoint ahead"))
+    return rows
+
+
 def model_description(model_identifier: str, token: str, rows: List[Dict[str, Any]], experiment: tuple,
                       description: str) -> bytes:
     """The FMI 3.0 model description of ``rows`` (value reference = row index), pretty-printed UTF-8.
 
-    Co-simulation only: Model Exchange's state and derivative rows (cam.fmu's, at the table's end) are left
-    out, and 'time' takes the value reference after them (TIME_VR in csrc/fmi/fmi3_cs.c)."""
+    Co-simulation, and Model Exchange where the table has continuous states (cam.fmu's state and derivative rows,
+    at the table's end): 'time' takes the value reference after the table (TIME_VR in csrc/fmi/fmi3_cs.c), the
+    event indicators the ones after it (fmi3_me.c)."""
     time_vr = len(rows)
-    rows = [row for row in rows if row["allowed"] not in ("(state)", "(derivative)")]
+    model_exchange = any(row.get("derivative") for row in rows)
     root = ET.Element("fmiModelDescription", fmiVersion="3.0", modelName=model_identifier,
                       instantiationToken=token, description=description, generationTool="cam_fmu",
                       variableNamingConvention="flat")
+    if model_exchange:  # beside co-simulation, one binary (csrc/fmi/fmi3_me.c over exchange.c)
+        ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, canGetAndSetFMUState="true",
+                      canSerializeFMUState="true", providesDirectionalDerivatives="false",
+                      providesAdjointDerivatives="false", needsCompletedIntegratorStep="true")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,
                   canHandleVariableCommunicationStepSize="true", canGetAndSetFMUState="true",
                   canSerializeFMUState="true", providesDirectionalDerivatives="false",
                   providesAdjointDerivatives="false", hasEventMode="false",
                   canReturnEarlyAfterIntermediateUpdate="false", providesIntermediateUpdate="false",
                   needsCompletedIntegratorStep="false", maxOutputDerivativeOrder="0")
-    units = sorted({row["unit"] for row in rows if row["unit"]} | {"s"})  # 's': the variable 'time'
+    indicators = indicator_rows() if model_exchange else []
+    units = sorted({row["unit"] for row in rows + indicators if row["unit"]} | {"s"})  # 's': the variable 'time'
     root.append(unit_definitions(units))
     if typed_units(units):
         root.append(type_definitions(units, fmi3=True))
@@ -49,14 +68,28 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
     # the independent variable FMI 3.0 asks for, after the whole table (value reference TIME_VR)
     ET.SubElement(variables, "Float64", name="time", valueReference=str(time_vr), causality="independent",
                   variability="continuous", description="simulation time", **unit_attributes("s"))
+    vr_of = {row["name"]: vr for vr, row in enumerate(rows)}
     for vr, row in enumerate(rows):
-        variables.append(_variable(vr, row))
+        element = _variable(vr, row)
+        if row.get("derivative"):  # FMI 3.0 names the state by its value reference
+            element.set("derivative", str(vr_of[row["derivative"]]))
+        variables.append(element)
+    indicator_vrs = [time_vr + 1 + k for k in range(len(indicators))]
+    for vr, row in zip(indicator_vrs, indicators):
+        ET.SubElement(variables, "Float64", name=row["name"], valueReference=str(vr), causality="local",
+                      variability="continuous", description=row["description"], **unit_attributes(row["unit"]))
     structure = ET.SubElement(root, "ModelStructure")
     outputs = [vr for vr, row in enumerate(rows) if row["causality"] == "output"]
+    derivatives = [vr for vr, row in enumerate(rows) if row.get("derivative")]
+    states = [vr_of[rows[vr]["derivative"]] for vr in derivatives]
     for vr in outputs:
         ET.SubElement(structure, "Output", valueReference=str(vr))
-    for vr in outputs:
+    for vr in derivatives:
+        ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(vr))
+    for vr in sorted(outputs + states + derivatives):
         ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
+    for vr in indicator_vrs:
+        ET.SubElement(structure, "EventIndicator", valueReference=str(vr))
     return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
 
 
@@ -84,4 +117,4 @@ def _variable(vr: int, row: Dict[str, Any]) -> ET.Element:
     return element
 
 
-__all__ = ["model_description"]
+__all__ = ["indicator_rows", "model_description"]

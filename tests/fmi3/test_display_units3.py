@@ -19,9 +19,11 @@ def test_cam3_fmu_shows_speeds_in_rpm_angles_in_degrees_and_lengths_in_mm(cam3_f
     assert {shown[n] for n in ("omega", "omega_m", "omega0", "omega_ref")} == {"rpm"}
     assert {shown[n] for n in ("theta", "theta_m", "alpha", "theta0", "gamma")} == {"deg"}
     assert {shown[n] for n in ("s", "s_cam", "c", "lift", "r_b")} == {"mm"}
-    # co-simulation only: cam.fmu's Model Exchange states are not here; every other variable shows as in cam.fmu
+    # every variable shows as in cam.fmu (Model Exchange's states too); FMI 3.0's event indicators are variables,
+    # the angle to the next breakpoint in degrees
     shown2 = check_display_units(model_description(cam_fmu_path), "2")
-    assert shown == {name: unit for name, unit in shown2.items() if not name.startswith(("x_", "der("))}
+    assert {name: unit for name, unit in shown.items() if not name.startswith("z_")} == shown2
+    assert shown["z_breakpoint"] == "deg" and shown["x_omega"] == "rpm" and shown["x_gap"] == "mm"
 
 
 def test_fmpy_reads_cam3s_display_units_and_their_factors(cam3_fmu_path):

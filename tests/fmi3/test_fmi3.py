@@ -41,7 +41,8 @@ def unzipped(cam3, tmp_path_factory):
 def test_fmpy_validates_it_and_reads_an_fmi3_co_simulation_fmu(cam3):
     assert validate_fmu(str(cam3)) == []
     md = read_model_description(str(cam3))
-    assert md.fmiVersion == "3.0" and md.coSimulation.modelIdentifier == "cam" and md.modelExchange is None
+    assert md.fmiVersion == "3.0" and md.coSimulation.modelIdentifier == "cam" and md.modelExchange is not None
+    # its Model Exchange: tests/fmi3/test_fmi3_me.py
     names = {v.name: v for v in md.modelVariables}
     assert set(OUTPUT_NAMES) <= set(names) and names["time"].causality == "independent"
     assert names["omega"].unit == "rad/s" and names["omega"].displayUnit == "rpm"

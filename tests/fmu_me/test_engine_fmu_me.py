@@ -47,7 +47,8 @@ def simulate(name: str, label: str | None, fmu, fmi_type: str, **options: Any) -
     start.update(options.pop("start", {}))
     logged: list[tuple[int, str]] = []
 
-    def logger(_env, _name, status, _category, message):
+    def logger(*args):  # FMI 2.0's (env, name, status, category, message), FMI 3.0's without the name
+        status, message = args[-3], args[-1]
         logged.append((status, message.decode() if isinstance(message, bytes) else str(message)))
 
     options.setdefault("output_interval", scene.output_interval)

@@ -44,7 +44,8 @@ def simulate(start: dict[str, Any], stop: float, fmi_type: str, interval: float,
     """fmpy's run: (result, [(kind, t)] of the follower's transitions, error messages)."""
     logged: list[tuple[int, str]] = []
 
-    def logger(_env, _name, status, _category, message):
+    def logger(*args):  # FMI 2.0's (env, name, status, category, message), FMI 3.0's without the name
+        status, message = args[-3], args[-1]
         logged.append((status, message.decode() if isinstance(message, bytes) else str(message)))
 
     result = fmpy.simulate_fmu(str(options.pop("fmu")), fmi_type=fmi_type,

@@ -22,6 +22,7 @@ BENCHMARKS = {
     "loops": ("loops", True, "tight loops: a C host, fmpy's FMU2Slave, one in-process run"),
     "memory": ("memory", False, "RSS over a long run through FMU2Slave"),
     "toolchain": ("toolchain", False, "cam.fmu's binary from zig against the system gcc's"),
+    "fmi3_me": ("fmi3_me", False, "FMI 3.0 Model Exchange (cam3.fmu) against FMI 2.0's (cam.fmu) in fmpy"),
 }
 DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
 

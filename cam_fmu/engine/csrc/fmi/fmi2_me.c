@@ -1,6 +1,7 @@
 /* FMI 2.0 Model Exchange, in one place: the calls, their argument checks and the state machine of event and
  * continuous-time mode, over the model's Model Exchange functions (model.h; cam.fmu's: exchange.c through
- * model_cam.c). The common functions are fmi2.c's; only FMI 2.0 has Model Exchange here. */
+ * model_cam.c). The common functions are fmi2.c's; FMI 3.0's Model Exchange is fmi3_me.c, over
+ * the same model functions in the same order. */
 #include <stddef.h>
 
 #include "fmi2_glue.h"

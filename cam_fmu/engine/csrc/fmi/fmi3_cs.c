@@ -1,50 +1,41 @@
-/* FMI 3.0 co-simulation glue over the shared glue (glue.h) and the model table (model.h), as fmi2.c is for FMI 2.0.
+/* FMI 3.0 glue, common and co-simulation functions, over the shared glue (glue.h) and the model table (model.h),
+ * as fmi2.c is for FMI 2.0; Model Exchange's functions are fmi3_me.c's.
  *
  * The same engine, instance layer and rules (docs/fmu.md "Errors"); what FMI 3.0 changes is here: the
  * instantiation token, fmi3DoStep's out-arguments (lastSuccessfulTime where the FMU stands after a Discard),
- * Float64 in place of Real, arrays of nValues. The FMU declares no event mode, no early return, no clocks
- * and no Model Exchange or Scheduled Execution: their entry points exist (the standard asks every function
+ * Float64 in place of Real, arrays of nValues. The FMU declares no co-simulation event mode, no early return,
+ * no clocks and no Scheduled Execution: their entry points exist (the standard asks every function
  * of the binary) and refuse with fmi3Error and a message. Compiled with the official FMI 3.0 headers (vendored
  * in csrc/fmi/headers); MODEL_GUID is the instantiation token, from guid.h (written by the build) or -DMODEL_GUID.
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "fmi3Functions.h"
-#include "glue.h"
+#include "fmi3_glue.h"
 
 #ifndef MODEL_GUID
 #include "guid.h" /* the model description's instantiationToken: written by the build beside the sources */
 #endif
-
-#define INSTANCE_MAGIC 0x666d6933u   /* 'fmi3' */
-
-typedef struct {
-    Glue glue;
-    fmi3LogMessageCallback logger;
-    fmi3InstanceEnvironment environment;
-} Instance;
 
 static void emit(void *host, int status, const char *category, const char *message) {
     Instance *S = host;
     S->logger(S->environment, (fmi3Status)status, category, message);
 }
 
-static Instance *instance(fmi3Instance c) {
+Instance *instance(fmi3Instance c) {
     Instance *S = c;
     return S && S->glue.magic == INSTANCE_MAGIC ? S : NULL;
 }
 
-#define GLUE(c) (&instance(c)->glue)
-#define STATUS(x) ((fmi3Status)(x))
-
-/* A call the FMU does not offer: fmi3Error with why. */
-static fmi3Status unsupported(fmi3Instance c, const char *call, const char *why) {
+fmi3Status fmi3_unsupported(fmi3Instance c, const char *call, const char *why) {
     if (!instance(c)) return fmi3Error;
     return STATUS(glue_fail(GLUE(c), call, why));
 }
 
-#define NOT_CS "this FMU is a co-simulation FMU without event mode, clocks or Model Exchange"
+#define unsupported fmi3_unsupported
+
+#define NOT_CS "this FMU has no clocks, no Scheduled Execution and no event mode in co-simulation"
 
 /* ------------------------------------------------------------------ inquire, instantiate, free */
 
@@ -59,8 +50,8 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance c, fmi3Boolean loggingOn, size_t nCa
     return fmi3OK;
 }
 
-static void refuse_instantiation(const char *name, fmi3InstanceEnvironment environment,
-                                 fmi3LogMessageCallback logger, const char *format, const char *a, const char *b) {
+void fmi3_refuse_instantiation(const char *name, fmi3InstanceEnvironment environment,
+                               fmi3LogMessageCallback logger, const char *call, const char *why) {
     Instance probe;
     memset(&probe, 0, sizeof probe);
     probe.logger = logger;
@@ -68,20 +59,37 @@ static void refuse_instantiation(const char *name, fmi3InstanceEnvironment envir
     probe.glue.emit = logger ? emit : NULL;
     probe.glue.host = &probe;
     probe.glue.name = (char *)(name ? name : model_table()->name);
-    glue_log(&probe.glue, GLUE_ERROR, "logStatusError", format, a, b);
+    glue_log(&probe.glue, GLUE_ERROR, "logStatusError", "%s: %s", call, why);
 }
 
-fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
-                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
-                                          fmi3InstanceEnvironment instanceEnvironment,
-                                          fmi3LogMessageCallback logMessage) {
-    (void)instantiationToken;
-    (void)resourcePath;
-    (void)visible;
-    (void)loggingOn;
-    refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s", "fmi3InstantiateModelExchange",
-                         "this FMU is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
-    return NULL;
+Instance *fmi3_instantiate(fmi3String instanceName, fmi3String instantiationToken, fmi3Boolean loggingOn,
+                           fmi3InstanceEnvironment environment, fmi3LogMessageCallback logMessage, int exchange,
+                           const char *call) {
+    char why[300];
+    Instance *S;
+    if (!instanceName || !instanceName[0]) {
+        fmi3_refuse_instantiation(instanceName, environment, logMessage, call, "instanceName must not be empty");
+        return NULL;
+    }
+    if (!instantiationToken || strcmp(instantiationToken, MODEL_GUID) != 0) {
+        snprintf(why, sizeof why, "instantiationToken '%.80s' is not this binary's %s: the model description and "
+                 "the binary come from different builds", instantiationToken ? instantiationToken : "(null)",
+                 MODEL_GUID);
+        fmi3_refuse_instantiation(instanceName, environment, logMessage, call, why);
+        return NULL;
+    }
+    S = calloc(1, sizeof *S);
+    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi3", exchange)) {
+        free(S);
+        fmi3_refuse_instantiation(instanceName, environment, logMessage, call, "out of memory");
+        return NULL;
+    }
+    S->logger = logMessage;
+    S->environment = environment;
+    S->glue.emit = logMessage ? emit : NULL;
+    S->glue.host = S;
+    S->glue.magic = INSTANCE_MAGIC;
+    return S;
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
@@ -98,9 +106,9 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
     (void)clockUpdate;
     (void)lockPreemption;
     (void)unlockPreemption;
-    refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s",
-                         "fmi3InstantiateScheduledExecution",
-                         "this FMU is a co-simulation FMU (use fmi3InstantiateCoSimulation)");
+    fmi3_refuse_instantiation(instanceName, instanceEnvironment, logMessage, "fmi3InstantiateScheduledExecution",
+                              "this FMU has no Scheduled Execution (use fmi3InstantiateCoSimulation or "
+                              "fmi3InstantiateModelExchange)");
     return NULL;
 }
 
@@ -112,7 +120,6 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3InstanceEnvironment instanceEnvironment,
                                          fmi3LogMessageCallback logMessage,
                                          fmi3IntermediateUpdateCallback intermediateUpdate) {
-    Instance *S;
     (void)resourcePath;
     (void)visible;
     (void)requiredIntermediateVariables;
@@ -122,32 +129,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
      * canReturnEarlyAfterIntermediateUpdate are false), so an importer that allows either sees neither. */
     (void)eventModeUsed;
     (void)earlyReturnAllowed;
-    if (!instanceName || !instanceName[0]) {
-        refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s", "fmi3InstantiateCoSimulation",
-                             "instanceName must not be empty");
-        return NULL;
-    }
-    if (!instantiationToken || strcmp(instantiationToken, MODEL_GUID) != 0) {
-        refuse_instantiation(instanceName, instanceEnvironment, logMessage,
-                             "fmi3InstantiateCoSimulation: instantiationToken '%.80s' is not this binary's %s: the "
-                             "model description and the binary come from different builds",
-                             instantiationToken ? instantiationToken : "(null)", MODEL_GUID);
-        return NULL;
-    }
-    S = calloc(1, sizeof *S);
-    if (!S || !glue_init(&S->glue, instanceName, loggingOn, "fmi3", 0)) {
-        free(S);
-        refuse_instantiation(instanceName, instanceEnvironment, logMessage, "%s: %s", "fmi3InstantiateCoSimulation",
-                             "out of memory");
-        return NULL;
-    }
-    S->logger = logMessage;
-    S->environment = instanceEnvironment;
-    S->glue.emit = logMessage ? emit : NULL;
-    S->glue.vr_end = S->glue.model->vr_cs_end;   /* Model Exchange's states are FMI 2.0's, not described here */
-    S->glue.host = S;
-    S->glue.magic = INSTANCE_MAGIC;
-    return S;
+    return fmi3_instantiate(instanceName, instantiationToken, loggingOn, instanceEnvironment, logMessage, 0,
+                            "fmi3InstantiateCoSimulation");
 }
 
 void fmi3FreeInstance(fmi3Instance c) {
@@ -175,8 +158,6 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance c) {
     return STATUS(glue_exit_initialization(GLUE(c), "fmi3ExitInitializationMode"));
 }
 
-fmi3Status fmi3EnterEventMode(fmi3Instance c) { return unsupported(c, "fmi3EnterEventMode", NOT_CS); }
-
 fmi3Status fmi3Terminate(fmi3Instance c) {
     if (!instance(c)) return fmi3Error;
     return STATUS(glue_terminate(GLUE(c), "fmi3Terminate"));
@@ -197,8 +178,20 @@ static int scalar_count(fmi3Instance c, size_t nvr, size_t nValues, const char *
     return 0;
 }
 
-/* The independent variable 'time' [s], after the whole table (model_description3.py). */
+/* The independent variable 'time' [s], after the whole table (model_description3.py), then the event indicators
+ * (fmi3_me.c; TIME_VR + 1 + k is indicator k). */
 #define TIME_VR ((fmi3ValueReference)model_table()->vr_end)
+
+/* One of the version's own variables: 'time' or an event indicator (vr > TIME_VR). */
+static int own_variable(fmi3Instance c, fmi3ValueReference vr, fmi3Float64 *value) {
+    Glue *g = GLUE(c);
+    if (vr > TIME_VR)
+        return fmi3_me_indicator(g, vr - TIME_VR - 1, value, "fmi3GetFloat64");
+    if (!glue_allowed(g, GLUE_GET_STATES, "fmi3GetFloat64"))
+        return GLUE_ERROR;
+    *value = g->model->initialized(g->m) ? g->model->time(g->m) : g->start_time;
+    return GLUE_OK;
+}
 
 fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
                           size_t nValues) {
@@ -207,19 +200,13 @@ fmi3Status fmi3GetFloat64(fmi3Instance c, const fmi3ValueReference vr[], size_t 
     if (values) for (k = 0; k < nValues; k++) values[k] = 0.0;
     if (!instance(c)) return fmi3Error;
     if (!scalar_count(c, nvr, nValues, "fmi3GetFloat64")) return fmi3Error;
-    for (k = 0; k < nvr && vr && vr[k] != TIME_VR; k++)
+    for (k = 0; k < nvr && vr && !fmi3_own_variable(vr[k]); k++)
         ;
-    if (k == nvr || !vr || !values)   /* no 'time' among them: the table's variables */
+    if (k == nvr || !vr || !values)   /* none of the version's own: the table's variables */
         return STATUS(glue_get_reals(GLUE(c), vr, nvr, values, "fmi3GetFloat64"));
-    for (k = 0; k < nvr && status == GLUE_OK; k++) {
-        if (vr[k] != TIME_VR)
-            status = glue_get_reals(GLUE(c), &vr[k], 1, &values[k], "fmi3GetFloat64");
-        else if (glue_allowed(GLUE(c), GLUE_GET_STATES, "fmi3GetFloat64"))
-            values[k] = GLUE(c)->model->initialized(GLUE(c)->m) ? GLUE(c)->model->time(GLUE(c)->m)
-                                                                : GLUE(c)->start_time;
-        else
-            status = GLUE_ERROR;
-    }
+    for (k = 0; k < nvr && status == GLUE_OK; k++)
+        status = fmi3_own_variable(vr[k]) ? own_variable(c, vr[k], &values[k])
+                                          : glue_get_reals(GLUE(c), &vr[k], 1, &values[k], "fmi3GetFloat64");
     if (status != GLUE_OK)
         for (k = 0; k < nvr; k++) values[k] = 0.0;
     return STATUS(status);
@@ -483,72 +470,6 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance c, const fmi3ValueReference vr[], s
 }
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance c) { return unsupported(c, "fmi3EvaluateDiscreteStates", NOT_CS); }
-
-fmi3Status fmi3UpdateDiscreteStates(fmi3Instance c, fmi3Boolean *discreteStatesNeedUpdate, fmi3Boolean *terminate,
-                                    fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged,
-                                    fmi3Boolean *nextEventTimeDefined, fmi3Float64 *nextEventTime) {
-    if (discreteStatesNeedUpdate) *discreteStatesNeedUpdate = fmi3False;
-    if (terminate) *terminate = fmi3False;
-    if (nominalsChanged) *nominalsChanged = fmi3False;
-    if (valuesChanged) *valuesChanged = fmi3False;
-    if (nextEventTimeDefined) *nextEventTimeDefined = fmi3False;
-    if (nextEventTime) *nextEventTime = 0.0;
-    return unsupported(c, "fmi3UpdateDiscreteStates", NOT_CS);
-}
-
-fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c) { return unsupported(c, "fmi3EnterContinuousTimeMode", NOT_CS); }
-
-fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
-                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
-    (void)noSetFMUStatePriorToCurrentPoint;
-    if (enterEventMode) *enterEventMode = fmi3False;
-    if (terminateSimulation) *terminateSimulation = fmi3False;
-    return unsupported(c, "fmi3CompletedIntegratorStep", NOT_CS);
-}
-
-fmi3Status fmi3SetTime(fmi3Instance c, fmi3Float64 time) {
-    (void)time;
-    return unsupported(c, "fmi3SetTime", NOT_CS);
-}
-
-fmi3Status fmi3SetContinuousStates(fmi3Instance c, const fmi3Float64 states[], size_t n) {
-    (void)states;
-    (void)n;
-    return unsupported(c, "fmi3SetContinuousStates", NOT_CS);
-}
-
-/* A Model Exchange array call: the array filled with a safe value, then the refusal. */
-static fmi3Status refuse_array(fmi3Instance c, const char *call, fmi3Float64 values[], size_t n, double safe) {
-    size_t k;
-    if (values) for (k = 0; k < n; k++) values[k] = safe;
-    return unsupported(c, call, NOT_CS);
-}
-
-fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance c, fmi3Float64 derivatives[], size_t n) {
-    return refuse_array(c, "fmi3GetContinuousStateDerivatives", derivatives, n, 0.0);
-}
-
-fmi3Status fmi3GetEventIndicators(fmi3Instance c, fmi3Float64 indicators[], size_t n) {
-    return refuse_array(c, "fmi3GetEventIndicators", indicators, n, 0.0);
-}
-
-fmi3Status fmi3GetContinuousStates(fmi3Instance c, fmi3Float64 states[], size_t n) {
-    return refuse_array(c, "fmi3GetContinuousStates", states, n, 0.0);
-}
-
-fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance c, fmi3Float64 nominals[], size_t n) {
-    return refuse_array(c, "fmi3GetNominalsOfContinuousStates", nominals, n, 1.0);
-}
-
-fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance c, size_t *n) {
-    if (n) *n = 0;
-    return unsupported(c, "fmi3GetNumberOfEventIndicators", NOT_CS);
-}
-
-fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance c, size_t *n) {
-    if (n) *n = 0;
-    return unsupported(c, "fmi3GetNumberOfContinuousStates", NOT_CS);
-}
 
 fmi3Status fmi3EnterStepMode(fmi3Instance c) { return unsupported(c, "fmi3EnterStepMode", NOT_CS); }
 

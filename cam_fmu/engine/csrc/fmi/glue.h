@@ -2,7 +2,7 @@
  * machine, logging with its message rules, the checks of value references, the variable access, the
  * communication step and the saved states, over the model table of
  * model.h (cam.fmu: model_cam.c; pi_speed.fmu: model_pi.c). fmi2.c and fmi3_cs.c are thin over it; fmi2_me.c
- * is Model Exchange, whole.
+ * and fmi3_me.c are Model Exchange, whole.
  *
  * Statuses are the FMI numbering both versions share: OK 0, Warning 1, Discard 2, Error 3, Fatal 4.
  * Every call name in a message is the version's own ("fmi2GetReal", "fmi3GetFloat64"): the glue passes it.
@@ -105,6 +105,6 @@ int glue_serialize(Glue *g, const GlueSaved *saved, unsigned char *out, size_t s
  * not a serialised state of this model. */
 int glue_deserialize(Glue *g, const unsigned char *in, size_t size, GlueSaved **saved, const char *call);
 
-/* Model Exchange's calls and their state machine are fmi2_me.c's (FMI 2.0 only). */
+/* Model Exchange's calls and their state machine are fmi2_me.c's and fmi3_me.c's, one per version. */
 
 #endif

@@ -7,9 +7,8 @@
  * and its allowed range: the one message the glue logs. A refused call changes nothing else.
  *
  * Value references run from 0 to vr_end - 1 without gaps; variable() names each one and its kind.
- * vr_cs_end (<= vr_end): the references an FMI 3.0 co-simulation FMU describes (the ones past it are
- * Model Exchange's states and derivatives, described by FMI 2.0's model description only); the FMI 3.0
- * independent variable 'time' takes vr_end.
+ * vr_cs_end (<= vr_end): where Model Exchange's states and derivatives begin (both versions describe them); the
+ * FMI 3.0 independent variable 'time' takes vr_end, its event indicators the references after it (fmi3_me.c).
  *
  * Model Exchange (exchange != NULL): the model integrates nothing itself; the host's solver does, over
  * the functions of ModelExchangeOps, each on the object m. A co-simulation-only model leaves it NULL and
@@ -47,13 +46,15 @@ typedef struct {
     int (*completed_step)(void *m, int *enter_event);
     /* The state as bytes (state_size long) with what Model Exchange books, the live books unchanged. */
     int (*save)(void *m, unsigned char *buffer, size_t size);
+    size_t n_states;       /* the continuous states' count (FMI 3.0's fmi3GetNumberOfContinuousStates) */
+    size_t n_indicators;   /* the event indicators' count (fmi3GetNumberOfEventIndicators) */
 } ModelExchangeOps;
 
 typedef struct {
     const char *name;            /* the model identifier: "cam", "pi_speed" */
     unsigned state_magic;        /* the first word of a serialised state of this model */
     unsigned vr_end;             /* one past the last value reference */
-    unsigned vr_cs_end;          /* one past the last one FMI 3.0 co-simulation describes */
+    unsigned vr_cs_end;          /* the first of Model Exchange's states and derivatives */
     void *(*create)(void);       /* NULL if out of memory */
     void (*destroy)(void *m);
     void (*reset)(void *m);      /* back to create's state: parameters at their defaults */

@@ -195,7 +195,7 @@ static int me_save(void *m, unsigned char *buffer, size_t size)
 
 static const ModelExchangeOps EXCHANGE = {
     me_attach, me_attached, me_detach, me_sync, me_set_time, me_set_states, me_read, me_enter_event_mode,
-    me_event_update, me_enter_continuous, me_completed_step, me_save,
+    me_event_update, me_enter_continuous, me_completed_step, me_save, CAM_ME_NX, CAM_EXCHANGE_NZ,
 };
 
 static const Model CAM = {
