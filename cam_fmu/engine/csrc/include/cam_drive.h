@@ -71,11 +71,13 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
                           double out[]);
 /* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
 typedef double (*CamEventValue)(void *ctx, int code, double x);
-/* The earliest of the n event functions codes[k] (non-zero codes) to cross, as `crossed(before, after)` says, from
- * fa[k] at a to fb[k] at b: located by bisection to the last bit (the first x where crossed(fa[k], value) holds); its
- * code, or 0 for none, and *at (follower.c, voltage_follower.c). */
+/* The earliest of the n event functions codes[k] to cross, as `crossed(before, after)` says, from fa[k] at a to fb[k]
+ * at b, each located by Illinois false position (the first x where crossed(fa[k], value) holds) to a bracket of tol
+ * [s], or with tol = 0 to the last bit: its index, or -1 for none, and *at. Every hybrid run's one locator
+ * (integrate.c). */
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at);
+                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
+                           double *at);
 #define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
 #define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
 

@@ -132,11 +132,6 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
  * its length [s], the end state in it->x_end; the retries it took into *retries. */
 int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt, long *retries, CamError *err);
 
-/* The zero of event ``code`` (or, code -1, of the gap direction (target - theta)) in (0, dt] by Illinois
- * false position on trial steps from d->x; it->x_hit holds the state at dt on entry and the state just
- * past the zero on return; returns its time from the step start [s]. */
-double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, double g_lo, double g_hi, double dt);
-
 /* Advance the consistent formulation's state d->x, d->mode by one communication step h [s] from
  * ``time`` with the method of d->model.solver: every step ends at the profile breakpoint it would
  * cross and at the located zero of the first event, whose transition is cam_apply_event. More than

@@ -1,5 +1,5 @@
 /* The voltage drive's follower of its own (docs/model.md 13.6): what voltage_follower.c (its equations and
- * co-simulation's step) shares with voltage_follower_me.c (Model Exchange's entry points, cam_drive.h cam_vf_me_*).
+ * co-simulation's step) shares with voltage_follower_events.c (the one event update, Model Exchange's view).
  * Internal to the engine, not for bindings. y = (theta, omega, i, s, v, phi, omega_m, sigma, dir): see
  * voltage_follower.c. */
 #ifndef CAM_VOLTAGE_FOLLOWER_H
@@ -49,5 +49,9 @@ int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact
                       int *left, long *dropped);
 /* At rest (omega = 0): stuck, or moving off where it accelerates (at once at a located break-away). */
 void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold);
+/* The one event update of co-simulation and Model Exchange: the transition `code` (EV_NONE: the contact settled, or
+ * at rest the shaft's rule) at y at time [s]; *contact, *left and *rebound before and after. */
+void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *contact, int *left, double *rebound,
+                         double time, long *dropped);
 
 #endif

@@ -4,7 +4,8 @@
  * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
  * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -CAM_TOUCH, an impact with
  * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
- * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The output
+ * a twentieth of the flight's period apart, finer just after a rebound) and located by the engine's one locator
+ * (integrate.c cam_locate_first_event). The output
  * N_contact is the flank's force along X (with the guide friction) over cos(alpha), signed: > 0 on the +1 flank,
  * < 0 on a groove's -1 flank, 0 in flight (docs/model.md 13.1). */
 #include <math.h>
@@ -139,7 +140,7 @@ static double motion_event(void *ctx, int code, double tau)
     return event_value(scan->mo, scan->p, scan->contact, code, tau);
 }
 
-/* The first event in (tau, end]: its code (EV_NONE: none) and *at, located by bisection between samples. */
+/* The first event in (tau, end]: its code (EV_NONE: none) and *at, located between samples. */
 static int first_event(const Motion *mo, const Piece *p, double contact, double tau, double end, double rebound,
                        double *at)
 {
@@ -166,39 +167,12 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
             b = end;
         for (k = 0; k < n; k++)
             fb[k] = event_value(mo, p, contact, codes[k], b);
-        found = cam_locate_first_event(n, codes, a, b, fa, fb, downward, motion_event, &scan, at);
+        k = cam_locate_first_event(n, codes, a, b, fa, fb, downward, motion_event, &scan, 0.0, at);
+        found = k >= 0 ? codes[k] : EV_NONE;
         for (k = 0; k < n; k++)
             fa[k] = fb[k];
         a = b;
     }
-    return found;
-}
-
-int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at)
-{
-    int k, found = 0;
-    double best = b;
-    for (k = 0; k < n; k++) {
-        double lo = a, hi = b;
-        if (!crossed(fa[k], fb[k]))
-            continue;
-        for (;;) {
-            double mid = 0.5 * (lo + hi);
-            if (mid <= lo || mid >= hi)
-                break;
-            if (crossed(fa[k], value(ctx, codes[k], mid)))
-                hi = mid;
-            else
-                lo = mid;
-        }
-        if (hi < best || found == 0) {
-            best = hi;
-            found = codes[k];
-        }
-    }
-    if (found != 0)
-        *at = best;
     return found;
 }
 

@@ -15,7 +15,7 @@
  * `solver` (rk.c's tableaus: rk45 with error control on rtol, atol; euler, rk4 and etdrk4's RK4 core fixed at h_max
  * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's oscillation and
  * of the shaft's (SHAFT_PHASE_RK45 under rk45), a tenth of the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
- * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
+ * from > 0 to <= 0 over a step is located on the step's length (integrate.c's locator). At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
  * follower off it: the follower flies alone and lands on the cam at rest (voltage_follower_events.c unstick). */
@@ -521,7 +521,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         }
         {
             Trial tr = {m, tableau, u, contact, ends, y};
-            code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
+            k = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, 0.0, &at);
+            code = k >= 0 ? codes[k] : EV_NONE;
         }
         have_before = code == EV_NONE;
         if (have_before) {   /* the mode the next step must keep to reuse the end's rates and event functions */
@@ -546,33 +547,12 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         tau = code == EV_NONE ? tau + dt : tau + at;
         if (rebound > 0.0)
             rebound = fmax(rebound - (code == EV_NONE ? dt : at), 0.0);
-        if (code == EV_NONE)
+        if (code == EV_NONE || code == EV_SIDE)
             continue;
-        if (code == EV_SIDE)
-            continue;
-        if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
-            if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
-                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
-                                  "(theta = %.6g rad); ", time + tau, y[0]);
-            continue;
-        }
-        if (++events > MAX_EVENTS)
+        if (code != EV_BREAK && ++events > MAX_EVENTS)   /* past a breakpoint only the contact is settled */
             return cam_error(err, CAM_ERR_SIMULATION, "the follower changed contact more than %d times in one step "
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
-        if (code == EV_STOP || code == EV_BREAK_AWAY) {
-            int was = contact;
-            cam_vf_at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
-                              "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
-                              time + tau, y[0]);
-            if (was && !contact)
-                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank "
-                                  "%+d at t = %.9g s (theta = %.6g rad); ", was, time + tau, y[0]);
-        } else if (code == EV_HALT) {
-            y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
-        } else {
-            contact = cam_vf_transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
-        }
+        cam_vf_event_update(d, y, u, code, &contact, &left, &rebound, time + tau, &dropped);
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
