@@ -54,4 +54,13 @@ void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int
 void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *contact, int *left, double *rebound,
                          double time, long *dropped);
 
+/* Model Exchange's view (the formulation's hooks cam_vf_exchange, cam_drive.h CamExchangeHooks). */
+void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX]);
+void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
+void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
+double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
+int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
+extern const CamExchangeHooks cam_vf_exchange;
+
 #endif

@@ -617,5 +617,5 @@ static void vf_advice(const CamDrive *d, char *buf, size_t len)
 }
 
 const CamFormulation cam_voltage_follower = {
-    "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice,
+    "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice, &cam_vf_exchange,
 };

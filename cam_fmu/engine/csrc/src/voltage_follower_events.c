@@ -303,3 +303,7 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     d->stale = 1;
     return CAM_OK;
 }
+
+const CamExchangeHooks cam_vf_exchange = {
+    cam_vf_me_states, cam_vf_set_me_states, cam_vf_me_rates, cam_vf_me_codes, cam_vf_me_event, cam_vf_me_apply,
+};
