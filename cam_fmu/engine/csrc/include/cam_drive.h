@@ -93,6 +93,11 @@ typedef double (*CamEventValue)(void *ctx, int code, double x);
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
                            int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
                            double *at);
+/* The follower's event codes (docs/model.md 13.7), one space for the speed drive's (follower.c) and the voltage
+ * drive's (voltage_follower.c, and Model Exchange's indicators): touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN);
+ * the voltage drive's shaft stops (EV_STOP) and breaks away; EV_BREAK and EV_SIDE only end a step. */
+typedef enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK,
+               EV_SIDE } CamFollowerEvent;
 #define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
 #define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
 
@@ -152,7 +157,7 @@ typedef struct CamDrive {
  * follower's states, events and transitions are its formulation's hooks (CamExchangeHooks, voltage_follower_events.c);
  * exchange.c drives them. */
 enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
-       CAM_VF_BREAK_AWAY = 6 /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
+       CAM_VF_BREAK_AWAY = EV_BREAK_AWAY /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
 /* The derivatives at x under the input d->form_u (the drive's mode and contact). */

@@ -18,8 +18,6 @@
 #define SCAN_ANGLE 1e-3         /* rad: cam angle between two samples of an event function */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
 
-enum { EV_NONE = 0, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT };
-
 typedef struct {
     const CamModel *m;
     double theta0, omega0, omega_dot;   /* theta(tau) = theta0 + (omega0 + omega_dot tau / 2) tau */

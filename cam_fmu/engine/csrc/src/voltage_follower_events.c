@@ -187,7 +187,6 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
 #define EV_TOUCH EV_TOUCH_UP    /* Model Exchange: the touch-down on the nearer flank (one indicator for both) */
 
 typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
-typedef char cam_vf_me_break_away_code[(int)CAM_VF_BREAK_AWAY == (int)EV_BREAK_AWAY ? 1 : -1];
 
 /* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
 static void me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
