@@ -122,6 +122,12 @@ typedef struct {
 void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double h,
                           CamStepWork *w);
 
+/* Error control (the former Python engine's, scipy's RK45): a step of *dt [s] with error norm `norm` (> 1 or NaN:
+ * rejected) under the method's error exponent. Accepted: 1, and the next trial step into *h_next (dt times the
+ * growth factor, at most 5x and 1e3 s; where the step reached `bound` [s] and may grow, no shorter than *h_next
+ * was). Rejected: 0, and *dt shrunk (to no less than a tenth). Every adaptive step of the engine takes it. */
+int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next);
+
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is
  * 1e-12 of it); below the floor: CAM_ERR_REJECTED with the former engine's message. */

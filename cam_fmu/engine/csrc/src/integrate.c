@@ -54,11 +54,26 @@ static void compliant_cause(const CamModel *m, char *buf, size_t len)
                  "rigid: k_shaft = 0)", shaft, 1.0 / shaft);
 }
 
+int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next)
+{
+    double factor;
+    if (norm <= 1.0) {
+        factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, exponent), 5.0);
+        if (*dt < bound || factor < 1.0)
+            *h_next = fmin(*dt * factor, 1e3);
+        else   /* a step the bounds cut: its success says nothing against a longer next one */
+            *h_next = fmax(*h_next, *dt * fmin(factor, 1.0));
+        return 1;
+    }
+    *dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, exponent), 0.1);
+    return 0;
+}
+
 int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt_out,
                       CamError *err)
 {
     const CamModel *m = &d->model;
-    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u, norm, factor, t;
+    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u;
     if (remaining < dt)
         dt = remaining;
     if (m->h_max < dt)
@@ -67,31 +82,14 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
     for (;;) {
         it->exponential = m->has_current && !m->compliant && dt * m->R / m->L > CAM_POLE_LIMIT;
         method_step(d, it, dt, u);
-        norm = cam_error_norm(m, d->x, &it->work);
-        if (norm <= 1.0) {
-            if (norm == 0.0) {
-                factor = 5.0;
-            } else {
-                t = 0.9 * pow(norm, it->method->tableau->error_exponent);
-                factor = t < 5.0 ? t : 5.0;
-            }
-            if (dt < remaining || factor < 1.0) {
-                t = dt * factor;
-                d->solver.h_next = 1e3 < t ? 1e3 : t;
-            } else {
-                t = dt * (1.0 < factor ? 1.0 : factor);
-                d->solver.h_next = t > d->solver.h_next ? t : d->solver.h_next;
-            }
+        if (cam_step_control(cam_error_norm(m, d->x, &it->work), it->method->tableau->error_exponent, remaining, &dt,
+                             &d->solver.h_next)) {
             memcpy(it->x_end, it->work.x_new, sizeof it->x_end);
             if (!it->exponential)
                 memcpy(it->f_end, it->work.f_new, sizeof it->f_end);
             *dt_out = dt;
             return CAM_OK;
         }
-        if (!isfinite(norm))
-            norm = 1e10;
-        t = 0.9 * pow(norm, it->method->tableau->error_exponent);
-        dt *= t > 0.1 ? t : 0.1;
         if (dt < floor_) {
             char a[32], b[32], c[32], e[32], cause[300];
             compliant_cause(m, cause, sizeof cause);

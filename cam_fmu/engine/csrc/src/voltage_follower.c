@@ -460,27 +460,21 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
         if (adaptive) {   /* error control on rtol, atol within the bounds above (integrate.c cam_step_adaptive) */
-            double bound = fmin(dt, m->h_max), norm, factor, e[NY];
+            double bound = fmin(dt, m->h_max), e[NY];
             dt = fmin(bound, d->solver.h_next);
             if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
                 fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
             for (;;) {
                 vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, forces);
                 fsal = 1;   /* k[0] is the rates at y from here on */
-                norm = vf_error_norm(m, contact, y, next, e);
-                if (norm <= 1.0)
+                if (cam_step_control(vf_error_norm(m, contact, y, next, e), tableau->error_exponent, bound, &dt,
+                                     &d->solver.h_next))
                     break;
-                dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, tableau->error_exponent), 0.1);
                 if (dt < 1e-12 * h)
                     return cam_error(err, CAM_ERR_REJECTED, "solver 'rk45' cannot meet rtol = %g, atol = %g: its step "
                                      "fell below %g s (1e-12 of the communication step) at t = %g s: loosen rtol/atol, "
                                      "or check the inputs and parameters", m->rtol, m->atol, 1e-12 * h, time + tau);
             }
-            factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, tableau->error_exponent), 5.0);
-            if (dt < bound || factor < 1.0)
-                d->solver.h_next = fmin(dt * factor, 1e3);
-            else   /* a step the bounds cut: its success says nothing against a longer next one */
-                d->solver.h_next = fmax(d->solver.h_next, dt * fmin(factor, 1.0));
         } else
             vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0, NULL);
         codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
