@@ -98,6 +98,10 @@ int cam_locate_first_event(int n, const int codes[], double a, double b, const d
  * the voltage drive's shaft stops (EV_STOP) and breaks away; EV_BREAK and EV_SIDE only end a step. */
 typedef enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK,
                EV_SIDE } CamFollowerEvent;
+/* N: the force closing the follower onto its +1 flank at s [m], F_spring0 + k_spring s - F_gx, and the guide's
+ * friction at no contact force, mu (|G_y| + |N_g|): both drives' followers' (follower.c). */
+double cam_follower_closing(const CamModel *m, double s);
+double cam_follower_friction0(const CamModel *m);
 #define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
 #define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
 

@@ -16,8 +16,6 @@
 
 /* m: a groove's clearance (closure 'form'), 0 for a spring's one flank. */
 double cam_vf_clearance(const CamModel *m);
-/* N: the guide's friction at no contact force. */
-double cam_vf_friction0(const CamModel *m);
 /* The flying follower's direction sgn(v), or at a halt where the net force pushes it (0: held by friction). */
 double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
 /* The rates of y on the flank `contact` (0: in flight) under the input u [V]. */

@@ -46,9 +46,14 @@ static double theta_at(const Motion *mo, double tau)
     return mo->theta0 + (mo->omega0 + 0.5 * mo->omega_dot * tau) * tau;
 }
 
-static double closing(const CamModel *m, double s)
+double cam_follower_closing(const CamModel *m, double s)
 {
     return m->F_spring0 + m->k_spring * s - m->F_gx;
+}
+
+double cam_follower_friction0(const CamModel *m)
+{
+    return m->mu * (fabs(m->G_y) + m->N_g);
 }
 
 /* The follower on the flank `contact`: d = (s, s', s'', s_cam). */
@@ -67,13 +72,13 @@ static double held(const Motion *mo, double theta, double omega, double omega_do
     on_flank(mo, theta, contact, d);
     v = d[1] * omega;
     friction = v > 0.0 ? mo->f0 : (v < 0.0 ? -mo->f0 : 0.0);
-    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + closing(m, d[0]) + friction);
+    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + cam_follower_closing(m, d[0]) + friction);
 }
 
 /* m/s2 in flight with the friction's direction -sigma; sigma = 0 at a halt: 0 while static friction holds. */
 static double free_acceleration(const Motion *mo, double s, double sigma)
 {
-    double net = -closing(mo->m, s);
+    double net = -cam_follower_closing(mo->m, s);
     if (sigma == 0.0) {
         if (fabs(net) <= mo->f0)
             return 0.0;
@@ -191,7 +196,7 @@ void cam_follower_note(char *events, size_t len, long *dropped, const char *form
 /* The contact the follower starts in at the inputs omega, omega_dot (reference/flight.py _start_contact). */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot)
 {
-    Motion mo = {m, st->theta, omega, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, omega, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double d[4], side;
     st->contact = held(&mo, st->theta, omega, omega_dot, 1.0) >= 0.0 ? 1.0
@@ -256,7 +261,7 @@ static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, doubl
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err)
 {
-    Motion mo = {m, st->theta, omega0, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, omega0, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double tau = 0.0, d[4];
     long count = 0, dropped = 0;
@@ -312,7 +317,7 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
 /* physics.speed_follower.SpeedFollower.outputs: the speed drive's outputs with the follower's own s, v, a. */
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction, double out[])
 {
-    Motion mo = {m, st->theta, st->speed, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, st->speed, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double omega = st->speed, theta = st->theta, d[4], tan_a, shaft, i, voltage, s = st->s, v = st->v, a;
     double M, J, N = 0.0;
@@ -326,7 +331,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
         for (k = 0; k < 3; k++) {   /* at theta, theta + step and theta - step: the voltage's dM/dtheta */
             double angle = theta + (k == 0 ? 0.0 : (k == 1 ? step : -step)), e[4], push, t_a, sigma, f;
             on_flank(&mo, angle, st->contact, e);
-            push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + closing(m, e[0]);
+            push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + cam_follower_closing(m, e[0]);
             t_a = e[1] / (m->r_b + e[3]);
             sigma = sgn(e[1] * direction);
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);

@@ -75,17 +75,6 @@ static double torque(const CamModel *m, const double y[NY], double u)
     return torque_toward(m, y, u, shaft_direction(y));
 }
 
-/* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
-double cam_vf_friction0(const CamModel *m)
-{
-    return m->mu * (fabs(m->G_y) + m->N_g);
-}
-
-static double closing(const CamModel *m, double s)
-{
-    return m->F_spring0 + m->k_spring * s - m->F_gx;
-}
-
 /* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
 double cam_vf_clearance(const CamModel *m)
 {
@@ -100,7 +89,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0] - contact * cam_vf_clearance(m));
+    F = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
     if (m->mu == 0.0) {
         *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
@@ -128,7 +117,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 {
     if (y[Y_DIR] == 0.0) {
         cam_profile_eval(&m->profile, y[0], d);
-        *P = closing(m, d[0] - contact * cam_vf_clearance(m));
+        *P = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -171,7 +160,7 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
 static double free_acceleration(const CamModel *m, double s, double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * cam_vf_friction0(m)) / m->m;
+    return sigma == 0.0 ? 0.0 : (-cam_follower_closing(m, s) - sigma * cam_follower_friction0(m)) / m->m;
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
@@ -181,8 +170,8 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     double net;
     if (y[4] != 0.0)
         return sgn(y[4]);
-    net = -closing(m, y[3]);
-    return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
+    net = -cam_follower_closing(m, y[3]);
+    return fabs(net) > cam_follower_friction0(m) ? sgn(net) : 0.0;
 }
 
 /* cam_vf_rates, and on a moving flank the contact's force *P [N] along X and the guide's side force *n_r [N] (else
@@ -210,7 +199,7 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
     }
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
-    dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+    dy[4] = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
 
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
@@ -318,7 +307,7 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+    return fabs(cam_follower_closing(m, d[0]) / m->m) + cam_follower_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -485,7 +474,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
-            if (y[Y_SIGMA] != 0.0 && cam_vf_friction0(m) > 0.0)
+            if (y[Y_SIGMA] != 0.0 && cam_follower_friction0(m) > 0.0)
                 codes[n++] = EV_HALT;
         }
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
@@ -593,7 +582,7 @@ static void vf_outputs(CamDrive *d, double out[])
         load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;
         load.v = y[4];
-        load.a = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+        load.a = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
     }
     cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
     if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too (outputs.c cam_outputs) */

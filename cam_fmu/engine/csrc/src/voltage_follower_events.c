@@ -265,7 +265,7 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
         return n;
     }
     codes[n++] = EV_TOUCH;
-    if (d->speed.sigma != 0.0 && cam_vf_friction0(&d->model) > 0.0)
+    if (d->speed.sigma != 0.0 && cam_follower_friction0(&d->model) > 0.0)
         codes[n++] = EV_HALT;
     return n;
 }
