@@ -56,16 +56,21 @@ static void compliant_cause(const CamModel *m, char *buf, size_t len)
 
 int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next)
 {
-    double factor;
+    double factor, t;   /* no fmin/fmax: a call each where the compiler may not assume finite numbers */
     if (norm <= 1.0) {
-        factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, exponent), 5.0);
-        if (*dt < bound || factor < 1.0)
-            *h_next = fmin(*dt * factor, 1e3);
-        else   /* a step the bounds cut: its success says nothing against a longer next one */
-            *h_next = fmax(*h_next, *dt * fmin(factor, 1.0));
+        t = norm == 0.0 ? 5.0 : 0.9 * pow(norm, exponent);
+        factor = t < 5.0 ? t : 5.0;
+        if (*dt < bound || factor < 1.0) {
+            t = *dt * factor;
+            *h_next = 1e3 < t ? 1e3 : t;
+        } else {   /* a step the bounds cut: its success says nothing against a longer next one */
+            t = *dt * (1.0 < factor ? 1.0 : factor);
+            *h_next = t > *h_next ? t : *h_next;
+        }
         return 1;
     }
-    *dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, exponent), 0.1);
+    t = 0.9 * pow(isfinite(norm) ? norm : 1e10, exponent);
+    *dt *= t > 0.1 ? t : 0.1;
     return 0;
 }
 
@@ -174,15 +179,26 @@ int cam_locate_first_event(int n, const int codes[], double a, double b, const d
 typedef struct {                /* trial_value's arguments but the code and the time */
     CamDrive *d;
     CamIntegrator *it;
+    const int *codes;           /* the functions located */
     double target;              /* rad: the breakpoint of code -1 */
+    double x[CAM_MAX_EVENTS][CAM_NX];   /* each function's latest trial state on its event side (<= 0) */
 } Trial;
 
-/* The event function `code` (-1: the gap direction (target - theta)) at the trial state tau [s] into the step. */
+/* The event function `code` (-1: the gap direction (target - theta)) at the trial state tau [s] into the step; the
+ * state kept where it is <= 0 (the located time is the latest such trial: no step taken again). */
 static double trial_value(void *ctx, int code, double tau)
 {
     Trial *t = ctx;
+    double g;
+    int k = 0;
     trial(t->d, t->it, tau, t->d->u);
-    return zero_value(t->d, code, t->target, t->it->work.x_new, t->d->u);
+    g = zero_value(t->d, code, t->target, t->it->work.x_new, t->d->u);
+    if (g <= 0.0) {
+        while (t->codes[k] != code)
+            k++;
+        memcpy(t->x[k], t->it->work.x_new, sizeof t->x[k]);
+    }
+    return g;
 }
 
 static int downward(double before, double after)
@@ -195,13 +211,20 @@ static int downward(double before, double after)
 static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], const double before[],
                   const double after[], double target, double dt, double *tau)
 {
-    Trial t = {d, it, target};
-    int k = cam_locate_first_event(n, codes, 0.0, dt, before, after, downward, trial_value, &t,
-                                   1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, tau);
-    if (k >= 0 && *tau < dt)
-        trial(d, it, *tau, d->u);
-    if (k >= 0)
-        memcpy(it->x_hit, *tau < dt ? it->work.x_new : it->x_end, sizeof it->x_hit);
+    Trial t;
+    int k;
+    for (k = 0; k < n && !downward(before[k], after[k]); k++)
+        ;
+    if (k == n)   /* the common case: nothing crossed, no call */
+        return -1;
+    t.d = d;
+    t.it = it;
+    t.codes = codes;
+    t.target = target;
+    k = cam_locate_first_event(n, codes, 0.0, dt, before, after, downward, trial_value, &t,
+                               1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, tau);
+    if (k >= 0)   /* at dt no trial fell on the event's side: the step's end */
+        memcpy(it->x_hit, *tau < dt ? t.x[k] : it->x_end, sizeof it->x_hit);
     return k;
 }
 
