@@ -32,11 +32,11 @@ static int fail(CamExchange *e, int status, const char *fmt, ...)
     return status;
 }
 
-/* The follower of its own on a voltage-driven cam (closures 'form', 'spring'): its states, events and transitions
- * are voltage_follower_me.c's (cam_drive.h cam_vf_me_*) on voltage_follower.c's equations. */
-static int follower(const CamDrive *d)
+/* A formulation with Model Exchange hooks of its own (the voltage drive's follower of its own, closures 'form',
+ * 'spring'): its states, events and event update are the hooks' (cam_drive.h CamExchangeHooks). */
+static const CamExchangeHooks *follower(const CamDrive *d)
 {
-    return d->form == &cam_voltage_follower;
+    return d->form->exchange;
 }
 
 void cam_exchange_init(CamExchange *e, CamInstance *instance)
@@ -164,7 +164,7 @@ static int active_codes(const CamDrive *d, int codes[CAM_MAX_EVENTS])
 {
     int n;
     if (follower(d))
-        return cam_vf_me_codes(d, codes);
+        return follower(d)->codes(d, codes);
     n = cam_event_codes(&d->model, &d->mode, codes);
     if (d->mode.stuck && !d->model.has_current && !d->model.compliant && n < CAM_MAX_EVENTS)
         codes[n++] = CAM_EV_BREAK_AWAY;
@@ -174,7 +174,7 @@ static int active_codes(const CamDrive *d, int codes[CAM_MAX_EVENTS])
 /* The event function `code` of the drive's mode at the states x. */
 static double event_value(const CamDrive *d, int code, const double x[CAM_ME_NX])
 {
-    return follower(d) ? cam_vf_me_event(d, code, x) : cam_event_value(&d->model, &d->mode, code, x, d->u);
+    return follower(d) ? follower(d)->event(d, code, x) : cam_event_value(&d->model, &d->mode, code, x, d->u);
 }
 
 /* Every indicator into z[CAM_EXCHANGE_NZ]; the codes of the slots into codes (n of them). */
@@ -271,7 +271,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     n = indicators(d, e->target, z, codes);
     k = due(e, z, codes, n);
     if (follower(d)) {   /* a lift-off, touch-down or halt, else the contact settled; its log line is the note */
-        int status = cam_vf_me_apply(d, k >= 0 ? codes[k] : 0, cam_instance_error(e->instance));
+        int status = follower(d)->event_update(d, k >= 0 ? codes[k] : 0, cam_instance_error(e->instance));
         if (status != CAM_OK)
             return status;
         fired->code = k >= 0 ? codes[k] : -1;

@@ -34,14 +34,29 @@ typedef struct {
     void (*outputs)(struct CamDrive *d, double out[]);
     /* the advice named in the guard messages ("reduce h_max ...") into buf */
     void (*advice)(const struct CamDrive *d, char *buf, size_t len);
+    /* optional: Model Exchange of states of its own (NULL: x under cam_rhs, the rigid drive's event table) */
+    const struct CamExchangeHooks *exchange;
 } CamFormulation;
 
-/* The formulation of an id (formulations.c), or NULL; each is const data in its own file. */
-const CamFormulation *cam_formulation(CamFormulationId id);
+/* A formulation's Model Exchange (cam_drive_me_* and fmi/exchange.c call them): its states x[CAM_ME_NX] and back,
+ * their rates, its event codes (how many, at most CAM_VF_ME_EVENTS) and functions (> 0: nothing happens), and its
+ * event update: the transition `code` (0: none, the mode settled at the state), the one its co-simulation runs. */
+typedef struct CamExchangeHooks {
+    void (*states)(const struct CamDrive *d, double *x);
+    void (*set_states)(struct CamDrive *d, const double *x);
+    void (*rates)(const struct CamDrive *d, const double *x, double *dx);
+    int (*codes)(const struct CamDrive *d, int *codes);
+    double (*event)(const struct CamDrive *d, int code, const double *x);
+    int (*event_update)(struct CamDrive *d, int code, CamError *err);
+} CamExchangeHooks;
+
+/* The formulation of a model (formulations.c; the consistent one with a follower of its own: the voltage
+ * follower's), or NULL; each is const data in its own file. */
+const CamFormulation *cam_formulation(const CamModel *m);
 extern const CamFormulation cam_consistent;   /* consistent.c */
 extern const CamFormulation cam_paper;        /* paper.c */
 extern const CamFormulation cam_speed;        /* speed.c */
-extern const CamFormulation cam_voltage_follower;   /* voltage_follower.c: consistent, closure 'spring' */
+extern const CamFormulation cam_voltage_follower;   /* voltage_follower.c: consistent, closures 'form', 'spring' */
 
 /* The fixed-step paper scheme's state (paper.PaperScheme: FIELDS and M_l), in SI units. */
 typedef struct {
@@ -71,11 +86,22 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
                           double out[]);
 /* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
 typedef double (*CamEventValue)(void *ctx, int code, double x);
-/* The earliest of the n event functions codes[k] (non-zero codes) to cross, as `crossed(before, after)` says, from
- * fa[k] at a to fb[k] at b: located by bisection to the last bit (the first x where crossed(fa[k], value) holds); its
- * code, or 0 for none, and *at (follower.c, voltage_follower.c). */
+/* The earliest of the n event functions codes[k] to cross, as `crossed(before, after)` says, from fa[k] at a to fb[k]
+ * at b, each located by Illinois false position (the first x where crossed(fa[k], value) holds) to a bracket of tol
+ * [s], or with tol = 0 to the last bit: its index, or -1 for none, and *at. Every hybrid run's one locator
+ * (integrate.c). */
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at);
+                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
+                           double *at);
+/* The follower's event codes (docs/model.md 13.7), one space for the speed drive's (follower.c) and the voltage
+ * drive's (voltage_follower.c, and Model Exchange's indicators): touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN);
+ * the voltage drive's shaft stops (EV_STOP) and breaks away; EV_BREAK and EV_SIDE only end a step. */
+typedef enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK,
+               EV_SIDE } CamFollowerEvent;
+/* N: the force closing the follower onto its +1 flank at s [m], F_spring0 + k_spring s - F_gx, and the guide's
+ * friction at no contact force, mu (|G_y| + |N_g|): both drives' followers' (follower.c). */
+double cam_follower_closing(const CamModel *m, double s);
+double cam_follower_friction0(const CamModel *m);
 #define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
 #define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
 
@@ -124,24 +150,14 @@ typedef struct CamDrive {
 /* Model Exchange's continuous state (physics/variables.py STATES): x[CAM_NX], then the voltage drive's free follower
  * (closures 'form', 'spring'; docs/model.md 13.6) as its gap g = left (s - s_flank(theta)) [m] to the flank it left
  * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
- * follower's events, its transitions and the refusals of the modes Model Exchange does not run are
- * voltage_follower_me.c's (cam_vf_me_*); exchange.c drives them. */
+ * follower's states, events and transitions are its formulation's hooks (CamExchangeHooks, voltage_follower_events.c);
+ * exchange.c drives them. */
 enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
-       CAM_VF_BREAK_AWAY = 6 /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
+       CAM_VF_BREAK_AWAY = EV_BREAK_AWAY /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
 /* The derivatives at x under the input d->form_u (the drive's mode and contact). */
 void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
-void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX]);
-void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
-void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
-/* The follower's event functions in this mode (their codes, how many) and one's value at x (> 0: nothing happens). */
-int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
-double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
-/* At the drive's state: the transition `code` (lift-off, touch-down with the impact law and the rebound guard, a halt
- * in flight), or with code 0 the contact settled (lifted at once where the force pulls); its log line into
- * d->step_events; the shaft's stop or break-away: stuck, or moving off (co-simulation's rule at rest). */
-int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
 
 /* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */
 int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err);

@@ -122,6 +122,12 @@ typedef struct {
 void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double h,
                           CamStepWork *w);
 
+/* Error control (the former Python engine's, scipy's RK45): a step of *dt [s] with error norm `norm` (> 1 or NaN:
+ * rejected) under the method's error exponent. Accepted: 1, and the next trial step into *h_next (dt times the
+ * growth factor, at most 5x and 1e3 s; where the step reached `bound` [s] and may grow, no shorter than *h_next
+ * was). Rejected: 0, and *dt shrunk (to no less than a tenth). Every adaptive step of the engine takes it. */
+int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next);
+
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is
  * 1e-12 of it); below the floor: CAM_ERR_REJECTED with the former engine's message. */
@@ -131,11 +137,6 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
 /* One fixed step inside the method's stability and resolution limits along the whole step:
  * its length [s], the end state in it->x_end; the retries it took into *retries. */
 int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt, long *retries, CamError *err);
-
-/* The zero of event ``code`` (or, code -1, of the gap direction (target - theta)) in (0, dt] by Illinois
- * false position on trial steps from d->x; it->x_hit holds the state at dt on entry and the state just
- * past the zero on return; returns its time from the step start [s]. */
-double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, double g_lo, double g_hi, double dt);
 
 /* Advance the consistent formulation's state d->x, d->mode by one communication step h [s] from
  * ``time`` with the method of d->model.solver: every step ends at the profile breakpoint it would

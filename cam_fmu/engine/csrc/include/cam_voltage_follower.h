@@ -1,5 +1,5 @@
 /* The voltage drive's follower of its own (docs/model.md 13.6): what voltage_follower.c (its equations and
- * co-simulation's step) shares with voltage_follower_me.c (Model Exchange's entry points, cam_drive.h cam_vf_me_*).
+ * co-simulation's step) shares with voltage_follower_events.c (the one event update, Model Exchange's view).
  * Internal to the engine, not for bindings. y = (theta, omega, i, s, v, phi, omega_m, sigma, dir): see
  * voltage_follower.c. */
 #ifndef CAM_VOLTAGE_FOLLOWER_H
@@ -13,13 +13,9 @@
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
 #define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
 
-/* touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN); EV_BREAK and EV_SIDE only end a step */
-enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK, EV_SIDE };
 
 /* m: a groove's clearance (closure 'form'), 0 for a spring's one flank. */
 double cam_vf_clearance(const CamModel *m);
-/* N: the guide's friction at no contact force. */
-double cam_vf_friction0(const CamModel *m);
 /* The flying follower's direction sgn(v), or at a halt where the net force pushes it (0: held by friction). */
 double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
 /* The rates of y on the flank `contact` (0: in flight) under the input u [V]. */
@@ -49,5 +45,18 @@ int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact
                       int *left, long *dropped);
 /* At rest (omega = 0): stuck, or moving off where it accelerates (at once at a located break-away). */
 void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold);
+/* The one event update of co-simulation and Model Exchange: the transition `code` (EV_NONE: the contact settled, or
+ * at rest the shaft's rule) at y at time [s]; *contact, *left and *rebound before and after. */
+void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *contact, int *left, double *rebound,
+                         double time, long *dropped);
+
+/* Model Exchange's view (the formulation's hooks cam_vf_exchange, cam_drive.h CamExchangeHooks). */
+void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX]);
+void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
+void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
+double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
+int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
+extern const CamExchangeHooks cam_vf_exchange;
 
 #endif

@@ -12,8 +12,7 @@ int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err)
     memset(d, 0, sizeof *d);
     if ((status = cam_model_init(&d->model, params, err)) != CAM_OK)
         return status;
-    d->form = d->model.free_follower && d->model.formulation == CAM_FORM_CONSISTENT ? &cam_voltage_follower
-              : cam_formulation(d->model.formulation);
+    d->form = cam_formulation(&d->model);
     if (d->form == NULL || cam_method(d->model.solver) == NULL) {   /* the generated choices and the registries */
         status = cam_error(err, CAM_ERR_PARAMETER, "formulation %d or solver %d is not in the engine",
                            (int)d->model.formulation, d->model.solver);
@@ -178,8 +177,8 @@ int cam_drive_run(CamDrive *d, long n_steps, const double *table, double *out, l
 
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX])
 {
-    if (d->form == &cam_voltage_follower) {
-        cam_vf_me_states(d, x);
+    if (d->form->exchange != NULL) {
+        d->form->exchange->states(d, x);
         return;
     }
     memcpy(x, d->x, sizeof d->x);
@@ -188,8 +187,8 @@ void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX])
 
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 {
-    if (d->form == &cam_voltage_follower) {
-        cam_vf_set_me_states(d, x);
+    if (d->form->exchange != NULL) {
+        d->form->exchange->set_states(d, x);
         return;
     }
     /* a rigid drive holds the shaft's slots at 0 (their derivatives are 0: a host's solver leaves them) */
@@ -200,8 +199,8 @@ void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
 {
     int k;
-    if (d->form == &cam_voltage_follower) {
-        cam_vf_me_rates(d, x, dx);
+    if (d->form->exchange != NULL) {
+        d->form->exchange->rates(d, x, dx);
         return;
     }
     for (k = 0; k < CAM_ME_NX; k++)   /* the held slots */

@@ -4,7 +4,8 @@
  * clearance c): in contact the follower rides its flank; lift-off where the flank's force reaches 0; in flight
  * m s'' = -(F_spring0 + k_spring s) + F_gx - sgn(v) f0; touch-down where a gap reaches -CAM_TOUCH, an impact with
  * restitution, and the Zeno guard. Events are found by sampling each step (at most SCAN_ANGLE of cam angle and
- * a twentieth of the flight's period apart, finer just after a rebound) and located by bisection. The output
+ * a twentieth of the flight's period apart, finer just after a rebound) and located by the engine's one locator
+ * (integrate.c cam_locate_first_event). The output
  * N_contact is the flank's force along X (with the guide friction) over cos(alpha), signed: > 0 on the +1 flank,
  * < 0 on a groove's -1 flank, 0 in flight (docs/model.md 13.1). */
 #include <math.h>
@@ -16,8 +17,6 @@
 
 #define SCAN_ANGLE 1e-3         /* rad: cam angle between two samples of an event function */
 #define MAX_EVENTS 100000       /* transitions in one step before the step is refused */
-
-enum { EV_NONE = 0, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT };
 
 typedef struct {
     const CamModel *m;
@@ -47,9 +46,14 @@ static double theta_at(const Motion *mo, double tau)
     return mo->theta0 + (mo->omega0 + 0.5 * mo->omega_dot * tau) * tau;
 }
 
-static double closing(const CamModel *m, double s)
+double cam_follower_closing(const CamModel *m, double s)
 {
     return m->F_spring0 + m->k_spring * s - m->F_gx;
+}
+
+double cam_follower_friction0(const CamModel *m)
+{
+    return m->mu * (fabs(m->G_y) + m->N_g);
 }
 
 /* The follower on the flank `contact`: d = (s, s', s'', s_cam). */
@@ -68,13 +72,13 @@ static double held(const Motion *mo, double theta, double omega, double omega_do
     on_flank(mo, theta, contact, d);
     v = d[1] * omega;
     friction = v > 0.0 ? mo->f0 : (v < 0.0 ? -mo->f0 : 0.0);
-    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + closing(m, d[0]) + friction);
+    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + cam_follower_closing(m, d[0]) + friction);
 }
 
 /* m/s2 in flight with the friction's direction -sigma; sigma = 0 at a halt: 0 while static friction holds. */
 static double free_acceleration(const Motion *mo, double s, double sigma)
 {
-    double net = -closing(mo->m, s);
+    double net = -cam_follower_closing(mo->m, s);
     if (sigma == 0.0) {
         if (fabs(net) <= mo->f0)
             return 0.0;
@@ -139,7 +143,7 @@ static double motion_event(void *ctx, int code, double tau)
     return event_value(scan->mo, scan->p, scan->contact, code, tau);
 }
 
-/* The first event in (tau, end]: its code (EV_NONE: none) and *at, located by bisection between samples. */
+/* The first event in (tau, end]: its code (EV_NONE: none) and *at, located between samples. */
 static int first_event(const Motion *mo, const Piece *p, double contact, double tau, double end, double rebound,
                        double *at)
 {
@@ -166,39 +170,12 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
             b = end;
         for (k = 0; k < n; k++)
             fb[k] = event_value(mo, p, contact, codes[k], b);
-        found = cam_locate_first_event(n, codes, a, b, fa, fb, downward, motion_event, &scan, at);
+        k = cam_locate_first_event(n, codes, a, b, fa, fb, downward, motion_event, &scan, 0.0, at);
+        found = k >= 0 ? codes[k] : EV_NONE;
         for (k = 0; k < n; k++)
             fa[k] = fb[k];
         a = b;
     }
-    return found;
-}
-
-int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double *at)
-{
-    int k, found = 0;
-    double best = b;
-    for (k = 0; k < n; k++) {
-        double lo = a, hi = b;
-        if (!crossed(fa[k], fb[k]))
-            continue;
-        for (;;) {
-            double mid = 0.5 * (lo + hi);
-            if (mid <= lo || mid >= hi)
-                break;
-            if (crossed(fa[k], value(ctx, codes[k], mid)))
-                hi = mid;
-            else
-                lo = mid;
-        }
-        if (hi < best || found == 0) {
-            best = hi;
-            found = codes[k];
-        }
-    }
-    if (found != 0)
-        *at = best;
     return found;
 }
 
@@ -219,7 +196,7 @@ void cam_follower_note(char *events, size_t len, long *dropped, const char *form
 /* The contact the follower starts in at the inputs omega, omega_dot (reference/flight.py _start_contact). */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot)
 {
-    Motion mo = {m, st->theta, omega, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, omega, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double d[4], side;
     st->contact = held(&mo, st->theta, omega, omega_dot, 1.0) >= 0.0 ? 1.0
@@ -284,7 +261,7 @@ static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, doubl
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err)
 {
-    Motion mo = {m, st->theta, omega0, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, omega0, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double tau = 0.0, d[4];
     long count = 0, dropped = 0;
@@ -340,7 +317,7 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
 /* physics.speed_follower.SpeedFollower.outputs: the speed drive's outputs with the follower's own s, v, a. */
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction, double out[])
 {
-    Motion mo = {m, st->theta, st->speed, omega_dot, m->mu * (fabs(m->G_y) + m->N_g), m->c,
+    Motion mo = {m, st->theta, st->speed, omega_dot, cam_follower_friction0(m), m->c,
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double omega = st->speed, theta = st->theta, d[4], tan_a, shaft, i, voltage, s = st->s, v = st->v, a;
     double M, J, N = 0.0;
@@ -354,7 +331,7 @@ void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double ome
         for (k = 0; k < 3; k++) {   /* at theta, theta + step and theta - step: the voltage's dM/dtheta */
             double angle = theta + (k == 0 ? 0.0 : (k == 1 ? step : -step)), e[4], push, t_a, sigma, f;
             on_flank(&mo, angle, st->contact, e);
-            push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + closing(m, e[0]);
+            push = m->m * (e[2] * omega * omega + e[1] * omega_dot) + cam_follower_closing(m, e[0]);
             t_a = e[1] / (m->r_b + e[3]);
             sigma = sgn(e[1] * direction);
             f = cam_guide_friction(push * t_a + m->G_y, t_a, sigma, m->mu, m->N_g, 0.0);

@@ -1,14 +1,15 @@
-/* The formulations of the drive, by id (physics/formulations: FORMULATIONS): each is const data in its
- * own file (consistent.c, paper.c, speed.c). */
+/* The formulations of the drive, by the model's id (physics/formulations: FORMULATIONS) and its follower: each is
+ * const data in its own file (consistent.c, paper.c, speed.c; voltage_follower.c, the consistent formulation with a
+ * follower of its own). */
 #include <stddef.h>
 
 #include "cam_drive.h"
 
-const CamFormulation *cam_formulation(CamFormulationId id)
+const CamFormulation *cam_formulation(const CamModel *m)
 {
-    switch (id) {
+    switch (m->formulation) {
     case CAM_FORM_CONSISTENT:
-        return &cam_consistent;
+        return m->free_follower ? &cam_voltage_follower : &cam_consistent;
     case CAM_FORM_PAPER:
         return &cam_paper;
     case CAM_FORM_SPEED:

@@ -1,6 +1,7 @@
 /* One communication step of the consistent formulation with any method: adaptive steps with error
  * control (or fixed steps inside the method's limits), profile breakpoints, events located by Illinois
- * false position on re-stepped trial states, transitions, the work bound max_steps, rollback.
+ * false position on re-stepped trial states (cam_locate_first_event, every hybrid run's one locator),
+ * transitions, the work bound max_steps, rollback.
  *
  * Ported from the former Python engine (its step attempt, trial, locate, first_event,
  * advance) with the order of floating-point operations kept: rk45 agrees with it to the last bit. */
@@ -10,7 +11,8 @@
 
 #include "cam_solver.h"
 
-#define EVENT_ITERATIONS 60   /* Illinois iterations at most per located zero */
+#define EVENT_ITERATIONS 60   /* Illinois iterations at most per zero located to a tolerance */
+#define EXACT_ITERATIONS 400  /* and to the last bit (never a hang; 60 halvings alone get there from 1 s) */
 
 /* f(x) into d->solver.k1 unless it is valid already. */
 static void ensure_k1(CamDrive *d, double u)
@@ -52,11 +54,31 @@ static void compliant_cause(const CamModel *m, char *buf, size_t len)
                  "rigid: k_shaft = 0)", shaft, 1.0 / shaft);
 }
 
+int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next)
+{
+    double factor, t;   /* no fmin/fmax: a call each where the compiler may not assume finite numbers */
+    if (norm <= 1.0) {
+        t = norm == 0.0 ? 5.0 : 0.9 * pow(norm, exponent);
+        factor = t < 5.0 ? t : 5.0;
+        if (*dt < bound || factor < 1.0) {
+            t = *dt * factor;
+            *h_next = 1e3 < t ? 1e3 : t;
+        } else {   /* a step the bounds cut: its success says nothing against a longer next one */
+            t = *dt * (1.0 < factor ? 1.0 : factor);
+            *h_next = t > *h_next ? t : *h_next;
+        }
+        return 1;
+    }
+    t = 0.9 * pow(isfinite(norm) ? norm : 1e10, exponent);
+    *dt *= t > 0.1 ? t : 0.1;
+    return 0;
+}
+
 int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double time, double span, double *dt_out,
                       CamError *err)
 {
     const CamModel *m = &d->model;
-    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u, norm, factor, t;
+    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u;
     if (remaining < dt)
         dt = remaining;
     if (m->h_max < dt)
@@ -65,31 +87,14 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
     for (;;) {
         it->exponential = m->has_current && !m->compliant && dt * m->R / m->L > CAM_POLE_LIMIT;
         method_step(d, it, dt, u);
-        norm = cam_error_norm(m, d->x, &it->work);
-        if (norm <= 1.0) {
-            if (norm == 0.0) {
-                factor = 5.0;
-            } else {
-                t = 0.9 * pow(norm, it->method->tableau->error_exponent);
-                factor = t < 5.0 ? t : 5.0;
-            }
-            if (dt < remaining || factor < 1.0) {
-                t = dt * factor;
-                d->solver.h_next = 1e3 < t ? 1e3 : t;
-            } else {
-                t = dt * (1.0 < factor ? 1.0 : factor);
-                d->solver.h_next = t > d->solver.h_next ? t : d->solver.h_next;
-            }
+        if (cam_step_control(cam_error_norm(m, d->x, &it->work), it->method->tableau->error_exponent, remaining, &dt,
+                             &d->solver.h_next)) {
             memcpy(it->x_end, it->work.x_new, sizeof it->x_end);
             if (!it->exponential)
                 memcpy(it->f_end, it->work.f_new, sizeof it->f_end);
             *dt_out = dt;
             return CAM_OK;
         }
-        if (!isfinite(norm))
-            norm = 1e10;
-        t = 0.9 * pow(norm, it->method->tableau->error_exponent);
-        dt *= t > 0.1 ? t : 0.1;
         if (dt < floor_) {
             char a[32], b[32], c[32], e[32], cause[300];
             compliant_cause(m, cause, sizeof cause);
@@ -125,34 +130,102 @@ static double zero_value(CamDrive *d, int code, double target, const double x[CA
     return cam_event_value(&d->model, &d->mode, code, x, u);
 }
 
-double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, double g_lo, double g_hi, double dt)
+/* Is the bracket (lo, hi] still open after j iterations: wider than tol, or (tol = 0) has it a double inside? */
+static int open_bracket(double lo, double hi, double tol, int j)
 {
-    double lo = 0.0, hi = dt, tau, g_tau, u = d->u;
-    int side = 0, k;
-    for (k = 0; k < EVENT_ITERATIONS; k++) {
-        if (hi - lo <= 1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15)
-            break;
-        tau = g_hi != g_lo ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
-        if (!(lo < tau && tau < hi))
-            tau = 0.5 * (lo + hi);
-        trial(d, it, tau, u);
-        g_tau = zero_value(d, code, target, it->work.x_new, u);
-        if (g_tau <= 0.0) {
-            hi = tau;
-            g_hi = g_tau;
-            memcpy(it->x_hit, it->work.x_new, sizeof it->x_hit);
-            if (side == -1)
-                g_lo *= 0.5;
-            side = -1;
-        } else {
-            lo = tau;
-            g_lo = g_tau;
-            if (side == 1)
-                g_hi *= 0.5;
-            side = 1;
+    double mid = 0.5 * (lo + hi);
+    return tol > 0.0 ? j < EVENT_ITERATIONS && hi - lo > tol : j < EXACT_ITERATIONS && lo < mid && mid < hi;
+}
+
+int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
+                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
+                           double *at)
+{
+    int k, j, side, first = -1;
+    double best = b;
+    for (k = 0; k < n; k++) {
+        double lo = a, hi = b, g_lo = fa[k], g_hi = fb[k], tau, g;
+        if (!crossed(fa[k], fb[k]))
+            continue;
+        for (side = 0, j = 0; open_bracket(lo, hi, tol, j); j++) {
+            tau = g_hi != g_lo ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
+            if (!(lo < tau && tau < hi))
+                tau = 0.5 * (lo + hi);
+            g = value(ctx, codes[k], tau);
+            if (crossed(fa[k], g)) {
+                hi = tau;
+                g_hi = g;
+                if (side == -1)
+                    g_lo *= 0.5;
+                side = -1;
+            } else {
+                lo = tau;
+                g_lo = g;
+                if (side == 1)
+                    g_hi *= 0.5;
+                side = 1;
+            }
+        }
+        if (first < 0 || hi < best) {
+            best = hi;
+            first = k;
         }
     }
-    return hi;
+    if (first >= 0)
+        *at = best;
+    return first;
+}
+
+typedef struct {                /* trial_value's arguments but the code and the time */
+    CamDrive *d;
+    CamIntegrator *it;
+    const int *codes;           /* the functions located */
+    double target;              /* rad: the breakpoint of code -1 */
+    double x[CAM_MAX_EVENTS][CAM_NX];   /* each function's latest trial state on its event side (<= 0) */
+} Trial;
+
+/* The event function `code` (-1: the gap direction (target - theta)) at the trial state tau [s] into the step; the
+ * state kept where it is <= 0 (the located time is the latest such trial: no step taken again). */
+static double trial_value(void *ctx, int code, double tau)
+{
+    Trial *t = ctx;
+    double g;
+    int k = 0;
+    trial(t->d, t->it, tau, t->d->u);
+    g = zero_value(t->d, code, t->target, t->it->work.x_new, t->d->u);
+    if (g <= 0.0) {
+        while (t->codes[k] != code)
+            k++;
+        memcpy(t->x[k], t->it->work.x_new, sizeof t->x[k]);
+    }
+    return g;
+}
+
+static int downward(double before, double after)
+{
+    return before > 0.0 && after <= 0.0;
+}
+
+/* The first of n functions codes[k] to go from before[k] > 0 to after[k] <= 0 over the step of dt from d->x to
+ * it->x_end: its index (-1: none), its time *tau from the step start [s] and the state there in it->x_hit. */
+static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], const double before[],
+                  const double after[], double target, double dt, double *tau)
+{
+    Trial t;
+    int k;
+    for (k = 0; k < n && !downward(before[k], after[k]); k++)
+        ;
+    if (k == n)   /* the common case: nothing crossed, no call */
+        return -1;
+    t.d = d;
+    t.it = it;
+    t.codes = codes;
+    t.target = target;
+    k = cam_locate_first_event(n, codes, 0.0, dt, before, after, downward, trial_value, &t,
+                               1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, tau);
+    if (k >= 0)   /* at dt no trial fell on the event's side: the step's end */
+        memcpy(it->x_hit, *tau < dt ? t.x[k] : it->x_end, sizeof it->x_hit);
+    return k;
 }
 
 /* The earliest event in (0, dt] of the step from d->x to it->x_end: its time from the step start [s],
@@ -161,7 +234,7 @@ double cam_locate(CamDrive *d, CamIntegrator *it, int code, double target, doubl
 static double first_event(CamDrive *d, CamIntegrator *it, double dt)
 {
     int n = it->n_events, k;
-    double best = -1.0, tau, b[CAM_NX] = {0.0, 0.0, 0.0}, u = d->u;
+    double tau, u = d->u;
     if (!it->have_before)
         for (k = 0; k < n; k++)
             it->before[k] = cam_event_value(&d->model, &d->mode, it->codes[k], d->x, u);
@@ -176,24 +249,15 @@ static double first_event(CamDrive *d, CamIntegrator *it, double dt)
             memcpy(it->x_hit, d->x, sizeof it->x_hit);
             return 0.0;
         }
-    for (k = 0; k < n; k++)
-        if (it->before[k] > 0.0 && it->after[k] <= 0.0) {
-            memcpy(it->x_hit, it->x_end, sizeof it->x_hit);
-            tau = cam_locate(d, it, it->codes[k], 0.0, it->before[k], it->after[k], dt);
-            if (best < 0.0 || tau < best) {
-                best = tau;
-                it->hit = it->codes[k];
-                memcpy(b, it->x_hit, sizeof b);
-            }
-        }
-    if (best < 0.0) {
+    k = locate(d, it, n, it->codes, it->before, it->after, 0.0, dt, &tau);
+    if (k < 0) {
         for (k = 0; k < n; k++)
             it->before[k] = it->after[k];
         it->have_before = 1;   /* the next step starts where this one ended */
         return -1.0;
     }
-    memcpy(it->x_hit, b, sizeof b);
-    return best;
+    it->hit = it->codes[k];
+    return tau;
 }
 
 static int max_steps_error(const CamDrive *d, const CamMethod *method, double time, double h, CamError *err)
@@ -259,9 +323,11 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
             }
             target = cam_profile_first_breakpoint(&m->profile, d->x[CAM_THETA], it->x_end[CAM_THETA]);
             if (target == target) {   /* the step crosses a breakpoint and ends just past it */
-                memcpy(it->x_hit, it->x_end, sizeof it->x_hit);
-                cut = cam_locate(d, it, -1, target, d->mode.direction * (target - d->x[CAM_THETA]),
-                                 d->mode.direction * (target - it->x_end[CAM_THETA]), dt);
+                int code = -1;
+                double g[2] = {d->mode.direction * (target - d->x[CAM_THETA]),
+                               d->mode.direction * (target - it->x_end[CAM_THETA])};
+                if (locate(d, it, 1, &code, &g[0], &g[1], target, dt, &cut) < 0)
+                    cut = dt;
                 if (cut != dt) {   /* its first-same-as-last derivative belonged to the longer step */
                     dt = cut;
                     memcpy(it->x_end, it->x_hit, sizeof it->x_end);

@@ -132,10 +132,10 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
             return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
                              "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
                              ? " or -1 (on the groove's other flank)" : "");
-        if (d->form == &cam_voltage_follower && s[CAM_S_SPEED + 8] != 1.0 && s[CAM_S_SPEED + 8] != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
+        if (m->formulation == CAM_FORM_CONSISTENT && s[CAM_S_SPEED + 8] != 1.0 && s[CAM_S_SPEED + 8] != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %s: allowed +1%s",
                              cam_num(s[CAM_S_SPEED + 8], a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
-        if (d->form == &cam_voltage_follower && !(s[CAM_S_SPEED + 9] == 0.0 || fabs(s[CAM_S_SPEED + 9]) == 1.0))
+        if (m->formulation == CAM_FORM_CONSISTENT && !(s[CAM_S_SPEED + 9] == 0.0 || fabs(s[CAM_S_SPEED + 9]) == 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower direction in flight %s: allowed -1, 0, +1",
                              cam_num(s[CAM_S_SPEED + 9], a));
     }

@@ -15,7 +15,7 @@
  * `solver` (rk.c's tableaus: rk45 with error control on rtol, atol; euler, rk4 and etdrk4's RK4 core fixed at h_max
  * within the stability and resolution limits of fixed_step.c), at most STEP_PHASE of the flight's oscillation and
  * of the shaft's (SHAFT_PHASE_RK45 under rk45), a tenth of the electrical time constant, FLIGHT_ANGLE of cam angle in flight; an event function gone
- * from > 0 to <= 0 over a step is located by bisection on the step's length. At rest (omega = 0: the start, a stop)
+ * from > 0 to <= 0 over a step is located on the step's length (integrate.c's locator). At rest (omega = 0: the start, a stop)
  * the shaft is stuck, the follower at rest on its flank (y[8] = 0), until the consistent formulation's break-away
  * rule with the contact's load starts it; the shaft's direction y[8] is held over a step. A cam stuck with the
  * follower off it: the follower flies alone and lands on the cam at rest (voltage_follower_events.c unstick). */
@@ -75,17 +75,6 @@ static double torque(const CamModel *m, const double y[NY], double u)
     return torque_toward(m, y, u, shaft_direction(y));
 }
 
-/* N: the guide's friction at no contact force, mu (|G_y| + |N_g|). */
-double cam_vf_friction0(const CamModel *m)
-{
-    return m->mu * (fabs(m->G_y) + m->N_g);
-}
-
-static double closing(const CamModel *m, double s)
-{
-    return m->F_spring0 + m->k_spring * s - m->F_gx;
-}
-
 /* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
 double cam_vf_clearance(const CamModel *m)
 {
@@ -100,7 +89,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_profile_eval(&m->profile, y[0], d);
-    F = closing(m, d[0] - contact * cam_vf_clearance(m));
+    F = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
     if (m->mu == 0.0) {
         *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
@@ -128,7 +117,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 {
     if (y[Y_DIR] == 0.0) {
         cam_profile_eval(&m->profile, y[0], d);
-        *P = closing(m, d[0] - contact * cam_vf_clearance(m));
+        *P = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -171,7 +160,7 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
 static double free_acceleration(const CamModel *m, double s, double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-closing(m, s) - sigma * cam_vf_friction0(m)) / m->m;
+    return sigma == 0.0 ? 0.0 : (-cam_follower_closing(m, s) - sigma * cam_follower_friction0(m)) / m->m;
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
@@ -181,8 +170,8 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     double net;
     if (y[4] != 0.0)
         return sgn(y[4]);
-    net = -closing(m, y[3]);
-    return fabs(net) > cam_vf_friction0(m) ? sgn(net) : 0.0;
+    net = -cam_follower_closing(m, y[3]);
+    return fabs(net) > cam_follower_friction0(m) ? sgn(net) : 0.0;
 }
 
 /* cam_vf_rates, and on a moving flank the contact's force *P [N] along X and the guide's side force *n_r [N] (else
@@ -210,7 +199,7 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
     }
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
-    dy[4] = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+    dy[4] = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
 
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
@@ -318,7 +307,7 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
 {
     double d[4];
     cam_profile_eval(&m->profile, y[0], d);
-    return fabs(closing(m, d[0]) / m->m) + cam_vf_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+    return fabs(cam_follower_closing(m, d[0]) / m->m) + cam_follower_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -460,27 +449,21 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
                              "t = %.9g s, step %g s, contact %d, rebound guard %g s): the step is refused", MAX_STEPS,
                              time, time + tau, dt, contact, rebound);
         if (adaptive) {   /* error control on rtol, atol within the bounds above (integrate.c cam_step_adaptive) */
-            double bound = fmin(dt, m->h_max), norm, factor, e[NY];
+            double bound = fmin(dt, m->h_max), e[NY];
             dt = fmin(bound, d->solver.h_next);
             if (!(fsal && contact == fsal_contact && y[Y_SIGMA] == fsal_sigma))
                 fsal = 0;   /* the rates at y are those the last step ended with while its mode holds */
             for (;;) {
                 vf_step(m, tableau, u, contact, y, dt, next, e, stages, fsal, forces);
                 fsal = 1;   /* k[0] is the rates at y from here on */
-                norm = vf_error_norm(m, contact, y, next, e);
-                if (norm <= 1.0)
+                if (cam_step_control(vf_error_norm(m, contact, y, next, e), tableau->error_exponent, bound, &dt,
+                                     &d->solver.h_next))
                     break;
-                dt *= fmax(0.9 * pow(isfinite(norm) ? norm : 1e10, tableau->error_exponent), 0.1);
                 if (dt < 1e-12 * h)
                     return cam_error(err, CAM_ERR_REJECTED, "solver 'rk45' cannot meet rtol = %g, atol = %g: its step "
                                      "fell below %g s (1e-12 of the communication step) at t = %g s: loosen rtol/atol, "
                                      "or check the inputs and parameters", m->rtol, m->atol, 1e-12 * h, time + tau);
             }
-            factor = norm == 0.0 ? 5.0 : fmin(0.9 * pow(norm, tableau->error_exponent), 5.0);
-            if (dt < bound || factor < 1.0)
-                d->solver.h_next = fmin(dt * factor, 1e3);
-            else   /* a step the bounds cut: its success says nothing against a longer next one */
-                d->solver.h_next = fmax(d->solver.h_next, dt * fmin(factor, 1.0));
         } else
             vf_step(m, tableau, u, contact, y, dt, next, NULL, NULL, 0, NULL);
         codes[n++] = y[Y_DIR] == 0.0 ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
@@ -491,7 +474,7 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
             codes[n++] = EV_TOUCH_UP;
             if (m->closure == CAM_CHOICE_CLOSURE_FORM)
                 codes[n++] = EV_TOUCH_DOWN;
-            if (y[Y_SIGMA] != 0.0 && cam_vf_friction0(m) > 0.0)
+            if (y[Y_SIGMA] != 0.0 && cam_follower_friction0(m) > 0.0)
                 codes[n++] = EV_HALT;
         }
         ends[0] = cam_profile_first_breakpoint(&m->profile, y[0], next[0]);
@@ -521,7 +504,8 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         }
         {
             Trial tr = {m, tableau, u, contact, ends, y};
-            code = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, &at);
+            k = cam_locate_first_event(n, codes, 0.0, dt, before, after, crossed, trial_event, &tr, 0.0, &at);
+            code = k >= 0 ? codes[k] : EV_NONE;
         }
         have_before = code == EV_NONE;
         if (have_before) {   /* the mode the next step must keep to reuse the end's rates and event functions */
@@ -546,33 +530,12 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
         tau = code == EV_NONE ? tau + dt : tau + at;
         if (rebound > 0.0)
             rebound = fmax(rebound - (code == EV_NONE ? dt : at), 0.0);
-        if (code == EV_NONE)
+        if (code == EV_NONE || code == EV_SIDE)
             continue;
-        if (code == EV_SIDE)
-            continue;
-        if (code == EV_BREAK) {   /* past it: a flank whose force jumped below 0 there lets go at once */
-            if (contact && !(contact = cam_vf_settle_from(m, y, u, contact, &left)))
-                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off at t = %.9g s "
-                                  "(theta = %.6g rad); ", time + tau, y[0]);
-            continue;
-        }
-        if (++events > MAX_EVENTS)
+        if (code != EV_BREAK && ++events > MAX_EVENTS)   /* past a breakpoint only the contact is settled */
             return cam_error(err, CAM_ERR_SIMULATION, "the follower changed contact more than %d times in one step "
                              "from t = %g s: the step is refused", MAX_EVENTS, time);
-        if (code == EV_STOP || code == EV_BREAK_AWAY) {
-            int was = contact;
-            cam_vf_at_rest(m, y, u, &contact, &left, code == EV_BREAK_AWAY);
-            cam_follower_note(d->step_events, sizeof d->step_events, &dropped, y[Y_DIR] == 0.0 ? "shaft: stuck at "
-                              "t = %.9g s (theta = %.6g rad); " : "shaft: moving at t = %.9g s (theta = %.6g rad); ",
-                              time + tau, y[0]);
-            if (was && !contact)
-                cam_follower_note(d->step_events, sizeof d->step_events, &dropped, "follower: lift-off from flank "
-                                  "%+d at t = %.9g s (theta = %.6g rad); ", was, time + tau, y[0]);
-        } else if (code == EV_HALT) {
-            y[4] = 0.0;   /* the friction turns, or holds the follower (flight_direction at the next step) */
-        } else {
-            contact = cam_vf_transition(d, y, u, code, contact, time + tau, &rebound, &left, &dropped);
-        }
+        cam_vf_event_update(d, y, u, code, &contact, &left, &rebound, time + tau, &dropped);
     }
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
@@ -619,7 +582,7 @@ static void vf_outputs(CamDrive *d, double out[])
         load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;
         load.v = y[4];
-        load.a = m->mu == 0.0 ? -closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+        load.a = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
     }
     cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
     if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too (outputs.c cam_outputs) */
@@ -637,5 +600,5 @@ static void vf_advice(const CamDrive *d, char *buf, size_t len)
 }
 
 const CamFormulation cam_voltage_follower = {
-    "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice,
+    "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice, &cam_vf_exchange,
 };
