@@ -300,7 +300,7 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
         ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, needsExecutionTool="false",
                       completedIntegratorStepNotNeeded="false", canBeInstantiatedOnlyOncePerProcess="false",
                       canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
-                      canSerializeFMUstate="true", providesDirectionalDerivative="false")
+                      canSerializeFMUstate="true", providesDirectionalDerivative="true")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier, needsExecutionTool="false",
                   canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
                   canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",

@@ -47,6 +47,10 @@ typedef struct {
     int (*completed_step)(void *m, int *enter_event);
     /* The state as bytes (state_size long) with what Model Exchange books, the live books unchanged. */
     int (*save)(void *m, unsigned char *buffer, size_t size);
+    /* Directional derivatives at the host's state and inputs: dv_unknown = d(unknowns)/d(knowns) dv_known, each
+     * named by value reference (NULL: the model provides none). */
+    int (*directional)(void *m, const unsigned unknown[], size_t n_unknown, const unsigned known[], size_t n_known,
+                       const double dv_known[], double dv_unknown[]);
 } ModelExchangeOps;
 
 typedef struct {
