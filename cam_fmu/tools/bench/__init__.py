@@ -22,6 +22,8 @@ BENCHMARKS = {
     "loops": ("loops", True, "tight loops: a C host, fmpy's FMU2Slave, one in-process run"),
     "memory": ("memory", False, "RSS over a long run through FMU2Slave"),
     "toolchain": ("toolchain", False, "cam.fmu's binary from zig against the system gcc's"),
+    "jacobian": ("jacobian", False, "stiff runs (L = 1 mH, rigid and compliant) under scipy's BDF and Radau with "
+                                    "cam.fmu's directional derivatives against differencing: right-hand sides, wall"),
 }
 DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
 
