@@ -158,3 +158,108 @@ def test_directional_derivatives_match_central_differences(engine_fmu_path, case
     finally:
         me.close()
     assert checked == 4
+
+
+def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
+    """The <Derivatives>/<Outputs> dependencies of modelDescription.xml hold every state and input that central
+    differences of the FMU's derivatives and outputs move, over every case at random states; beyond the probe only the
+    entries of a follower of its own in flight (variables.DEPENDENCIES says why). fmpy's validation is clean and the FMU
+    says it provides directional derivatives."""
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(str(engine_fmu_path)) == []
+    md = fmpy.read_model_description(str(engine_fmu_path))
+    assert md.modelExchange.providesDirectionalDerivative
+    listed = {u.variable.name: {d.name for d in u.dependencies} for u in md.derivatives + md.outputs}
+    for u in md.derivatives + md.outputs:
+        assert u.dependenciesKind == ["dependent"] * len(u.dependencies)
+    rng = np.random.default_rng(7)
+    found: dict[str, set] = {name: set() for name in listed}
+    flight = {"x_gap", "x_gap_rate"}
+    for case, start in {**CASES, "spring": {"omega0": 20.0, "closure": "spring"}}.items():
+        me = Me(engine_fmu_path, start)
+        names = [f"der({row[0]})" for row in STATES] + [row[0] for row in OUTPUTS]
+        knowns = [row[0] for row in STATES] + ["u"]
+        for _ in range(3):
+            random_states(me, rng, start.get("omega0", 1.0) == 0.0)
+            fd = me.central(1e-6)
+            scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
+            for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
+                found[names[r]].add(knowns[c])
+        me.close()
+    for name in listed:
+        assert found[name] <= listed[name], (name, found[name] - listed[name])
+        unprobed = listed[name] if name.startswith("der(x_gap") else flight   # only in flight
+        assert listed[name] - found[name] <= unprobed, (name, listed[name] - found[name])
+
+
+def refusal(me: Me, unknowns: list, knowns: list, logged: list) -> str:
+    """The message of a refused fmi2GetDirectionalDerivative (fmi2Error), with the unknowns' values."""
+    with pytest.raises(FMICallException) as info:
+        me.model.getDirectionalDerivative(unknowns, knowns, [1.0] * len(knowns))
+    assert info.value.status == 3
+    return logged[-1]
+
+
+def logging_me(fmu, start: dict) -> tuple[Me, list]:
+    from fmpy.fmi2 import (calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                           fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
+
+    messages: list[str] = []
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(lambda _e, _n, _s, _c, text: messages.append(text.decode()))
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    original = FMU2Model.instantiate
+    FMU2Model.instantiate = lambda self, **kw: original(self, callbacks=callbacks, **kw)
+    try:
+        me = Me(fmu, start)
+    finally:
+        FMU2Model.instantiate = original
+    me.callbacks = callbacks   # kept alive with the instance
+    return me, messages
+
+
+def test_bad_requests_are_errors_with_the_reason(engine_fmu_path):
+    """An unknown value reference, a parameter as a known, an output or state as an unknown of the wrong kind, and a
+    follower of its own: fmi2Error and the reason in the log, never a zero that looks like a derivative."""
+    me, logged = logging_me(engine_fmu_path, {"omega0": 20.0})
+    try:
+        der_omega, x_theta = me.vr["der(x_omega)"], me.vr["x_theta"]
+        assert "value reference 99999 ('no variable') is no known" in refusal(me, [der_omega], [99999], logged)
+        assert "('R') is no known (a continuous state or input)" in refusal(me, [der_omega], [me.vr["R"]], logged)
+        assert "('x_theta') is no unknown (a state derivative or output)" in refusal(me, [x_theta], [x_theta], logged)
+        assert "('u') is no unknown" in refusal(me, [me.vr["u"]], [x_theta], logged)
+        good = me.model.getDirectionalDerivative([der_omega], [me.vr["u"]], [1.0])[0]
+        assert good > 0.0   # more voltage, more acceleration: the same call answers once the request is right
+    finally:
+        me.close()
+    me, logged = logging_me(engine_fmu_path, {"omega0": 20.0, "closure": "spring"})
+    try:
+        assert "follower of its own" in refusal(me, [me.vr["der(x_omega)"]], [me.vr["x_theta"]], logged)
+    finally:
+        me.close()
+
+
+def test_outside_model_exchange_is_an_error(engine_fmu_path):
+    """Before initialisation and in a co-simulation instance the call is refused with the reason."""
+    md = fmpy.read_model_description(str(engine_fmu_path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    model = FMU2Model(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
+                      instanceName="early")
+    model.instantiate()
+    with pytest.raises(FMICallException):
+        model.getDirectionalDerivative([vr["der(x_omega)"]], [vr["x_theta"]], [1.0])
+    model.freeInstance()
+    from fmpy.fmi2 import FMU2Slave
+
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
+                      instanceName="cs")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    with pytest.raises(FMICallException):
+        slave.getDirectionalDerivative([vr["omega"]], [vr["u"]], [1.0])
+    slave.terminate()
+    slave.freeInstance()
