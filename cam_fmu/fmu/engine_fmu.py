@@ -78,7 +78,7 @@ def controller_experiment() -> tuple[float, float, float]:
 
 def _cam_sources() -> List[Path]:
     return [*engine_build.source_files(), FMI / "instance.c", FMI / "exchange.c", FMI / "exchange.h",
-            FMI / "model_cam.c"]
+            FMI / "directional.c", FMI / "directional.h", FMI / "model_cam.c"]
 
 
 def _pi_sources() -> List[Path]:

@@ -25,8 +25,8 @@ from xml.etree import ElementTree as ET
 
 from ..physics import parameters
 from ..physics.units import BASE_UNIT_ORDER, UNITS, display_unit
-from ..physics.variables import (EVENT_INDICATORS, FEEDTHROUGH, FEEDTHROUGH_INPUTS, INPUT_RANGES, INPUTS, OUTPUTS,
-                                 STATES)
+from ..physics.variables import (DEPENDENCIES, EVENT_INDICATORS, FEEDTHROUGH, FEEDTHROUGH_INPUTS, INPUT_RANGES,
+                                 INPUTS, OUTPUTS, STATES)
 
 
 def unit_definitions(units: List[str]) -> ET.Element:
@@ -251,18 +251,29 @@ def postprocess(xml_bytes: bytes, default_experiment: tuple, description: Option
     out_node = ET.SubElement(structure, "Outputs")
     feedthrough = " ".join(str(index_of[name]) for name in FEEDTHROUGH_INPUTS if name in index_of)
     for name in sorted(outputs, key=index_of.get):
-        ET.SubElement(out_node, "Unknown", index=str(index_of[name]),
-                      dependencies=feedthrough if name in FEEDTHROUGH and derivatives else "")
+        if derivatives:   # Model Exchange: the states and the input each output follows (variables.DEPENDENCIES)
+            _depends(out_node, name, index_of)
+        else:
+            ET.SubElement(out_node, "Unknown", index=str(index_of[name]),
+                          dependencies=feedthrough if name in FEEDTHROUGH and derivatives else "")
     if derivatives:
         der_node = ET.SubElement(structure, "Derivatives")
         for name in sorted(derivatives, key=index_of.get):
-            ET.SubElement(der_node, "Unknown", index=str(index_of[name]))
+            _depends(der_node, name, index_of)
     init_node = ET.SubElement(structure, "InitialUnknowns")
     for name in sorted(outputs + states + derivatives, key=index_of.get):
         ET.SubElement(init_node, "Unknown", index=str(index_of[name]))
 
     text = ET.tostring(root, encoding="UTF-8")
     return parseString(text).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+def _depends(parent: ET.Element, name: str, index_of: Dict[str, int]) -> None:
+    """An <Unknown> for ``name`` with its dependencies (variables.DEPENDENCIES: states and inputs, by index) and
+    dependenciesKind 'dependent' for each (the directional derivatives give the coefficients)."""
+    known = sorted(index_of[k] for k in DEPENDENCIES[name])
+    ET.SubElement(parent, "Unknown", index=str(index_of[name]), dependencies=" ".join(map(str, known)),
+                  dependenciesKind=" ".join("dependent" for _ in known))
 
 
 LOG_CATEGORIES = (
@@ -300,7 +311,7 @@ def skeleton(model_identifier: str, model_guid: str, rows: List[Dict[str, Any]],
         ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, needsExecutionTool="false",
                       completedIntegratorStepNotNeeded="false", canBeInstantiatedOnlyOncePerProcess="false",
                       canNotUseMemoryManagementFunctions="true", canGetAndSetFMUstate="true",
-                      canSerializeFMUstate="true", providesDirectionalDerivative="false")
+                      canSerializeFMUstate="true", providesDirectionalDerivative="true")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier, needsExecutionTool="false",
                   canHandleVariableCommunicationStepSize="true", canInterpolateInputs="false",
                   canBeInstantiatedOnlyOncePerProcess="false", canNotUseMemoryManagementFunctions="true",

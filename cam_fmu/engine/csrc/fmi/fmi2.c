@@ -329,16 +329,3 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
     return (fmi2Status)glue_deserialize(GLUE(c), (const unsigned char *)serializedState, size,
                                         (GlueSaved **)FMUstate, "fmi2DeSerializeFMUstate");
 }
-
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
-                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
-                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    size_t k;
-    (void)vUnknown_ref;
-    (void)vKnown_ref;
-    (void)nKnown;
-    (void)dvKnown;
-    if (dvUnknown) for (k = 0; k < nUnknown; k++) dvUnknown[k] = 0.0;
-    if (!instance(c)) return fmi2Error;
-    return (fmi2Status)glue_fail(GLUE(c), "fmi2GetDirectionalDerivative", "this FMU provides no directional derivatives");
-}

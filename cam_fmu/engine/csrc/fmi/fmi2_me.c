@@ -159,3 +159,26 @@ fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx) {
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx) {
     return read(c, MODEL_READ_NOMINALS, x_nominal, nx, "fmi2GetNominalsOfContinuousStates");
 }
+
+/* The derivatives of state derivatives and outputs (vUnknown_ref) along a seed of states and inputs (vKnown_ref,
+ * dvKnown), analytic in the engine (jacobian.c); Model Exchange only. A refusal zeroes nothing into a derivative's
+ * place silently: dvUnknown is zeroed and the call returns fmi2Error with the reason. */
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
+    const char *call = "fmi2GetDirectionalDerivative";
+    size_t k;
+    Glue *g;
+    if (dvUnknown) for (k = 0; k < nUnknown; k++) dvUnknown[k] = 0.0;
+    if (!instance(c)) return fmi2Error;
+    g = GLUE(c);
+    if (!allowed(g, READ_STATES, 1, call)) return fmi2Error;
+    if (g->model->exchange->directional == NULL)
+        return (fmi2Status)glue_fail(g, call, "this FMU provides no directional derivatives");
+    if (g->model->exchange->directional(g->m, vUnknown_ref, nUnknown, vKnown_ref, nKnown, dvKnown, dvUnknown)
+        != MODEL_OK) {
+        for (k = 0; dvUnknown && k < nUnknown; k++) dvUnknown[k] = 0.0;
+        return (fmi2Status)glue_fail(g, call, g->model->message(g->m));
+    }
+    return fmi2OK;
+}

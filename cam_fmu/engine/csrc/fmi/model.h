@@ -48,6 +48,10 @@ typedef struct {
     int (*save)(void *m, unsigned char *buffer, size_t size);
     size_t n_states;       /* the continuous states' count (FMI 3.0's fmi3GetNumberOfContinuousStates) */
     size_t n_indicators;   /* the event indicators' count (fmi3GetNumberOfEventIndicators) */
+    /* Directional derivatives at the host's state and inputs: dv_unknown = d(unknowns)/d(knowns) dv_known, each
+     * named by value reference (NULL: the model provides none). */
+    int (*directional)(void *m, const unsigned unknown[], size_t n_unknown, const unsigned known[], size_t n_known,
+                       const double dv_known[], double dv_unknown[]);
 } ModelExchangeOps;
 
 typedef struct {

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "exchange.h"
+#include "directional.h"
 #include "model.h"
 
 typedef struct {
@@ -193,9 +194,16 @@ static int me_save(void *m, unsigned char *buffer, size_t size)
     return status_of(cam_exchange_save(&((CamFmuModel *)m)->me, buffer, size));
 }
 
+static int me_directional(void *m, const unsigned unknown[], size_t n_unknown, const unsigned known[], size_t n_known,
+                          const double dv_known[], double dv_unknown[])
+{
+    return status_of(cam_exchange_directional(&((CamFmuModel *)m)->me, unknown, n_unknown, known, n_known, dv_known,
+                                              dv_unknown));
+}
+
 static const ModelExchangeOps EXCHANGE = {
     me_attach, me_attached, me_detach, me_sync, me_set_time, me_set_states, me_read, me_enter_event_mode,
-    me_event_update, me_enter_continuous, me_completed_step, me_save, CAM_ME_NX, CAM_EXCHANGE_NZ,
+    me_event_update, me_enter_continuous, me_completed_step, me_save, CAM_ME_NX, CAM_EXCHANGE_NZ, me_directional,
 };
 
 static const Model CAM = {

@@ -1,0 +1,265 @@
+"""cam.fmu's directional derivatives in Model Exchange (csrc/src/jacobian.c through fmi/directional.c): against
+central differences of the FMU's own derivatives and outputs at random states of every drive and mode, away from
+events; the ModelStructure's dependencies against a numerical sparsity probe; bad requests refused with the reason."""
+from __future__ import annotations
+
+import math
+from ctypes import POINTER, c_double
+
+import fmpy
+import numpy as np
+import pytest
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Model
+
+from cam_fmu.physics.variables import OUTPUTS, STATES
+
+NX = len(STATES)
+RTOL = 1e-6
+# (label, start values): every drive-train and mode the tangent covers; closure 'kinematic' keeps the follower on the
+# cam (a follower of its own is refused, test_follower_of_its_own_is_refused).
+CASES = {
+    "rigid": {"omega0": 20.0},
+    "rigid_L": {"omega0": 20.0, "L": 1e-3},
+    "no_guide_friction": {"omega0": 20.0, "guide_friction": 0.0},
+    "tilted": {"omega0": 20.0, "gamma": 1.2, "beta": 0.7, "mu": 0.05},
+    "compliant": {"omega0": 20.0, "k_shaft": 50.0, "d_shaft": 1e-3, "J_m": 3e-5, "J_cam": 1.41e-5},
+    "compliant_L": {"omega0": 20.0, "k_shaft": 50.0, "d_shaft": 1e-3, "J_m": 3e-5, "J_cam": 1.41e-5, "L": 1e-3},
+    "free_in_gap": {"omega0": 20.0, "c": 1e-3, "closure": "kinematic"},
+    "stuck": {"omega0": 0.0, "u": 0.0},
+    "stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3},
+}
+
+
+class Me:
+    """cam.fmu in continuous-time mode through fmpy's fmi2 API, with the calls the tests need."""
+
+    def __init__(self, fmu, start: dict) -> None:
+        md = fmpy.read_model_description(str(fmu))
+        self.md = md
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.kind = {v.name: v.type for v in md.modelVariables}
+        self.model = FMU2Model(guid=md.guid, unzipDirectory=fmpy.extract(str(fmu)), modelIdentifier="cam",
+                               instanceName="jac")
+        self.model.instantiate()
+        self.model.setupExperiment(startTime=0.0)
+        self.model.enterInitializationMode()
+        for name, value in start.items():
+            if isinstance(value, str):
+                self.model.setString([self.vr[name]], [value])
+            elif self.kind[name] == "Boolean":
+                self.model.setBoolean([self.vr[name]], [bool(value)])
+            else:
+                self.model.setReal([self.vr[name]], [value])
+        self.model.exitInitializationMode()
+        while self.model.newDiscreteStates()[0]:
+            pass
+        self.model.enterContinuousTimeMode()
+        self.states = [self.vr[row[0]] for row in STATES]
+        self.ders = [self.vr[f"der({row[0]})"] for row in STATES]
+        self.outputs = [self.vr[row[0]] for row in OUTPUTS]
+        self.knowns = self.states + [self.vr["u"]]
+
+    def x(self) -> np.ndarray:
+        values = np.zeros(NX)
+        self.model.getContinuousStates(values.ctypes.data_as(POINTER(c_double)), NX)
+        return values
+
+    def set_x(self, x: np.ndarray) -> None:
+        x = np.ascontiguousarray(x, dtype=float)
+        self.model.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), NX)
+
+    def f(self) -> np.ndarray:
+        """The state derivatives and the outputs at the FMU's state and inputs."""
+        dx = np.zeros(NX)
+        self.model.getDerivatives(dx.ctypes.data_as(POINTER(c_double)), NX)
+        return np.concatenate([dx, self.model.getReal(self.outputs)])
+
+    def knowns_now(self) -> np.ndarray:
+        return np.concatenate([self.x(), self.model.getReal([self.vr["u"]])])
+
+    def set_knowns(self, z: np.ndarray) -> None:
+        self.set_x(z[:NX])
+        self.model.setReal([self.vr["u"]], [float(z[NX])])
+
+    def jacobian(self) -> np.ndarray:
+        """The FMU's analytic Jacobian of (derivatives, outputs) by (states, u), one seed per known."""
+        unknowns = self.ders + self.outputs
+        cols = [self.model.getDirectionalDerivative(unknowns, [k], [1.0]) for k in self.knowns]
+        return np.array(cols).T
+
+    def central(self, rel: float) -> np.ndarray:
+        """Central differences of the FMU's own derivatives and outputs, step rel max(1, |z_j|) (x_gap's scale 1e-3)."""
+        z = self.knowns_now()
+        cols = []
+        for j in range(len(z)):
+            h = rel * max(1.0, abs(z[j])) * (1e-3 if j in (NX - 2, NX - 1) else 1.0)
+            plus, minus = z.copy(), z.copy()
+            plus[j] += h
+            minus[j] -= h
+            self.set_knowns(plus)
+            fp = self.f()
+            self.set_knowns(minus)
+            fm = self.f()
+            cols.append((fp - fm) / (2 * h))
+        self.set_knowns(z)
+        return np.array(cols).T
+
+    def close(self) -> None:
+        self.model.terminate()
+        self.model.freeInstance()
+
+
+def random_states(me: Me, rng: np.random.Generator, stuck: bool) -> None:
+    """A random state near the drive's own: any cam angle, speed 5..40 rad/s in the mode's direction (0 at rest),
+    current and twist of their scale."""
+    x = me.x()
+    x[0] = rng.uniform(0.0, 2 * math.pi)
+    x[1] = 0.0 if stuck else rng.uniform(5.0, 40.0)
+    x[2] = rng.uniform(0.05, 0.3)
+    x[3] = rng.uniform(-2e-4, 2e-4)
+    x[4] = x[1] + rng.uniform(-2.0, 2.0)
+    me.set_x(x)
+    me.model.setReal([me.vr["u"]], [rng.uniform(1.0, 5.0)])
+
+
+def smooth_differences(me: Me) -> np.ndarray | None:
+    """Central differences at two steps that agree (no breakpoint of the profile within them), else None."""
+    coarse, fine = me.central(1e-5), me.central(5e-6)
+    scale = np.maximum(np.abs(fine).max(axis=1, keepdims=True), 1e-300)
+    if np.all(np.abs(coarse - fine) <= 1e-8 * scale + 1e-8 * np.abs(fine)):
+        return fine
+    return None
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_directional_derivatives_match_central_differences(engine_fmu_path, case):
+    """At 4 random states per drive and mode, away from events and breakpoints, the analytic Jacobian of the state
+    derivatives and outputs by the states and u agrees with central differences of fmi2GetDerivatives / fmi2GetReal
+    to 1e-6 relative (of each row's largest entry)."""
+    rng = np.random.default_rng(42)
+    me = Me(engine_fmu_path, CASES[case])
+    stuck = CASES[case].get("omega0", 1.0) == 0.0
+    checked = 0
+    try:
+        for _ in range(40):
+            random_states(me, rng, stuck)
+            fd = smooth_differences(me)
+            if fd is None:
+                continue
+            analytic = me.jacobian()
+            scale = np.abs(fd).max(axis=1, keepdims=True)
+            err = np.abs(analytic - fd)
+            assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
+            assert np.abs(analytic).max() > 0.0
+            checked += 1
+            if checked == 4:
+                break
+    finally:
+        me.close()
+    assert checked == 4
+
+
+def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
+    """The <Derivatives>/<Outputs> dependencies of modelDescription.xml hold every state and input that central
+    differences of the FMU's derivatives and outputs move, over every case at random states; beyond the probe only the
+    entries of a follower of its own in flight (variables.DEPENDENCIES says why). fmpy's validation is clean and the FMU
+    says it provides directional derivatives."""
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(str(engine_fmu_path)) == []
+    md = fmpy.read_model_description(str(engine_fmu_path))
+    assert md.modelExchange.providesDirectionalDerivative
+    listed = {u.variable.name: {d.name for d in u.dependencies} for u in md.derivatives + md.outputs}
+    for u in md.derivatives + md.outputs:
+        assert u.dependenciesKind == ["dependent"] * len(u.dependencies)
+    rng = np.random.default_rng(7)
+    found: dict[str, set] = {name: set() for name in listed}
+    flight = {"x_gap", "x_gap_rate"}
+    for case, start in {**CASES, "spring": {"omega0": 20.0, "closure": "spring"}}.items():
+        me = Me(engine_fmu_path, start)
+        names = [f"der({row[0]})" for row in STATES] + [row[0] for row in OUTPUTS]
+        knowns = [row[0] for row in STATES] + ["u"]
+        for _ in range(3):
+            random_states(me, rng, start.get("omega0", 1.0) == 0.0)
+            fd = me.central(1e-6)
+            scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
+            for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
+                found[names[r]].add(knowns[c])
+        me.close()
+    for name in listed:
+        assert found[name] <= listed[name], (name, found[name] - listed[name])
+        unprobed = listed[name] if name.startswith("der(x_gap") else flight   # only in flight
+        assert listed[name] - found[name] <= unprobed, (name, listed[name] - found[name])
+
+
+def refusal(me: Me, unknowns: list, knowns: list, logged: list) -> str:
+    """The message of a refused fmi2GetDirectionalDerivative (fmi2Error), with the unknowns' values."""
+    with pytest.raises(FMICallException) as info:
+        me.model.getDirectionalDerivative(unknowns, knowns, [1.0] * len(knowns))
+    assert info.value.status == 3
+    return logged[-1]
+
+
+def logging_me(fmu, start: dict) -> tuple[Me, list]:
+    from fmpy.fmi2 import (calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                           fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
+
+    messages: list[str] = []
+    callbacks = fmi2CallbackFunctions()
+    callbacks.logger = fmi2CallbackLoggerTYPE(lambda _e, _n, _s, _c, text: messages.append(text.decode()))
+    callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+    callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    original = FMU2Model.instantiate
+    FMU2Model.instantiate = lambda self, **kw: original(self, callbacks=callbacks, **kw)
+    try:
+        me = Me(fmu, start)
+    finally:
+        FMU2Model.instantiate = original
+    me.callbacks = callbacks   # kept alive with the instance
+    return me, messages
+
+
+def test_bad_requests_are_errors_with_the_reason(engine_fmu_path):
+    """An unknown value reference, a parameter as a known, an output or state as an unknown of the wrong kind, and a
+    follower of its own: fmi2Error and the reason in the log, never a zero that looks like a derivative."""
+    me, logged = logging_me(engine_fmu_path, {"omega0": 20.0})
+    try:
+        der_omega, x_theta = me.vr["der(x_omega)"], me.vr["x_theta"]
+        assert "value reference 99999 ('no variable') is no known" in refusal(me, [der_omega], [99999], logged)
+        assert "('R') is no known (a continuous state or input)" in refusal(me, [der_omega], [me.vr["R"]], logged)
+        assert "('x_theta') is no unknown (a state derivative or output)" in refusal(me, [x_theta], [x_theta], logged)
+        assert "('u') is no unknown" in refusal(me, [me.vr["u"]], [x_theta], logged)
+        good = me.model.getDirectionalDerivative([der_omega], [me.vr["u"]], [1.0])[0]
+        assert good > 0.0   # more voltage, more acceleration: the same call answers once the request is right
+    finally:
+        me.close()
+    me, logged = logging_me(engine_fmu_path, {"omega0": 20.0, "closure": "spring"})
+    try:
+        assert "follower of its own" in refusal(me, [me.vr["der(x_omega)"]], [me.vr["x_theta"]], logged)
+    finally:
+        me.close()
+
+
+def test_outside_model_exchange_is_an_error(engine_fmu_path):
+    """Before initialisation and in a co-simulation instance the call is refused with the reason."""
+    md = fmpy.read_model_description(str(engine_fmu_path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    model = FMU2Model(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
+                      instanceName="early")
+    model.instantiate()
+    with pytest.raises(FMICallException):
+        model.getDirectionalDerivative([vr["der(x_omega)"]], [vr["x_theta"]], [1.0])
+    model.freeInstance()
+    from fmpy.fmi2 import FMU2Slave
+
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
+                      instanceName="cs")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    with pytest.raises(FMICallException):
+        slave.getDirectionalDerivative([vr["omega"]], [vr["u"]], [1.0])
+    slave.terminate()
+    slave.freeInstance()
