@@ -16,7 +16,7 @@ from typing import Any, Dict, List
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
-from ..physics.variables import EVENT_INDICATORS
+from ..physics.variables import DEPENDENCIES, EVENT_INDICATORS
 from .model_description import (LOG_CATEGORIES, experiment_element, type_definitions, typed_units, unit_attributes,
                                 unit_definitions)
 
@@ -47,7 +47,7 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
                       variableNamingConvention="flat")
     if model_exchange:  # beside co-simulation, one binary (csrc/fmi/fmi3_me.c over exchange.c)
         ET.SubElement(root, "ModelExchange", modelIdentifier=model_identifier, canGetAndSetFMUState="true",
-                      canSerializeFMUState="true", providesDirectionalDerivatives="false",
+                      canSerializeFMUState="true", providesDirectionalDerivatives="true",
                       providesAdjointDerivatives="false", needsCompletedIntegratorStep="true")
     ET.SubElement(root, "CoSimulation", modelIdentifier=model_identifier,
                   canHandleVariableCommunicationStepSize="true", canGetAndSetFMUState="true",
@@ -82,15 +82,30 @@ def model_description(model_identifier: str, token: str, rows: List[Dict[str, An
     outputs = [vr for vr, row in enumerate(rows) if row["causality"] == "output"]
     derivatives = [vr for vr, row in enumerate(rows) if row.get("derivative")]
     states = [vr_of[rows[vr]["derivative"]] for vr in derivatives]
+    # Model Exchange: each output and state derivative lists the states and inputs it depends on
+    # (variables.DEPENDENCIES, by value reference), as cam.fmu's FMI 2.0 <ModelStructure> does by index
     for vr in outputs:
-        ET.SubElement(structure, "Output", valueReference=str(vr))
+        _unknown(structure, "Output", vr, rows, vr_of, model_exchange)
     for vr in derivatives:
-        ET.SubElement(structure, "ContinuousStateDerivative", valueReference=str(vr))
+        _unknown(structure, "ContinuousStateDerivative", vr, rows, vr_of, model_exchange)
     for vr in sorted(outputs + states + derivatives):
         ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
     for vr in indicator_vrs:
         ET.SubElement(structure, "EventIndicator", valueReference=str(vr))
     return parseString(ET.tostring(root, encoding="UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+def _unknown(structure: ET.Element, kind: str, vr: int, rows: List[Dict[str, Any]], vr_of: Dict[str, int],
+             model_exchange: bool) -> None:
+    """An <Output> or <ContinuousStateDerivative> of ``vr``; under Model Exchange with the value references it
+    depends on (variables.DEPENDENCIES) and dependenciesKind 'dependent' for each (the directional derivatives
+    give the coefficients)."""
+    element = ET.SubElement(structure, kind, valueReference=str(vr))
+    name = rows[vr]["name"]
+    if model_exchange and name in DEPENDENCIES:
+        known = sorted(vr_of[k] for k in DEPENDENCIES[name])
+        element.set("dependencies", " ".join(map(str, known)))
+        element.set("dependenciesKind", " ".join("dependent" for _ in known))
 
 
 def _variable(vr: int, row: Dict[str, Any]) -> ET.Element:

@@ -81,7 +81,7 @@ FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # fmi2GetDirectionalDerivative: the states and the inputs; omega_ref and omega_dot_ref drive no Model Exchange run),
 # the union over every drive-train, effect and mode. Probed numerically by tests/fmu_me/test_directional_me.py (central
 # differences of the FMU's derivatives and outputs); the entries of x_gap and x_gap_rate are a follower of its own in
-# flight (voltage_follower_me.c: der(x_gap) = x_gap_rate, the relative acceleration from the follower's and the
+# flight (voltage_follower_events.c: der(x_gap) = x_gap_rate, the relative acceleration from the follower's and the
 # cam's motion), where the probe cannot put the mode.
 _ALL = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "x_gap", "x_gap_rate", "u")
 _CAM = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "u")

@@ -394,18 +394,12 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance c, const fmi3Byte serializedStat
 
 /* ------------------------------------------------------------------ what the FMU does not provide */
 
-/* Derivatives the FMU does not provide: the sensitivities 0, then the refusal. */
+/* Adjoint derivatives, which the FMU does not provide: the sensitivities 0, then the refusal (the directional
+ * derivatives are Model Exchange's: fmi3_me.c). */
 static fmi3Status no_derivatives(fmi3Instance c, const char *call, fmi3Float64 sensitivity[], size_t n) {
     size_t k;
     if (sensitivity) for (k = 0; k < n; k++) sensitivity[k] = 0.0;
-    return unsupported(c, call, "this FMU provides no directional or adjoint derivatives");
-}
-
-fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
-                                        const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
-                                        size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
-    (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed; (void)nSeed;
-    return no_derivatives(c, "fmi3GetDirectionalDerivative", sensitivity, nSensitivity);
+    return unsupported(c, call, "this FMU provides no adjoint derivatives");
 }
 
 fmi3Status fmi3GetAdjointDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,

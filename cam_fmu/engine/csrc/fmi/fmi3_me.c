@@ -226,3 +226,40 @@ int fmi3_me_indicator(Glue *g, size_t k, fmi3Float64 *value, const char *call) {
     *value = z[k];
     return GLUE_OK;
 }
+
+/* The derivatives of state derivatives and outputs (unknowns) along a seed of states and inputs (knowns), analytic
+ * in the engine (jacobian.c) as fmi2GetDirectionalDerivative's: a Model Exchange instance, initialised, scalar
+ * variables (nSeed = nKnowns, nSensitivity = nUnknowns). A refusal leaves the sensitivities 0 and returns Error
+ * with the reason, never a 0 in a derivative's place with OK. */
+typedef char value_reference_is_unsigned[sizeof(fmi3ValueReference) == sizeof(unsigned) ? 1 : -1];
+
+fmi3Status fmi3GetDirectionalDerivative(fmi3Instance c, const fmi3ValueReference unknowns[], size_t nUnknowns,
+                                        const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+                                        size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    const char *call = "fmi3GetDirectionalDerivative";
+    char text[160];
+    size_t k;
+    Glue *g;
+    if (sensitivity) for (k = 0; k < nSensitivity; k++) sensitivity[k] = 0.0;
+    if (!instance(c)) return fmi3Error;
+    g = GLUE(c);
+    if (!allowed(g, READ_STATES, 1, call)) return fmi3Error;
+    if (nSeed != nKnowns || nSensitivity != nUnknowns) {
+        snprintf(text, sizeof text, "nSeed (%lu) must equal nKnowns (%lu) and nSensitivity (%lu) nUnknowns (%lu): "
+                 "every variable here is a scalar", (unsigned long)nSeed, (unsigned long)nKnowns,
+                 (unsigned long)nSensitivity, (unsigned long)nUnknowns);
+        glue_fail(g, call, text);
+        return fmi3Error;
+    }
+    if (g->model->exchange->directional == NULL) {
+        glue_fail(g, call, "this FMU provides no directional derivatives");
+        return fmi3Error;
+    }
+    if (g->model->exchange->directional(g->m, (const unsigned *)unknowns, nUnknowns, (const unsigned *)knowns,
+                                        nKnowns, seed, sensitivity) != MODEL_OK) {
+        for (k = 0; sensitivity && k < nSensitivity; k++) sensitivity[k] = 0.0;
+        glue_fail(g, call, g->model->message(g->m));
+        return fmi3Error;
+    }
+    return fmi3OK;
+}
