@@ -24,8 +24,10 @@ def test_cam_fmu_shows_speeds_in_rpm_angles_in_degrees_and_lengths_in_mm(cam_fmu
     assert "v" not in shown and "i" not in shown and "M" not in shown  # SI where SI reads well
 
 
-def test_fmpy_reads_the_display_units_and_their_factors(cam_fmu_path):
-    md = read_model_description(str(cam_fmu_path), validate=True)
+@pytest.mark.parametrize("fmu", ["cam_fmu_path", "cam3_fmu_path"])
+def test_fmpy_reads_the_display_units_and_their_factors(request, fmu):
+    """cam.fmu (FMI 2.0) and cam3.fmu (FMI 3.0) alike, as fmpy reads them."""
+    md = read_model_description(str(request.getfixturevalue(fmu)), validate=True)
     factors = {(u.name, d.name): d.factor for u in md.unitDefinitions for d in u.displayUnits}
     variables = {v.name: v for v in md.modelVariables}
     for name, display, closed in (("omega", "rpm", 60.0 / (2.0 * math.pi)), ("theta", "deg", 180.0 / math.pi),
