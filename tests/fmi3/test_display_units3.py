@@ -3,7 +3,6 @@ unit and displayUnit): read back from the built FMU, checked against the closed 
 the FMI 3.0 XSD and fmpy's validation; the same units as cam.fmu's."""
 from __future__ import annotations
 
-
 from fmpy.validation import validate_fmu
 
 from display_units import check_display_units, model_description, schema_problems
