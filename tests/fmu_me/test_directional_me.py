@@ -201,15 +201,22 @@ def refusal(me: Me, unknowns: list, knowns: list, logged: list) -> str:
     return logged[-1]
 
 
-def logging_me(fmu, start: dict) -> tuple[Me, list]:
+def collecting_callbacks(messages: list):
+    """fmi2 callbacks of this test's own that collect the log: fmpy's defaultCallbacks call freed memory once an
+    earlier test in the process ran simulate_fmu with a logger (tests/fmu_cs/test_fmu_interface.py)."""
     from fmpy.fmi2 import (calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
                            fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
 
-    messages: list[str] = []
     callbacks = fmi2CallbackFunctions()
     callbacks.logger = fmi2CallbackLoggerTYPE(lambda _e, _n, _s, _c, text: messages.append(text.decode()))
     callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
     callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+    return callbacks
+
+
+def logging_me(fmu, start: dict) -> tuple[Me, list]:
+    messages: list[str] = []
+    callbacks = collecting_callbacks(messages)
     original = FMU2Model.instantiate
     FMU2Model.instantiate = lambda self, **kw: original(self, callbacks=callbacks, **kw)
     try:
@@ -247,19 +254,23 @@ def test_outside_model_exchange_is_an_error(engine_fmu_path):
     vr = {v.name: v.valueReference for v in md.modelVariables}
     model = FMU2Model(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
                       instanceName="early")
-    model.instantiate()
+    messages: list[str] = []
+    callbacks = collecting_callbacks(messages)
+    model.instantiate(callbacks=callbacks)
     with pytest.raises(FMICallException):
         model.getDirectionalDerivative([vr["der(x_omega)"]], [vr["x_theta"]], [1.0])
+    assert any(text.startswith("fmi2GetDirectionalDerivative: ") for text in messages)
     model.freeInstance()
     from fmpy.fmi2 import FMU2Slave
 
     slave = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(str(engine_fmu_path)), modelIdentifier="cam",
                       instanceName="cs")
-    slave.instantiate()
+    slave.instantiate(callbacks=callbacks)
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
     slave.exitInitializationMode()
     with pytest.raises(FMICallException):
         slave.getDirectionalDerivative([vr["omega"]], [vr["u"]], [1.0])
+    assert "co-simulation" in messages[-1]
     slave.terminate()
     slave.freeInstance()
