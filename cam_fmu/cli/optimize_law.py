@@ -41,34 +41,28 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def _jerk(text: str | None, default: float) -> float | None:
-    if text is None:
-        return default
-    if text.strip().lower() == "none":
+def _bound(part: str, refusal: str) -> float | None:
+    """A jerk bound: a number > 0, or None for 'none' (unbounded); ValueError(refusal) otherwise."""
+    if part.strip().lower() == "none":
         return None
     try:
-        value = float(text)
+        value = float(part)
     except ValueError:
-        raise ValueError(f"--max-cj {text!r}: allowed a number > 0 or none") from None
+        raise ValueError(refusal) from None
     if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"--max-cj {text!r}: allowed a number > 0 or none")
+        raise ValueError(refusal)
     return value
 
 
+def _jerk(text: str | None, default: float) -> float | None:
+    if text is None:
+        return default
+    return _bound(text, f"--max-cj {text!r}: allowed a number > 0 or none")
+
+
 def _front_bounds(text: str) -> list[float | None]:
-    out: list[float | None] = []
-    for part in (p.strip() for p in text.split(",") if p.strip()):
-        if part.lower() == "none":
-            out.append(None)
-            continue
-        try:
-            value = float(part)
-        except ValueError:
-            raise ValueError(f"--front {text!r}: allowed jerk bounds > 0 (or none), comma-separated") from None
-        if not (math.isfinite(value) and value > 0.0):
-            raise ValueError(f"--front {text!r}: allowed jerk bounds > 0 (or none), comma-separated")
-        out.append(value)
-    return out
+    refusal = f"--front {text!r}: allowed jerk bounds > 0 (or none), comma-separated"
+    return [_bound(part, refusal) for part in (p.strip() for p in text.split(",")) if part]
 
 
 def law_toml(scene_name: str, T, worst: float, band, max_ca, max_cj) -> str:
