@@ -78,13 +78,13 @@ int cam_exchange_attach(CamExchange *e)
     if (d->model.formulation == CAM_FORM_PAPER)
         return fail(e, CAM_ERR_PARAMETER, "formulation 'paper' is the paper's fixed-step discrete algorithm: it "
                     "defines the state at the points of its own step, no derivatives a host's solver could "
-                    "integrate, so it runs in co-simulation only (fmi2CoSimulation); in Model Exchange use "
+                    "integrate, so it runs in co-simulation only; in Model Exchange use "
                     "formulation 'consistent' (the default)");
     if (d->model.formulation == CAM_FORM_SPEED)
         return fail(e, CAM_ERR_PARAMETER, "drive 'speed' imposes omega from the input omega_ref and moves the "
                     "follower through a play operator (memory in the gap, a jump to the rest position at "
                     "standstill): no ODE for a host's solver, and co-simulation computes it exactly, so it runs "
-                    "in co-simulation only (fmi2CoSimulation); in Model Exchange use drive 'voltage'");
+                    "in co-simulation only; in Model Exchange use drive 'voltage'");
     e->drive = d;
     d->solver.k1_valid = 0;   /* outputs compute omega_dot at the host's state, never a solver's stage */
     cam_exchange_sync(e);
@@ -362,11 +362,11 @@ int cam_exchange_completed_step(CamExchange *e, int *enter_event)
         if (e->requested || k < 0) {
             if (verdict == CAM_PUBLISH_CLEARANCE)
                 return fail(e, CAM_ERR_SIMULATION, "the follower is %.6g m from the cam at t = %g s, beyond the "
-                            "clearance c = %g m: a contact event was not handled (fmi2CompletedIntegratorStep asked "
-                            "for event mode and the host went on integrating)", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]),
+                            "clearance c = %g m: a contact event was not handled (the completed "
+                            "integrator step asked for event mode and the host went on integrating)", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]),
                             d->time, d->model.c);
             return fail(e, CAM_ERR_SIMULATION, "event '%s' is due since the last step before t = %g s and the host "
-                        "went on integrating without event mode (fmi2CompletedIntegratorStep asked for it): the "
+                        "went on integrating without event mode (the completed integrator step asked for it): the "
                         "drive's mode is wrong from there", cam_exchange_event_name(codes[k]), d->time);
         }
         e->requested = 1;   /* the event the host's solver stepped over: handled at the next event mode */
