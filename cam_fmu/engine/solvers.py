@@ -24,6 +24,7 @@ SOLVERS: dict[str, Solver] = {s.name: s for s in (
     Solver("rk4", False, 1e-2),        # 6e-5 measured at 100 V
     Solver("rk45", True, float("inf")),
     Solver("etdrk4", False, 1e-2),     # 2.5e-4 measured at 400 V
+    Solver("rk23", True, float("inf")),
 )}
 assert tuple(SOLVERS) == SOLVER_NAMES, "one entry per choice of the parameter 'solver'"
 

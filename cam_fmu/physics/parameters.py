@@ -102,7 +102,7 @@ LAW_CHOICES = (*PRESETS, "custom")  # derived from the one preset table
 # Checked against the registries (physics.formulations.FORMULATIONS, solvers.SOLVERS) by tests/tools/test_layout.py.
 FORMULATIONS = ("consistent", "paper")
 DRIVES = ("voltage", "speed")
-SOLVERS = ("euler", "rk4", "rk45", "etdrk4")
+SOLVERS = ("euler", "rk4", "rk45", "etdrk4", "rk23")
 # The choices that model a rigid drive-train only: k_shaft > 0 with one of them is refused, with the reason and
 # what to use instead (docs/model.md section 12.1).
 RIGID_ONLY: dict[tuple[str, str], tuple[str, str]] = {
@@ -159,7 +159,7 @@ _MODE = (
 )
 
 _SOLVER = (
-    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole); not used by the speed drive; each runs a follower of its own in the voltage drive too (docs/model.md 13.6)", kind="string", choices=SOLVERS),
+    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole), 'rk23' (adaptive Bogacki-Shampine 3(2): half rk45's stages a step, for loose tolerances); not used by the speed drive; each runs a follower of its own in the voltage drive too (docs/model.md 13.6)", kind="string", choices=SOLVERS),
     _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; not used by the speed drive, "
        "which takes its own steps, docs/model.md 13.4)",
        low=1e-9, high=10.0),

@@ -3,6 +3,7 @@
     python -m cam_fmu.tools.baseline --write    # record (the engine of this checkout)
     python -m cam_fmu.tools.baseline --check    # replay and compare; prints the largest difference
     python -m cam_fmu.tools.baseline --rerecord WHY [--keep NAME=VALUE] [--only CASE ...]   # only the moved cases
+    python -m cam_fmu.tools.baseline --add WHY        # record only the cases not recorded yet (a new solver)
 
 Engine-agnostic: a case runs through the public in-process API only,
 ``DriveSimulator(params)``, ``set_inputs``, ``do_step(t, h, u, omega_ref, omega_dot_ref)``
@@ -311,13 +312,40 @@ def rerecord(why: str, directory: Path = RECORD_DIR, keep: dict[str, Any] | None
         data.setdefault("re_recorded", []).append({"commit": commit, "why": why, "cases": moved})
         if keep:
             data["re_recorded"][-1]["kept_as"] = tag.strip()
-        path = directory / f"{stem}.json"
-        rows = ",\n".join(json.dumps(case, separators=(",", ":")) for case in data["cases"])
-        path.write_text(f'{{"recorded_with":{json.dumps(data["recorded_with"])},\n'
-                        f'"re_recorded":{json.dumps(data["re_recorded"])},\n"cases":[\n{rows}]}}\n')
+        path = save(directory, stem, data)
         print(f"{path}: {len(moved)} case(s) re-recorded: {', '.join(moved)}", flush=True)
         moved_all += moved
     return moved_all
+
+
+def save(directory: Path, stem: str, data: dict[str, Any]) -> Path:
+    """One group's file: its provenance, its re-recorded and added lists, a case per line."""
+    path = directory / f"{stem}.json"
+    rows = ",\n".join(json.dumps(case, separators=(",", ":")) for case in data["cases"])
+    lists = "".join(f'"{key}":{json.dumps(data[key])},\n' for key in ("re_recorded", "added") if key in data)
+    path.write_text(f'{{"recorded_with":{json.dumps(data["recorded_with"])},\n{lists}"cases":[\n{rows}]}}\n')
+    return path
+
+
+def add(why: str, directory: Path = RECORD_DIR) -> list[str]:
+    """Record the cases that are new (a new solver or scene run: in ``groups()`` but not in the files), naming them
+    with ``why`` and the commit in their file's "added" list; every recorded case keeps its record. Returns their
+    names."""
+    recorded = load(directory)
+    commit = provenance()["commit"]
+    added_all: list[str] = []
+    for stem, cases in groups():
+        data = recorded[stem]
+        known = {case["name"] for case in data["cases"]}
+        new = [dict(case, result=replay(case)) for case in cases if case["name"] not in known]
+        if not new:
+            continue
+        data["cases"] += new
+        data.setdefault("added", []).append({"commit": commit, "why": why, "cases": [c["name"] for c in new]})
+        path = save(directory, stem, data)
+        print(f"{path}: {len(new)} case(s) added", flush=True)
+        added_all += [c["name"] for c in new]
+    return added_all
 
 
 def check(directory: Path = RECORD_DIR) -> int:
@@ -340,6 +368,7 @@ def main(argv: list[str] | None = None) -> int:
     what.add_argument("--write", action="store_true", help=f"record the baseline into {RECORD_DIR}")
     what.add_argument("--check", action="store_true", help="replay the recorded cases and compare")
     what.add_argument("--rerecord", metavar="WHY", help="re-record only the cases that moved, naming them with WHY")
+    what.add_argument("--add", metavar="WHY", help="record only the cases not recorded yet (a new solver, a new run)")
     parser.add_argument("--keep", action="append", default=[], metavar="NAME=VALUE",
                         help="with --rerecord: keep each moved case's record beside it under this parameter "
                              "(repeatable; e.g. closure=kinematic when a default moved)")
@@ -353,6 +382,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.rerecord:
         keep = dict(item.split("=", 1) for item in args.keep)
         rerecord(args.rerecord, args.dir, keep, args.only)
+        return 0
+    if args.add:
+        add(args.add, args.dir)
         return 0
     return check(args.dir)
 

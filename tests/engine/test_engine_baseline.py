@@ -20,6 +20,8 @@ from cam_fmu.tools import baseline
 
 RECORDED = baseline.load()
 CASES = [case for data in RECORDED.values() for case in data["cases"]]
+# cases recorded later than the rest (`baseline --add`: a new solver's runs), with every output of their day
+LATER = {name for data in RECORDED.values() for entry in data.get("added", []) for name in entry["cases"]}
 
 
 def _off_the_paper_grid(case) -> bool:
@@ -41,7 +43,7 @@ def _as_fixed(case, now) -> dict | None:
     Everything else is held to the record unchanged."""
     recorded = copy.deepcopy(case["result"])
     p = resolve(case["params"])
-    if p["drive"] == "voltage" and p["formulation"] == "paper":
+    if p["drive"] == "voltage" and p["formulation"] == "paper" and case["name"] not in LATER:
         if _off_the_paper_grid(case):
             error = now["error"]
             assert error and error["class"] == "StepRejected" and error["step"] == 1, error
@@ -103,12 +105,13 @@ def test_every_shipped_scene_is_recorded_with_every_solver_and_formulation():
         for case in cases:
             assert (case["comm_step"], case["stop_time"]) == (scene.output_interval, scene.stop_time)
             steps = case["result"]["steps"]
+            names = set(OUTPUT_NAMES) - (set() if case["name"] in LATER else ADDED_OUTPUTS)
             if case["result"]["error"] is None:
                 assert len(steps) > baseline.SAMPLES and steps[-1] == n, case["name"]
-                assert set(case["result"]["final"]) == set(OUTPUT_NAMES) - ADDED_OUTPUTS
+                assert set(case["result"]["final"]) == names
             elif case["result"]["error"]["step"] == 0:  # refused when the drive is built: no outputs
                 assert steps == [] and case["result"]["final"] == {}, case["name"]
-            assert set(case["result"]["outputs"]) == set(OUTPUT_NAMES) - ADDED_OUTPUTS
+            assert set(case["result"]["outputs"]) == names
 
 
 # Outputs added after the record was made (the compliant shaft, docs/model.md section 12): every recorded

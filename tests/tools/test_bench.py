@@ -23,7 +23,7 @@ COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "defaul
            "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
            "floor_us_per_step", "cost_ratio", "repeats", "pareto", "error")
 QUICK_FMU_ROWS = {("euler", "h=0.001"), ("rk4", "h=0.001"), ("etdrk4", "h=0.001"),
-                  ("rk45", "rtol=1e-06"), ("rk45", "rtol=1e-10")}
+                  ("rk45", "rtol=1e-06"), ("rk45", "rtol=1e-10"), ("rk23", "rtol=1e-06")}
 
 
 @pytest.fixture(scope="module")

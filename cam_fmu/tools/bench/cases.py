@@ -14,6 +14,9 @@ from ...engine.solvers import SOLVERS
 SOLVER_KEYS = ("solver", "h_max", "rtol", "atol", "max_steps")
 FIXED_STEP_H = (1e-3, 2.5e-4, 1e-4)  # s, h_max of euler, rk4, etdrk4
 RK45_RTOL = (1e-6, 1e-7, 1e-8, 1e-9, 1e-10)  # atol = rtol / 100 (1e-10 is the default)
+# each adaptive solver's rtol grid: rk23 (third order) is for loose tolerances, where it is cheaper than rk45
+ADAPTIVE_RTOL = {"rk45": RK45_RTOL, "rk23": (1e-5, 1e-6, 1e-7, 1e-8)}
+ADAPTIVE_RTOL_QUICK = {"rk45": (1e-6, 1e-10), "rk23": (1e-6,)}
 COMM_STEPS = (1e-4, 1e-3, 1e-2)  # s
 CASES = ("fig6", "backlash", "inductance", "groove_voltage", "spring_voltage")   # the last two: followers of their own
 LEVELS = (1e-3, 1e-6, 1e-8)  # rad: accuracy levels of the choice table
@@ -70,20 +73,21 @@ def settings_grid(comm_step: float, quick: bool) -> list[Setting]:
     """Solver settings run at one communication step (fixed-step h_max capped at the step, deduplicated).
 
     The solvers come from the registry: every fixed-step solver over FIXED_STEP_H, every
-    adaptive one over RK45_RTOL (atol = rtol / 100).
+    adaptive one over its ADAPTIVE_RTOL (atol = rtol / 100).
     """
     h_default = defaults()["h_max"]
     fixed = [name for name, cls in SOLVERS.items() if not cls.adaptive]
     adaptive = [name for name, cls in SOLVERS.items() if cls.adaptive]
     if quick:
         return ([Setting(solver, min(1e-3, comm_step), 1e-10, 1e-12) for solver in fixed]
-                + [Setting(solver, h_default, rtol, rtol / 100.0) for solver in adaptive for rtol in (1e-6, 1e-10)])
+                + [Setting(solver, h_default, rtol, rtol / 100.0) for solver in adaptive
+                   for rtol in ADAPTIVE_RTOL_QUICK[solver]])
     grid: list[Setting] = []
     for solver in fixed:
         for h in sorted({min(h, comm_step) for h in FIXED_STEP_H}, reverse=True):
             grid.append(Setting(solver, h, 1e-10, 1e-12))
     for solver in adaptive:
-        for rtol in RK45_RTOL:
+        for rtol in ADAPTIVE_RTOL[solver]:
             grid.append(Setting(solver, h_default, rtol, rtol / 100.0))
     return grid
 

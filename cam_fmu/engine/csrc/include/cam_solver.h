@@ -69,6 +69,7 @@ const CamMethod *cam_method(int solver_choice);
 
 /* The tableaus: const data (no mutable state), in rk.c. */
 extern const CamTableau cam_dopri5;   /* Dormand-Prince 5(4), FSAL, embedded error */
+extern const CamTableau cam_bs23;     /* Bogacki-Shampine 3(2), FSAL, embedded error */
 extern const CamTableau cam_rk4;      /* the classical Runge-Kutta method, order 4 */
 extern const CamTableau cam_euler;    /* explicit Euler, order 1 */
 

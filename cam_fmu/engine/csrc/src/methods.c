@@ -10,6 +10,10 @@
  * step is 1e-12 of the communication step; theta's error is scaled by at most 2 pi. */
 static const CamMethod RK45 = {"rk45", &cam_dopri5, cam_rk_step, 1, HUGE_VAL, HUGE_VAL, HUGE_VAL, 0};
 
+/* Adaptive Bogacki-Shampine 3(2) with error control (rtol, atol): half the stages of rk45 per step, for
+ * loose tolerances. */
+static const CamMethod RK23 = {"rk23", &cam_bs23, cam_rk_step, 1, HUGE_VAL, HUGE_VAL, HUGE_VAL, 0};
+
 /* Explicit Euler: no resolution sub-steps (measured on fig. 6, sub-stepping euler to the profile's
  * features made its error larger, 0.59 rad against 0.053 rad at h_max 1 ms); instead a step that sweeps
  * more than a quarter of the finest feature is refused, naming h_max (it was 41 rad of 68 off at 100 V). */
@@ -30,6 +34,8 @@ const CamMethod *cam_method(int solver_choice)
         return &RK4;
     case CAM_CHOICE_SOLVER_RK45:
         return &RK45;
+    case CAM_CHOICE_SOLVER_RK23:
+        return &RK23;
     case CAM_CHOICE_SOLVER_ETDRK4:
         return &ETDRK4;
     default:

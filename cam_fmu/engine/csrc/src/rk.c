@@ -26,6 +26,18 @@ const CamTableau cam_dopri5 = {
     0.0,
 };
 
+/* Bogacki-Shampine 3(2), FSAL, embedded error: 3 new stages per step where dopri5 takes 6. */
+const CamTableau cam_bs23 = {
+    3,
+    {{0.0}, {1.0 / 2.0}, {0.0, 3.0 / 4.0}},
+    {2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0},
+    {0.0, 1.0 / 2.0, 3.0 / 4.0},
+    1,
+    {-5.0 / 72.0, 1.0 / 12.0, 1.0 / 9.0, -1.0 / 8.0},
+    -1.0 / 3.0,
+    0.0,
+};
+
 /* The classical Runge-Kutta method: x + (h / 6) (k1 + 2 k2 + 2 k3 + k4), in that order. */
 const CamTableau cam_rk4 = {
     4,
