@@ -17,17 +17,15 @@ int cam_exchange_directional(CamExchange *e, const unsigned unknown[], size_t n_
                              size_t n_known, const double dv_known[], double dv_unknown[])
 {
     CamDrive *d = e->drive;
-    double x[CAM_ME_NX], seed[CAM_NX] = {0.0}, du = 0.0, ddx[CAM_NX], dout[CAM_N_OUTPUTS];
+    double x[CAM_ME_NX], seed[CAM_ME_NX] = {0.0}, du = 0.0, ddx[CAM_ME_NX], dout[CAM_N_OUTPUTS];
     size_t k;
-    int status;
     if ((n_known > 0 && (known == NULL || dv_known == NULL)) || (n_unknown > 0 && (unknown == NULL || dv_unknown == NULL)))
         return cam_error(cam_instance_error(e->instance), CAM_ERR_SIMULATION,
                          "directional derivative: the arrays must not be NULL");
     for (k = 0; k < n_known; k++) {
         unsigned vr = known[k];
         if (vr >= CAM_VR_STATES && vr < CAM_VR_STATES + CAM_ME_NX) {
-            if (vr - CAM_VR_STATES < CAM_NX)
-                seed[vr - CAM_VR_STATES] += dv_known[k];   /* a free follower's slots: held, derivative 0 */
+            seed[vr - CAM_VR_STATES] += dv_known[k];
         } else if (vr == CAM_VR_INPUTS + CAM_I_U) {
             du += dv_known[k];
         } else if (vr - (unsigned)CAM_VR_INPUTS >= (unsigned)CAM_N_INPUTS) {   /* omega_ref, omega_dot_ref:
@@ -39,21 +37,15 @@ int cam_exchange_directional(CamExchange *e, const unsigned unknown[], size_t n_
         if (!(unknown[k] >= CAM_VR_DERIVATIVES && unknown[k] < CAM_VR_DERIVATIVES + CAM_ME_NX)
             && !(unknown[k] >= CAM_VR_OUTPUTS && unknown[k] < CAM_VR_OUTPUTS + CAM_N_OUTPUTS))
             return refuse(e, "unknown (a state derivative or output)", unknown[k]);
-    if (d->form == &cam_voltage_follower)
-        return cam_error(cam_instance_error(e->instance), CAM_ERR_SIMULATION, "directional derivatives of a follower "
-                         "of its own (closure 'spring', or 'form' with c > 0) are not implemented: use a host that "
-                         "differences the model");
     cam_exchange_sync(e);
     cam_drive_me_states(d, x);
-    if ((status = cam_tangent(&d->model, &d->mode, x, d->form_u, seed, du, ddx, dout, cam_instance_error(e->instance)))
-        != CAM_OK)
-        return status;
+    cam_drive_me_tangent(d, x, seed, du, ddx, dout);
     for (k = 0; k < n_unknown; k++) {
         unsigned vr = unknown[k];
         if (vr >= CAM_VR_OUTPUTS && vr < CAM_VR_OUTPUTS + CAM_N_OUTPUTS)
             dv_unknown[k] = dout[vr - CAM_VR_OUTPUTS];
-        else   /* the held slots (a rigid shaft's, a free follower's) have derivative 0 at every state */
-            dv_unknown[k] = vr - CAM_VR_DERIVATIVES < (unsigned)d->model.slots ? ddx[vr - CAM_VR_DERIVATIVES] : 0.0;
+        else   /* the held slots (a rigid shaft's, a follower's gap on the flank) have 0 */
+            dv_unknown[k] = ddx[vr - CAM_VR_DERIVATIVES];
     }
     return CAM_OK;
 }

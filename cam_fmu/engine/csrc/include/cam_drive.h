@@ -48,6 +48,9 @@ typedef struct CamExchangeHooks {
     int (*codes)(const struct CamDrive *d, int *codes);
     double (*event)(const struct CamDrive *d, int code, const double *x);
     int (*event_update)(struct CamDrive *d, int code, CamError *err);
+    /* the tangent of rates and of the outputs along seed and du (directional derivatives) */
+    void (*tangent)(const struct CamDrive *d, const double *x, const double *seed, double du, double *ddx,
+                    double *dout);
 } CamExchangeHooks;
 
 /* The formulation of a model (formulations.c; the consistent one with a follower of its own: the voltage
@@ -158,6 +161,10 @@ void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
 /* The derivatives at x under the input d->form_u (the drive's mode and contact). */
 void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+/* The tangent of cam_drive_me_rates (ddx, the held slots' 0) and of the outputs (dout[CAM_N_OUTPUTS]) at x along
+ * seed (state units) and du [V], in the drive's mode: analytic, no differencing. */
+void cam_drive_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
+                          double ddx[CAM_ME_NX], double dout[]);
 
 /* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */
 int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err);

@@ -57,6 +57,12 @@ void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
+/* y of the follower from Model Exchange's x (the follower on its flank, or its gap and rate in flight). */
+void cam_vf_me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY]);
+/* The tangent of cam_vf_me_rates and of the outputs at x along seed[CAM_ME_NX] and du, in the drive's mode
+ * (jacobian_follower.c). */
+void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
+                       double ddx[CAM_ME_NX], double dout[]);
 extern const CamExchangeHooks cam_vf_exchange;
 
 #endif

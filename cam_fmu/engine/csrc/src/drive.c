@@ -209,3 +209,16 @@ void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[
     for (k = d->model.slots; k < CAM_ME_NX; k++)
         dx[k] = 0.0;
 }
+
+void cam_drive_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
+                          double ddx[CAM_ME_NX], double dout[])
+{
+    int k;
+    if (d->form->exchange != NULL) {
+        d->form->exchange->tangent(d, x, seed, du, ddx, dout);
+        return;
+    }
+    cam_tangent(&d->model, &d->mode, x, d->form_u, seed, du, ddx, dout, NULL);
+    for (k = d->model.slots; k < CAM_ME_NX; k++)   /* the held slots (a rigid shaft's, the follower's gap) */
+        ddx[k] = 0.0;
+}

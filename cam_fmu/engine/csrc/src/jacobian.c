@@ -3,7 +3,7 @@
  * seed of the states and the input u, at a fixed mode. Exact to rounding, no differencing; the FMI 2.0 Model
  * Exchange glue forwards fmi2GetDirectionalDerivative here (fmi/directional.c; docs/fmu.md, "Model Exchange").
  * Every mode of the drive whose cam carries the follower (rigid or compliant, L = 0 or L > 0, engaged with or without
- * guide friction, free in the clearance, stuck); a follower of its own is voltage_follower.c's and refused there. */
+ * guide friction, free in the clearance, stuck); a follower of its own: jacobian_follower.c. */
 #include <math.h>
 
 #include "cam_model.h"
@@ -32,35 +32,45 @@ static double friction_tangent(const CamModel *m, double n0, double dn0, double 
     return f;
 }
 
-/* The tangent of omega_dot [rad/s3 per seed] at (theta, omega) under the drive torque T with tangents dtheta,
- * domega, dT (cam_omega_dot, model.c's load_terms): J = J_0 + m s'^2, x0 = (T - M_f dir - (m s'' omega^2 - F_gx) s')
- * / J, and with guide friction omega_dot = x0 - sigma f s' / J. */
-static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const double d[4], double omega, double T,
-                                double dtheta, double domega, double dT)
+double cam_flank_tangent(const CamModel *m, const double d[4], double omega, double T, double F, double dir,
+                         double side, const double dq[4], double *f_out, double *df_out)
 {
-    double s1 = d[1], s2 = d[2], ds1, ds2, inertial, dinertial, J, dJ, x0, dx0, sigma, tan_a, dtan, n0, dn0, kappa;
-    double dkappa, f, df, base = m->r_b + d[0];
-    if (!(mode->contact != 0 && m->follower))
-        return dT / m->J_0;
+    double s1 = d[1], s2 = d[2], dtheta = dq[0], domega = dq[1], ds1, ds2, inertial, dinertial, J, dJ, x0, dx0;
+    double sigma, tan_a, dtan, n0, dn0, kappa, dkappa, f, df, base = m->r_b + d[0];
     ds1 = s2 * dtheta;
     ds2 = d[3] * dtheta;
-    inertial = m->m * s2 * omega * omega - m->F_gx;
-    dinertial = m->m * (ds2 * omega * omega + 2.0 * s2 * omega * domega);
+    inertial = m->m * s2 * omega * omega + F;
+    dinertial = m->m * (ds2 * omega * omega + 2.0 * s2 * omega * domega) + dq[3];
     J = m->J_0 + m->m * s1 * s1;
     dJ = 2.0 * m->m * s1 * ds1;
-    x0 = (T - m->M_f * mode->direction - inertial * s1) / J;
-    dx0 = (dT - dinertial * s1 - inertial * ds1 - x0 * dJ) / J;
+    x0 = (T - m->M_f * dir - inertial * s1) / J;
+    dx0 = (dq[2] - dinertial * s1 - inertial * ds1 - x0 * dJ) / J;
+    *f_out = *df_out = 0.0;
     if (m->mu == 0.0)
         return dx0;
-    sigma = sign_of(s1 * mode->direction);
+    sigma = sign_of(s1 * dir);
     tan_a = s1 / base;
     dtan = (ds1 * base - s1 * s1 * dtheta) / (base * base);
     n0 = (inertial + m->m * s1 * x0) * tan_a + m->G_y;
     dn0 = (dinertial + m->m * (ds1 * x0 + s1 * dx0)) * tan_a + (inertial + m->m * s1 * x0) * dtan;
     kappa = m->J_0 / J * tan_a;
     dkappa = m->J_0 * (dtan * J - tan_a * dJ) / (J * J);
-    f = friction_tangent(m, n0, dn0, kappa, dkappa, sigma, m->guide_side ? mode->side : 0.0, &df);
+    f = friction_tangent(m, n0, dn0, kappa, dkappa, sigma, side, &df);
+    *f_out = f;
+    *df_out = df;
     return dx0 - sigma * ((df * s1 + f * ds1) * J - f * s1 * dJ) / (J * J);
+}
+
+/* The tangent of omega_dot [rad/s3 per seed] at (theta, omega) under the drive torque T with tangents dtheta,
+ * domega, dT (cam_omega_dot, model.c's load_terms): on the flank the closing force is gravity's, -F_gx. */
+static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const double d[4], double omega, double T,
+                                double dtheta, double domega, double dT)
+{
+    double dq[4] = {dtheta, domega, dT, 0.0}, f, df;
+    if (!(mode->contact != 0 && m->follower))
+        return dT / m->J_0;
+    return cam_flank_tangent(m, d, omega, T, -m->F_gx, mode->direction, m->guide_side ? mode->side : 0.0, dq, &f,
+                             &df);
 }
 
 /* The tangent of the motor's torque c_m i (L > 0) or c_m (u - c_e omega_m) / R (L = 0). */

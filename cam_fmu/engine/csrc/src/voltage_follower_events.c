@@ -189,7 +189,7 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
 typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
 
 /* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
-static void me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
+void cam_vf_me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
 {
     const CamModel *m = &d->model;
     double dd[4];
@@ -229,7 +229,7 @@ void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 {
     double y[NY];
     memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
-    me_load(d, x, y);
+    cam_vf_me_load(d, x, y);
     d->speed.s = y[3];
     d->speed.v = y[4];
     d->speed.theta = y[0];
@@ -240,7 +240,7 @@ void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
 {
     double y[NY], dy[NY], dd[4];
-    me_load(d, x, y);
+    cam_vf_me_load(d, x, y);
     cam_vf_rates(&d->model, d->form_u, (int)d->speed.contact, y, dy);
     dx[CAM_THETA] = dy[0];
     dx[CAM_OMEGA] = dy[1];
@@ -276,7 +276,7 @@ double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
     double y[NY], g = x[CAM_ME_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
         return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + CAM_TOUCH;
-    me_load(d, x, y);
+    cam_vf_me_load(d, x, y);
     return cam_vf_event_value(m, d->form_u, code, (int)d->speed.contact, y);
 }
 
@@ -289,7 +289,7 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     (void)err;
     d->step_events[0] = '\0';
     cam_vf_me_states(d, x);
-    me_load(d, x, y);
+    cam_vf_me_load(d, x, y);
     if (code == EV_TOUCH)   /* the nearer flank: a groove's other one past half its width */
         code = (m->closure == CAM_CHOICE_CLOSURE_FORM && x[CAM_ME_GAP] > cam_vf_clearance(m) ? -left : left) > 0
                ? EV_TOUCH_UP : EV_TOUCH_DOWN;
@@ -305,4 +305,5 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
 
 const CamExchangeHooks cam_vf_exchange = {
     cam_vf_me_states, cam_vf_set_me_states, cam_vf_me_rates, cam_vf_me_codes, cam_vf_me_event, cam_vf_me_apply,
+    cam_vf_me_tangent,
 };

@@ -1,0 +1,104 @@
+/* The tangent of the voltage drive's follower of its own in Model Exchange (forward-mode derivatives, written out by
+ * hand, as jacobian.c's for the rigid drive): the directional derivative of cam_vf_me_rates (voltage_follower_events.c)
+ * and of the outputs (voltage_follower.c's vf_outputs) along a seed of the states x[CAM_ME_NX] (theta, omega, i, the
+ * shaft's twist and rotor speed; in flight the gap and its rate from the flank last left) and the input u, at the
+ * fixed mode: on a flank (moving or stuck), in flight (the cam moving or stuck, the follower sliding or held by the
+ * guide's friction). Exact to rounding, no differencing (docs/fmu.md, "Model Exchange"). */
+#include <math.h>
+
+#include "cam_voltage_follower.h"
+
+/* The seed's tangents of what drives the cam side: the current's (quasi-static with L = 0), the motor's torque, the
+ * shaft's torque (compliant) and the torque on the cam (the shaft's or the motor's). */
+typedef struct {
+    double omega_m, current, motor, shaft, drive;
+} Tangents;
+
+static Tangents drive_tangents(const CamModel *m, const double seed[CAM_ME_NX], double du)
+{
+    Tangents t;
+    t.omega_m = m->compliant ? seed[CAM_OMEGA_M] : seed[CAM_OMEGA];
+    t.current = m->has_current ? seed[CAM_CURRENT] : (du - m->c_e * t.omega_m) / m->R;
+    t.motor = m->c_m * t.current;
+    t.shaft = m->compliant ? m->k_shaft * seed[CAM_TWIST] + m->d_shaft * (t.omega_m - seed[CAM_OMEGA]) : 0.0;
+    t.drive = m->compliant ? t.shaft : t.motor;
+    return t;
+}
+
+/* N m: the torque on the cam side before the shaft's friction (the shaft's or the motor's). */
+static double drive_torque(const CamModel *m, const double y[NY], double u)
+{
+    if (m->compliant)
+        return m->k_shaft * y[Y_TWIST] + m->d_shaft * (y[Y_ROTOR] - y[1]);
+    return m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R;
+}
+
+void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
+                       double ddx[CAM_ME_NX], double dout[])
+{
+    const CamModel *m = &d->model;
+    const int contact = (int)d->speed.contact;
+    const double left = d->speed.left, dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
+    double y[NY], dy[NY], p[4], base, t, dt, root, ds, dv, da, dF, domega_dot = 0.0, dP = 0.0, P = 0.0, f, df;
+    Tangents g = drive_tangents(m, seed, du);
+    int k, stuck;
+    cam_vf_me_load(d, x, y);
+    stuck = y[Y_DIR] == 0.0;
+    cam_vf_rates(m, d->form_u, contact, y, dy);   /* the values the tangent needs: omega_dot */
+    cam_profile_eval(&m->profile, y[0], p);
+    for (k = 0; k < CAM_ME_NX; k++)
+        ddx[k] = 0.0;
+    for (k = 0; k < CAM_N_OUTPUTS; k++)
+        dout[k] = 0.0;
+    ddx[CAM_CURRENT] = m->has_current ? (du - m->R * seed[CAM_CURRENT] - m->c_e * g.omega_m) / m->L : 0.0;
+    ddx[CAM_TWIST] = m->compliant ? g.omega_m - domega : 0.0;
+    ddx[CAM_OMEGA_M] = m->compliant ? (g.motor - g.shaft) / m->J_m : 0.0;
+    ds = p[1] * dtheta;   /* the follower's position: on the flank, s_cam's */
+    dv = p[2] * dtheta * y[1] + p[1] * domega;
+    if (contact) {
+        dF = m->k_spring * p[1] * dtheta;   /* the closing force at s = s_cam - contact c */
+        if (!stuck) {
+            double dq[4] = {dtheta, domega, g.drive, dF};
+            domega_dot = cam_flank_tangent(m, p, y[1], drive_torque(m, y, d->form_u), cam_follower_closing(m, y[3]),
+                                           y[Y_DIR], 0.0, dq, &f, &df);
+            ddx[CAM_THETA] = domega;
+            ddx[CAM_OMEGA] = domega_dot;
+            cam_vf_on_flank(m, y, d->form_u, contact, p, &dy[1], &P);
+        } else {
+            P = cam_follower_closing(m, y[3]);
+            f = df = 0.0;
+        }
+        da = p[3] * dtheta * y[1] * y[1] + 2.0 * p[2] * y[1] * domega + p[2] * dtheta * dy[1] + p[1] * domega_dot;
+        dP = stuck ? dF : m->m * da + dF + (p[1] * y[Y_DIR] > 0.0 ? df : (p[1] * y[Y_DIR] < 0.0 ? -df : 0.0));
+        dout[CAM_O_M] = stuck ? g.drive : dP * p[1] + P * p[2] * dtheta;
+        dout[CAM_O_J] = 2.0 * m->m * p[1] * p[2] * dtheta;
+    } else {
+        int held = m->mu != 0.0 && y[Y_SIGMA] == 0.0;   /* at a halt, held by the guide's friction */
+        ds += left * seed[CAM_ME_GAP];
+        dv += left * seed[CAM_ME_RATE];
+        domega_dot = stuck ? 0.0 : g.drive / m->J_0;
+        da = held ? 0.0 : -m->k_spring * ds / m->m;   /* the free follower's acceleration */
+        ddx[CAM_THETA] = domega;
+        ddx[CAM_OMEGA] = domega_dot;
+        ddx[CAM_ME_GAP] = seed[CAM_ME_RATE];
+        ddx[CAM_ME_RATE] = left * (da - (p[3] * dtheta * y[1] * y[1] + 2.0 * p[2] * y[1] * domega
+                                         + p[2] * dtheta * dy[1] + p[1] * domega_dot));
+    }
+    base = m->r_b + p[0];
+    t = p[1] / base;
+    dt = (p[2] * dtheta * base - p[1] * p[1] * dtheta) / (base * base);
+    root = sqrt(1.0 + t * t);
+    dout[CAM_O_OMEGA] = domega;
+    dout[CAM_O_THETA] = dtheta;
+    dout[CAM_O_S] = ds;
+    dout[CAM_O_I] = g.current;
+    dout[CAM_O_V] = dv;
+    dout[CAM_O_A] = da;
+    dout[CAM_O_ALPHA] = dt / (1.0 + t * t);
+    dout[CAM_O_S_CAM] = p[1] * dtheta;
+    dout[CAM_O_VOLTAGE] = du;
+    dout[CAM_O_N_CONTACT] = contact ? dP * root + P * t * dt / root : 0.0;
+    dout[CAM_O_THETA_M] = dtheta + (m->compliant ? seed[CAM_TWIST] : 0.0);
+    dout[CAM_O_OMEGA_M] = g.omega_m;
+    dout[CAM_O_M_SHAFT] = m->compliant ? g.shaft : 0.0;
+}
