@@ -158,6 +158,11 @@ void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
 /* The derivatives at x under the input d->form_u (the drive's mode and contact). */
 void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
+/* The tangent of a follower of its own's Model Exchange derivatives (cam_vf_me_rates) and outputs at x under u [V]
+ * along the seed (seed [state units], du [V]): ddx[CAM_ME_NX] and dout[CAM_N_OUTPUTS], analytic, in the mode the last
+ * event update left (jacobian_follower.c; the drive's own follower: cam_tangent, jacobian.c). */
+void cam_vf_tangent(const CamDrive *d, const double x[CAM_ME_NX], double u, const double seed[CAM_ME_NX], double du,
+                    double ddx[CAM_ME_NX], double dout[]);
 
 /* Build a drive from parameters (checked: cam_params_check, cam_model_init) at the start inputs. */
 int cam_drive_init(CamDrive *d, const CamParams *params, CamError *err);

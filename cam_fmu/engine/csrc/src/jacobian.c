@@ -3,7 +3,7 @@
  * seed of the states and the input u, at a fixed mode. Exact to rounding, no differencing; the FMI 2.0 Model
  * Exchange glue forwards fmi2GetDirectionalDerivative here (fmi/directional.c; docs/fmu.md, "Model Exchange").
  * Every mode of the drive whose cam carries the follower (rigid or compliant, L = 0 or L > 0, engaged with or without
- * guide friction, free in the clearance, stuck); a follower of its own is voltage_follower.c's and refused there. */
+ * guide friction, free in the clearance, stuck); a follower of its own: jacobian_follower.c. */
 #include <math.h>
 
 #include "cam_model.h"
@@ -13,10 +13,9 @@ static double sign_of(double x)
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
 
-/* The guide friction f = mu (side n0 + N_g) / (1 - side mu sigma kappa) (cam_guide_friction, model.c) on the branch
- * side (0: the one that holds there) and its tangent *df from those of n0 and kappa. */
-static double friction_tangent(const CamModel *m, double n0, double dn0, double kappa, double dkappa, double sigma,
-                               double side, double *df)
+/* The guide friction on the branch side and its tangent (cam_model.h). */
+double cam_friction_tangent(const CamModel *m, double n0, double dn0, double kappa, double dkappa, double sigma,
+                            double side, double *df)
 {
     double f, denominator;
     *df = 0.0;
@@ -59,7 +58,7 @@ static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const do
     dn0 = (dinertial + m->m * (ds1 * x0 + s1 * dx0)) * tan_a + (inertial + m->m * s1 * x0) * dtan;
     kappa = m->J_0 / J * tan_a;
     dkappa = m->J_0 * (dtan * J - tan_a * dJ) / (J * J);
-    f = friction_tangent(m, n0, dn0, kappa, dkappa, sigma, m->guide_side ? mode->side : 0.0, &df);
+    f = cam_friction_tangent(m, n0, dn0, kappa, dkappa, sigma, m->guide_side ? mode->side : 0.0, &df);
     return dx0 - sigma * ((df * s1 + f * ds1) * J - f * s1 * dJ) / (J * J);
 }
 
@@ -121,7 +120,7 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
         da = d[2] * dtheta * w * w + 2.0 * d[2] * w * dw + ds1 * omega_dot + s1 * domega_dot;
         push = m->m * a - m->F_gx;   /* cam_load: the friction at the axial force, on the branch that holds */
         sigma = sign_of(s1 * (moving ? mode->direction : 0.0));
-        f = friction_tangent(m, push * t + m->G_y, m->m * da * t + push * dt, t, dt, sigma, 0.0, &df);
+        f = cam_friction_tangent(m, push * t + m->G_y, m->m * da * t + push * dt, t, dt, sigma, 0.0, &df);
         along = push + sigma * f;
         dalong = m->m * da + sigma * df;
         dout[CAM_O_J] = 2.0 * m->m * s1 * ds1;
