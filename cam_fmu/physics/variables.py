@@ -79,12 +79,13 @@ FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage", "N_contact")
 FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # Model Exchange's ModelStructure: what each state derivative and output may depend on at a fixed mode (the knowns of
 # fmi2GetDirectionalDerivative: the states and the inputs; omega_ref and omega_dot_ref drive no Model Exchange run),
-# the union over every drive-train, effect and mode. Probed numerically by tests/fmu_me/test_directional_me.py (central
-# differences of the FMU's derivatives and outputs); the entries of x_gap and x_gap_rate are a follower of its own in
-# flight (voltage_follower_events.c: der(x_gap) = x_gap_rate, the relative acceleration from the follower's and the
-# cam's motion), where the probe cannot put the mode.
-_ALL = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "x_gap", "x_gap_rate", "u")
+# the union over every drive-train, effect and mode, a follower of its own's in flight too. Probed numerically, exactly
+# (tests/fmu_me/test_directional_me.py: central differences of the FMU's derivatives and outputs in every mode). In
+# flight (voltage_follower_events.c) der(x_gap) = x_gap_rate and der(x_gap_rate) is the follower's acceleration at its
+# s (x_theta, x_gap) less the flank's: not x_gap_rate (the friction's direction is held between events); the follower's
+# a follows s, not its speed; M and N_contact are the contact's (in flight M = M_f sgn(omega), N_contact = 0).
 _CAM = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "u")
+_FLYING = _CAM + ("x_gap",)
 DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "der(x_theta)": ("x_omega",),
     "der(x_omega)": _CAM,
@@ -92,22 +93,22 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "der(x_twist)": ("x_omega", "x_omega_m"),
     "der(x_omega_m)": ("x_omega", "x_i", "x_twist", "x_omega_m", "u"),
     "der(x_gap)": ("x_gap_rate",),
-    "der(x_gap_rate)": _ALL,
+    "der(x_gap_rate)": _FLYING,
     "omega": ("x_omega",),
     "theta": ("x_theta",),
     "s": ("x_theta", "x_gap"),
     "i": ("x_omega", "x_i", "x_omega_m", "u"),
-    "M": _ALL,
+    "M": _CAM,
     "J": ("x_theta",),
     "v": ("x_theta", "x_omega", "x_gap_rate"),
-    "a": _ALL,
+    "a": _FLYING,
     "alpha": ("x_theta",),
     "s_cam": ("x_theta",),
     "voltage": ("u",),
     "theta_m": ("x_theta", "x_twist"),
     "omega_m": ("x_omega", "x_omega_m"),
     "M_shaft": ("x_omega", "x_twist", "x_omega_m"),
-    "N_contact": _ALL,
+    "N_contact": _CAM,
 }
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).
