@@ -1,5 +1,5 @@
-"""cam3.fmu's FMI 3.0 directional derivatives: the engine's analytic tangent (jacobian.c; jacobian_follower.c for a
-follower of its own) through fmi3_me.c, the same call as FMI 2.0's. Checked against cam.fmu's fmi2GetDirectionalDerivative at the same state to the bit (that
+"""cam3.fmu's FMI 3.0 directional derivatives: the engine's analytic tangent (jacobian.c, jacobian_follower.c) through
+fmi3_me.c, the same call as FMI 2.0's. Checked against cam.fmu's fmi2GetDirectionalDerivative at the same state to the bit (that
 one is checked against central differences in tests/fmu_me/test_directional_me.py) and against central differences
 of cam3.fmu's own derivatives; the bad requests refused with their reason."""
 from __future__ import annotations
@@ -25,7 +25,8 @@ def set_knowns(host: Host, z: np.ndarray) -> None:
     host.model.setFloat64([host.vr["u"]], [float(z[NX])])
 
 
-@pytest.mark.parametrize("case", ["rigid", "compliant_L", "free_in_gap", "stuck"])
+@pytest.mark.parametrize("case", ["rigid", "compliant_L", "free_in_gap", "stuck", "spring_in_flight",
+                                  "groove_other_flank_tilted"])
 def test_fmi3_directional_derivatives_are_fmi2s_and_the_differences(cam3_fmu_path, engine_fmu_path, case):
     rng = np.random.default_rng(7)
     me = Me(engine_fmu_path, CASES[case])

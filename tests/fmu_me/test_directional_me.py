@@ -1,7 +1,6 @@
-"""cam.fmu's directional derivatives in Model Exchange (csrc/src/jacobian.c, and jacobian_follower.c for a follower of
-its own, through fmi/directional.c): against central differences of the FMU's own derivatives and outputs at random
-states of every drive and mode, away from events; the ModelStructure's dependencies against a numerical sparsity
-probe; bad requests refused with the reason."""
+"""cam.fmu's directional derivatives in Model Exchange (csrc/src/jacobian.c through fmi/directional.c): against
+central differences of the FMU's own derivatives and outputs at random states of every drive and mode, away from
+events; the ModelStructure's dependencies against a numerical sparsity probe; bad requests refused with the reason."""
 from __future__ import annotations
 
 import math
@@ -18,8 +17,26 @@ from cam_fmu.physics.variables import OUTPUTS, STATES
 
 NX = len(STATES)
 RTOL = 1e-6
-# (label, start values): every drive-train and mode the tangent covers with closure 'kinematic', which keeps the
-# follower on the cam (a follower of its own: FOLLOWER_CASES below).
+# (label, start values): every drive-train and mode the tangent covers. Closure 'kinematic' keeps the follower on the
+# cam (jacobian.c); a follower of its own (jacobian_follower.c) starts on its flank, or, at 150 rad/s where the cam
+# falls away faster than the spring pulls the follower (theta0 = 1.2 rad), in flight: FLIGHT names those.
+SPRING = {"closure": "spring", "k_spring": 200.0, "F_spring0": 1.0}
+SHAFT = {"k_shaft": 50.0, "d_shaft": 1e-3, "J_m": 3e-5, "J_cam": 1.41e-5, "L": 1e-3}
+TILT = {"gamma": 1.2, "beta": 0.7, "mu": 0.05}
+LIFTED = {"omega0": 150.0, "theta0": 1.2}
+FOLLOWER = {
+    "spring_on_flank": {"omega0": 20.0, **SPRING},
+    "spring_stuck": {"omega0": 0.0, "u": 0.0, "theta0": 1.0, **SPRING},
+    "spring_in_flight": {**LIFTED, **SPRING},
+    "spring_in_flight_tilted": {**LIFTED, **SPRING, **TILT},
+    "spring_in_flight_L": {**LIFTED, **SPRING, "L": 1e-3, "i0": -1.0},   # the current brakes: it lifts off
+    "spring_in_flight_compliant_L": {**LIFTED, **SPRING, **SHAFT},
+    "groove_on_flank": {"omega0": 20.0, "c": 5e-4},
+    "groove_other_flank_tilted": {**LIFTED, "c": 5e-4, **TILT},
+    "groove_compliant_L": {"omega0": 20.0, "c": 5e-4, **SHAFT},
+    "groove_stuck": {"omega0": 0.0, "u": 0.0, "c": 5e-4},
+}
+FLIGHT = {"spring_in_flight", "spring_in_flight_tilted", "spring_in_flight_L", "spring_in_flight_compliant_L"}
 CASES = {
     "rigid": {"omega0": 20.0},
     "rigid_L": {"omega0": 20.0, "L": 1e-3},
@@ -30,6 +47,7 @@ CASES = {
     "free_in_gap": {"omega0": 20.0, "c": 1e-3, "closure": "kinematic"},
     "stuck": {"omega0": 0.0, "u": 0.0},
     "stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3},
+    **FOLLOWER,
 }
 
 
@@ -39,8 +57,8 @@ def scene_start(name: str, **changes) -> dict:
     return {**scene.primary.start_values(), "u": scene.u.value(0.0), **changes}
 
 
-# A follower of its own (closure 'spring', or 'form' with c > 0; docs/model.md 13.6), jacobian_follower.c: label ->
-# (start values, mode, cam speed [rad/s] at which the flank lets the follower go). The modes: on a flank with the
+# A follower of its own in the shipped scenes, each mode reached by the FMU's own event updates (FOLLOWER above starts
+# in its mode): label -> (start values, mode, cam speed [rad/s] at which the flank lets the follower go). The modes: on a flank with the
 # shaft moving ('contact') or stuck ('stuck': from rest with u = 0), in flight with the cam moving ('flight': lifted off
 # by an event update where the contact force is < 0) or stuck under it ('flight_stuck': then stopped with u = 0).
 _GROOVE = scene_start("groove_voltage")
@@ -256,6 +274,9 @@ def test_directional_derivatives_match_central_differences(engine_fmu_path, case
             if fd is None:
                 continue
             analytic = me.jacobian()
+            if case in FOLLOWER:   # the mode the case is named for: the gap's rate moves the gap only in flight
+                gap_by_rate = analytic[[row[0] for row in STATES].index("x_gap"), NX - 1]
+                assert gap_by_rate == (1.0 if case in FLIGHT else 0.0), (case, gap_by_rate)
             scale = np.abs(fd).max(axis=1, keepdims=True)
             err = np.abs(analytic - fd)
             assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
@@ -300,10 +321,10 @@ def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_pa
 
 
 def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
-    """The <Derivatives>/<Outputs> dependencies of modelDescription.xml are exactly the states and inputs that central
-    differences of the FMU's derivatives and outputs move, over every case and every mode of a follower of its own
-    (in flight too) at random states. fmpy's validation is clean and the FMU says it provides directional
-    derivatives."""
+    """The <Derivatives>/<Outputs> dependencies of modelDescription.xml hold every state and input that central
+    differences of the FMU's derivatives and outputs move, over every case at random states (a follower of its own on
+    its flank and in flight among them), and no more. fmpy's validation is clean and the FMU says it provides
+    directional derivatives."""
     from fmpy.validation import validate_fmu
 
     assert validate_fmu(str(engine_fmu_path)) == []
@@ -314,26 +335,29 @@ def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
         assert u.dependenciesKind == ["dependent"] * len(u.dependencies)
     rng = np.random.default_rng(7)
     found: dict[str, set] = {name: set() for name in listed}
-    names = [f"der({row[0]})" for row in STATES] + [row[0] for row in OUTPUTS]
-    knowns = [row[0] for row in STATES] + ["u"]
-    runs = [(start, None, 0.0) for start in CASES.values()] + list(FOLLOWER_CASES.values())
-    for start, mode, speed in runs:
+    for case, start in CASES.items():
         me = Me(engine_fmu_path, start)
-        if mode is not None:
-            enter_follower_mode(me, mode, speed)
+        names = [f"der({row[0]})" for row in STATES] + [row[0] for row in OUTPUTS]
+        knowns = [row[0] for row in STATES] + ["u"]
         for _ in range(3):
-            if mode is None:
-                random_states(me, rng, start.get("omega0", 1.0) == 0.0)
-            else:
-                random_follower_state(me, rng, mode, start.get("c", 1e-3))
+            random_states(me, rng, start.get("omega0", 1.0) == 0.0)
             fd = me.central(1e-6)
             scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
             for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
                 found[names[r]].add(knowns[c])
         me.close()
-    differ = {name: (found[name] - listed[name], listed[name] - found[name]) for name in listed
-              if found[name] != listed[name]}
-    assert differ == {}   # name: (found, not listed; listed, not found)
+    for start, mode, speed in FOLLOWER_CASES.values():   # and in every mode the event updates reach
+        me = Me(engine_fmu_path, start)
+        enter_follower_mode(me, mode, speed)
+        for _ in range(3):
+            random_follower_state(me, rng, mode, start.get("c", 1e-3))
+            fd = me.central(1e-6)
+            scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
+            for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
+                found[names[r]].add(knowns[c])
+        me.close()
+    for name in listed:
+        assert found[name] == listed[name], (name, found[name] ^ listed[name])
 
 
 def refusal(me: Me, unknowns: list, knowns: list, logged: list) -> str:
@@ -372,8 +396,7 @@ def logging_me(fmu, start: dict) -> tuple[Me, list]:
 
 def test_bad_requests_are_errors_with_the_reason(engine_fmu_path):
     """An unknown value reference, a parameter as a known, an output or state as an unknown of the wrong kind:
-    fmi2Error and the reason in the log, never a zero that looks like a derivative; the same with a follower of its
-    own, whose right requests answer."""
+    fmi2Error and the reason in the log, never a zero that looks like a derivative."""
     me, logged = logging_me(engine_fmu_path, {"omega0": 20.0})
     try:
         der_omega, x_theta = me.vr["der(x_omega)"], me.vr["x_theta"]
