@@ -58,13 +58,14 @@ def scene_start(name: str, **changes) -> dict:
 
 
 # A follower of its own in the shipped scenes, each mode reached by the FMU's own event updates (FOLLOWER above starts
-# in its mode): label -> (start values, mode, cam speed [rad/s] at which the flank lets the follower go). The modes: on a flank with the
-# shaft moving ('contact') or stuck ('stuck': from rest with u = 0), in flight with the cam moving ('flight': lifted off
-# by an event update where the contact force is < 0) or stuck under it ('flight_stuck': then stopped with u = 0).
+# in its mode): label -> (start values, mode, cam speed [rad/s] at which the flank lets the follower go). The modes:
+# on a flank with the shaft moving ('contact') or stuck ('stuck': from rest with u = 0), in flight with the cam moving
+# ('flight': lifted off by an event update where the contact force is < 0) or stuck under it ('flight_stuck': then
+# stopped with u = 0).
 _GROOVE = scene_start("groove_voltage")
 _SPRING = scene_start("spring_voltage")
 _BACKLASH_FORM = scene_start("backlash", closure="form", omega0=20.0)
-_BACKLASH_SPRING = scene_start("backlash", closure="spring", c=0.0, omega0=20.0)   # a spring: one flank, no clearance
+_BACKLASH_SPRING = scene_start("backlash", closure="spring", c=0.0, omega0=20.0)   # one flank: no clearance
 _FRICTION_L = {"mu": 0.05, "L": 1e-3}
 _SHAFT = {"k_shaft": 100.0, "d_shaft": 0.01, "J_m": 3e-5, "mu": 0.05}
 FOLLOWER_CASES = {

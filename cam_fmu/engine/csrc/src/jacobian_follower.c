@@ -58,8 +58,8 @@ static void flank_tangent(const CamModel *m, int contact, double dir, const doub
     double s1 = d[1], s2 = d[2], ds1 = s2 * dtheta, ds2 = d[3] * dtheta, base = m->r_b + d[0];
     double F = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m)), dF = m->k_spring * s1 * dtheta;
     double J = m->J_0 + m->m * s1 * s1, dJ = 2.0 * m->m * s1 * ds1;
-    double inertial = m->m * s2 * omega * omega + F, dinertial = m->m * (ds2 * omega * omega + 2.0 * s2 * omega * domega)
-                                                                 + dF;
+    double inertial = m->m * s2 * omega * omega + F;
+    double dinertial = m->m * (ds2 * omega * omega + 2.0 * s2 * omega * domega) + dF;
     double x0 = (T - inertial * s1) / J, dx0 = (dT - dinertial * s1 - inertial * ds1 - x0 * dJ) / J;
     double sigma, tan_a, dtan, n0, dn0, kappa, dkappa, f = 0.0, df = 0.0;
     *omega_dot = x0;
