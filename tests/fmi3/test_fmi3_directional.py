@@ -11,7 +11,8 @@ import pytest
 from fmpy.fmi1 import FMICallException
 
 from fmi3.test_fmi3_me import NX, Host
-from fmu_me.test_directional_me import CASES, RTOL, Me, random_states
+from fmu_me.test_directional_me import (CASES, FOLLOWER_CASES, RTOL, Me, enter_follower_mode, random_follower_state,
+                                       random_states)
 
 
 def fmi3_jacobian(host: Host, unknowns: list, knowns: list) -> np.ndarray:
@@ -60,6 +61,85 @@ def test_fmi3_directional_derivatives_are_fmi2s_and_the_differences(cam3_fmu_pat
         host.model.freeInstance()
 
 
+class Host3(Host):
+    """The FMI 3.0 host with the calls enter_follower_mode and random_follower_state make (Me's, FMI 3.0's names)."""
+
+    def x(self) -> np.ndarray:
+        return self.array(self.model.getContinuousStates, NX)
+
+    def set_x(self, x: np.ndarray) -> None:
+        x = np.ascontiguousarray(x, dtype=float)
+        self.model.setContinuousStates(x.ctypes.data_as(POINTER(c_double)), NX)
+
+    def indicators(self) -> np.ndarray:
+        return self.array(self.model.getEventIndicators, self.md.numberOfEventIndicators)
+
+    def event(self) -> None:
+        self.model.enterEventMode()
+        while self.model.updateDiscreteStates()[0]:
+            pass
+        self.model.enterContinuousTimeMode()
+
+    def set_u(self, u: float) -> None:
+        self.model.setFloat64([self.vr["u"]], [u])
+
+    def f(self, outputs: list) -> np.ndarray:
+        return np.concatenate([self.array(self.model.getContinuousStateDerivatives, NX),
+                               self.model.getFloat64(outputs)])
+
+
+@pytest.mark.parametrize("case", ["groove_voltage/flight", "spring_voltage/stuck", "spring_compliant/contact",
+                                  "backlash_form/flight_stuck", "groove_friction_L/contact"])
+def test_fmi3_follower_of_its_own_derivatives(cam3_fmu_path, engine_fmu_path, case):
+    """A follower of its own in each mode (reached by each version's own event updates): fmi3GetDirectionalDerivative
+    is fmi2GetDirectionalDerivative at the same state to the bit, and central differences of cam3.fmu's own
+    fmi3GetContinuousStateDerivatives and outputs agree with it to 1e-6 relative (of each row's largest entry)."""
+    start, mode, speed = FOLLOWER_CASES[case]
+    rng = np.random.default_rng(5)
+    me = Me(engine_fmu_path, start)
+    host = Host3(cam3_fmu_path)
+    host.start(**start)
+    unknowns = me.ders + me.outputs
+    checked = 0
+    try:
+        enter_follower_mode(me, mode, speed)
+        enter_follower_mode(host, mode, speed)
+        for _ in range(20):
+            random_follower_state(me, rng, mode, start.get("c", 1e-3))
+            z = me.knowns_now()
+            set_knowns(host, z)
+            j2, j3 = me.jacobian(), fmi3_jacobian(host, unknowns, me.knowns)
+            assert np.array_equal(j2, j3)
+            differences = []
+            for rel in (1e-5, 5e-6):
+                columns = []
+                for j in range(len(z)):
+                    h = rel * max(1.0, abs(z[j])) * (1e-3 if j in (NX - 2, NX - 1) else 1.0)
+                    rows = []
+                    for sign in (1.0, -1.0):
+                        shifted = z.copy()
+                        shifted[j] += sign * h
+                        set_knowns(host, shifted)
+                        rows.append(host.f(me.outputs))
+                    columns.append((rows[0] - rows[1]) / (2 * h))
+                differences.append(np.array(columns).T)
+            set_knowns(host, z)
+            coarse, fine = differences
+            scale = np.maximum(np.abs(fine).max(axis=1, keepdims=True), 1e-300)
+            if not np.all(np.abs(coarse - fine) <= 1e-8 * scale + 1e-8 * np.abs(fine)):
+                continue   # a breakpoint of the profile within the steps
+            assert np.all(np.abs(j3 - fine) <= RTOL * scale + 1e-12), np.argwhere(np.abs(j3 - fine) > RTOL * scale)
+            assert np.abs(j3).max() > 0.0
+            checked += 1
+            if checked == 3:
+                break
+    finally:
+        me.close()
+        host.model.terminate()
+        host.model.freeInstance()
+    assert checked == 3
+
+
 def test_fmi3_bad_directional_requests_are_errors_with_the_reason(cam3_fmu_path):
     host = Host(cam3_fmu_path)
     host.start(omega0=20.0)
@@ -81,3 +161,11 @@ def test_fmi3_bad_directional_requests_are_errors_with_the_reason(cam3_fmu_path)
     assert model.getDirectionalDerivative([der_omega], [vr["u"]], [1.0])[0] > 0.0   # a right request still answers
     model.terminate()
     model.freeInstance()
+    spring = Host(cam3_fmu_path)   # a follower of its own: the same refusals, and a right request answers
+    spring.start(omega0=20.0, closure="spring")
+    with pytest.raises(FMICallException):
+        spring.model.getDirectionalDerivative([der_omega], [99999], [1.0])
+    assert any("value reference 99999" in t for t in spring.errors())
+    assert spring.model.getDirectionalDerivative([der_omega], [vr["u"]], [1.0])[0] > 0.0
+    spring.model.terminate()
+    spring.model.freeInstance()

@@ -12,6 +12,7 @@ import pytest
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Model
 
+from cam_fmu.experiments.scenes import find_scene
 from cam_fmu.physics.variables import OUTPUTS, STATES
 
 NX = len(STATES)
@@ -50,6 +51,45 @@ CASES = {
 }
 
 
+def scene_start(name: str, **changes) -> dict:
+    """A shipped scene's start values and its input at t = 0, with changes."""
+    scene = find_scene(name)
+    return {**scene.primary.start_values(), "u": scene.u.value(0.0), **changes}
+
+
+# A follower of its own in the shipped scenes, each mode reached by the FMU's own event updates (FOLLOWER above starts
+# in its mode): label -> (start values, mode, cam speed [rad/s] at which the flank lets the follower go). The modes:
+# on a flank with the shaft moving ('contact') or stuck ('stuck': from rest with u = 0), in flight with the cam moving
+# ('flight': lifted off by an event update where the contact force is < 0) or stuck under it ('flight_stuck': then
+# stopped with u = 0).
+_GROOVE = scene_start("groove_voltage")
+_SPRING = scene_start("spring_voltage")
+_BACKLASH_FORM = scene_start("backlash", closure="form", omega0=20.0)
+_BACKLASH_SPRING = scene_start("backlash", closure="spring", c=0.0, omega0=20.0)   # one flank: no clearance
+_FRICTION_L = {"mu": 0.05, "L": 1e-3}
+_SHAFT = {"k_shaft": 100.0, "d_shaft": 0.01, "J_m": 3e-5, "mu": 0.05}
+FOLLOWER_CASES = {
+    "groove_voltage/contact": (_GROOVE, "contact", 0.0),
+    "groove_voltage/flight": (_GROOVE, "flight", 60.0),
+    "groove_voltage/flight_stuck": (_GROOVE, "flight_stuck", 60.0),
+    "groove_friction_L/contact": ({**_GROOVE, **_FRICTION_L}, "contact", 0.0),
+    "groove_friction_L/flight": ({**_GROOVE, **_FRICTION_L}, "flight", 60.0),
+    "spring_voltage/contact": (_SPRING, "contact", 0.0),
+    "spring_voltage/stuck": ({**_SPRING, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
+    "spring_voltage/flight": (_SPRING, "flight", 150.0),
+    "spring_voltage/flight_stuck": (_SPRING, "flight_stuck", 150.0),
+    "spring_compliant/contact": ({**_SPRING, **_SHAFT}, "contact", 0.0),
+    "spring_compliant/flight": ({**_SPRING, **_SHAFT}, "flight", 150.0),
+    "spring_compliant_L/stuck": ({**_SPRING, **_SHAFT, "L": 1e-3, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
+    "backlash_form/contact": (_BACKLASH_FORM, "contact", 0.0),
+    "backlash_form/stuck": ({**_BACKLASH_FORM, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
+    "backlash_form/flight": ({**_BACKLASH_FORM, "mu": 0.05}, "flight", 60.0),
+    "backlash_form/flight_stuck": ({**_BACKLASH_FORM, "mu": 0.05}, "flight_stuck", 60.0),
+    "backlash_spring/contact": (_BACKLASH_SPRING, "contact", 0.0),
+    "backlash_spring/flight": (_BACKLASH_SPRING, "flight", 150.0),
+}
+
+
 class Me:
     """cam.fmu in continuous-time mode through fmpy's fmi2 API, with the calls the tests need."""
 
@@ -83,6 +123,21 @@ class Me:
         values = np.zeros(NX)
         self.model.getContinuousStates(values.ctypes.data_as(POINTER(c_double)), NX)
         return values
+
+    def indicators(self) -> np.ndarray:
+        values = np.zeros(self.md.numberOfEventIndicators)
+        self.model.getEventIndicators(values.ctypes.data_as(POINTER(c_double)), len(values))
+        return values
+
+    def event(self) -> None:
+        """An event iteration at the current state and inputs (the transitions of the indicators below zero)."""
+        self.model.enterEventMode()
+        while self.model.newDiscreteStates()[0]:
+            pass
+        self.model.enterContinuousTimeMode()
+
+    def set_u(self, u: float) -> None:
+        self.model.setReal([self.vr["u"]], [u])
 
     def set_x(self, x: np.ndarray) -> None:
         x = np.ascontiguousarray(x, dtype=float)
@@ -142,6 +197,59 @@ def random_states(me: Me, rng: np.random.Generator, stuck: bool) -> None:
     me.model.setReal([me.vr["u"]], [rng.uniform(1.0, 5.0)])
 
 
+def enter_follower_mode(me, mode: str, speed: float) -> None:
+    """Put a follower of its own (in contact after the start) into `mode` (FOLLOWER_CASES) by the FMU's own event
+    updates: the first cam angle (of 721) where the contact force at `speed` is < 0 (indicator slot 1), an event
+    there (the lift-off); for 'flight_stuck' then u = 0 and the cam a hair past its stop, an event (stuck). `me` is an
+    FMI 2.0 (Me) or FMI 3.0 host with x, set_x, indicators, event and set_u."""
+    if mode in ("contact", "stuck"):
+        return
+    x = me.x()
+    for theta in np.linspace(0.0, 2 * math.pi, 721):
+        x[0], x[1] = theta, speed
+        me.set_x(x)
+        if me.indicators()[1] < 0.0:
+            break
+    else:
+        raise AssertionError(f"the flank holds the follower at every angle at {speed} rad/s")
+    me.event()
+    if mode == "flight_stuck":
+        me.set_u(0.0)
+        x = me.x()
+        x[1] = -1e-9
+        me.set_x(x)
+        me.event()
+
+
+def random_follower_state(me, rng: np.random.Generator, mode: str, clearance: float) -> None:
+    """A random state in `mode`: random_states' cam side (at rest in the stuck modes), in flight a gap within 0.1..1.9
+    of the clearance (1 mm for a spring) and a rate within +-5 cm/s."""
+    x = me.x()
+    x[0] = rng.uniform(0.0, 2 * math.pi)
+    x[1] = 0.0 if mode in ("stuck", "flight_stuck") else rng.uniform(5.0, 40.0)
+    x[2] = rng.uniform(0.05, 0.3)
+    x[3] = rng.uniform(-2e-4, 2e-4)
+    x[4] = x[1] + rng.uniform(-2.0, 2.0)
+    if mode.startswith("flight"):
+        x[NX - 2] = rng.uniform(0.1, 1.9) * clearance
+        x[NX - 1] = rng.uniform(-0.05, 0.05)
+    me.set_x(x)
+    me.set_u(rng.uniform(1.0, 5.0))
+
+
+def assert_follower_mode(x: np.ndarray, dx: np.ndarray, mode: str) -> None:
+    """The FMU's derivatives say the mode: in flight der(x_gap) = x_gap_rate, on a flank the gap's slots held; stuck
+    (on a flank or under the flying follower) the cam's angle and speed held."""
+    if mode.startswith("flight"):
+        assert dx[NX - 2] == x[NX - 1] != 0.0
+    else:
+        assert dx[NX - 2] == dx[NX - 1] == 0.0
+    if mode in ("stuck", "flight_stuck"):
+        assert dx[0] == dx[1] == 0.0
+    else:
+        assert dx[0] == x[1] != 0.0
+
+
 def smooth_differences(me: Me) -> np.ndarray | None:
     """Central differences at two steps that agree (no breakpoint of the profile within them), else None."""
     coarse, fine = me.central(1e-5), me.central(5e-6)
@@ -182,6 +290,37 @@ def test_directional_derivatives_match_central_differences(engine_fmu_path, case
     assert checked == 4
 
 
+@pytest.mark.parametrize("case", list(FOLLOWER_CASES))
+def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_path, case):
+    """A follower of its own in each mode (reached by the FMU's own event updates), at 4 random states away from
+    events and breakpoints: the analytic Jacobian of the state derivatives (the gap's too) and outputs by the states
+    and u agrees with central differences of fmi2GetDerivatives / fmi2GetReal to 1e-6 relative (of each row's largest
+    entry); in flight with the cam moving the gap rate's row is not zero."""
+    start, mode, speed = FOLLOWER_CASES[case]
+    rng = np.random.default_rng(11)
+    me = Me(engine_fmu_path, start)
+    checked = 0
+    try:
+        enter_follower_mode(me, mode, speed)
+        for _ in range(40):
+            random_follower_state(me, rng, mode, start.get("c", 1e-3))
+            assert_follower_mode(me.x(), me.f()[:NX], mode)
+            fd = smooth_differences(me)
+            if fd is None:
+                continue
+            analytic = me.jacobian()
+            scale = np.abs(fd).max(axis=1, keepdims=True)
+            err = np.abs(analytic - fd)
+            assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
+            assert np.abs(analytic[NX - 1 if mode == "flight" else slice(None)]).max() > 0.0
+            checked += 1
+            if checked == 4:
+                break
+    finally:
+        me.close()
+    assert checked == 4
+
+
 def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
     """The <Derivatives>/<Outputs> dependencies of modelDescription.xml hold every state and input that central
     differences of the FMU's derivatives and outputs move, over every case at random states (a follower of its own on
@@ -203,6 +342,16 @@ def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
         knowns = [row[0] for row in STATES] + ["u"]
         for _ in range(3):
             random_states(me, rng, start.get("omega0", 1.0) == 0.0)
+            fd = me.central(1e-6)
+            scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
+            for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
+                found[names[r]].add(knowns[c])
+        me.close()
+    for start, mode, speed in FOLLOWER_CASES.values():   # and in every mode the event updates reach
+        me = Me(engine_fmu_path, start)
+        enter_follower_mode(me, mode, speed)
+        for _ in range(3):
+            random_follower_state(me, rng, mode, start.get("c", 1e-3))
             fd = me.central(1e-6)
             scale = np.maximum(np.abs(fd).max(axis=1, keepdims=True), 1e-300)
             for r, c in np.argwhere(np.abs(fd) > 1e-9 * scale):
@@ -258,6 +407,15 @@ def test_bad_requests_are_errors_with_the_reason(engine_fmu_path):
         assert "('u') is no unknown" in refusal(me, [me.vr["u"]], [x_theta], logged)
         good = me.model.getDirectionalDerivative([der_omega], [me.vr["u"]], [1.0])[0]
         assert good > 0.0   # more voltage, more acceleration: the same call answers once the request is right
+    finally:
+        me.close()
+    # a follower of its own answers (jacobian_follower.c) and refuses the same bad requests
+    me, logged = logging_me(engine_fmu_path, {"omega0": 20.0, "closure": "spring"})
+    try:
+        der_omega = me.vr["der(x_omega)"]
+        assert "value reference 99999 ('no variable') is no known" in refusal(me, [der_omega], [99999], logged)
+        assert "('x_gap') is no unknown" in refusal(me, [me.vr["x_gap"]], [me.vr["x_gap"]], logged)
+        assert me.model.getDirectionalDerivative([der_omega], [me.vr["u"]], [1.0])[0] > 0.0
     finally:
         me.close()
 

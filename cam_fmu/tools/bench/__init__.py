@@ -23,8 +23,9 @@ BENCHMARKS = {
     "memory": ("memory", False, "RSS over a long run through FMU2Slave"),
     "toolchain": ("toolchain", False, "cam.fmu's binary from zig against the system gcc's"),
     "fmi3_me": ("fmi3_me", False, "FMI 3.0 Model Exchange (cam3.fmu) against FMI 2.0's (cam.fmu) in fmpy"),
-    "jacobian": ("jacobian", False, "stiff runs (L = 1 mH, rigid and compliant) under scipy's BDF and Radau with "
-                                    "cam.fmu's directional derivatives against differencing: right-hand sides, wall"),
+    "jacobian": ("jacobian", False, "stiff runs (L = 1 mH, rigid and compliant) and a run through events (backlash, "
+                                    "closure form) under scipy's BDF and Radau with cam.fmu's directional derivatives "
+                                    "against differencing: right-hand sides, wall"),
 }
 DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
 
