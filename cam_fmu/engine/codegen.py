@@ -245,6 +245,10 @@ def contract_header() -> str:
     lines += ["/* The saved state: CAM_STATE_LEN doubles, entry CAM_S_<name> from index CAM_S_<name> on. */", "enum {"]
     lines += [f"    CAM_S_{name} = {index}," for name, index in slots.items() if name != "END"]
     lines += [f"    CAM_S_END = {slots['END']}", "};",
+              "/* How many doubles each entry holds (CAM_S_<name>_N). */", "enum {"]
+    lines += [f"    CAM_S_{name}_N = {count}," for name, count in contract.STATE_LAYOUT]
+    lines[-1] = lines[-1].rstrip(",")
+    lines += ["};",
               f"#define CAM_STATE_VERSION {contract.STATE_VERSION!r}   /* the layout's format version */",
               f"#define CAM_STATE_LEN {contract.STATE_LEN}   /* CAM_S_END and room for entries a later version adds */",
               "", "/* The name of event code `code` (\"stop\"), or NULL. */", "const char *cam_event_name(int code);",
