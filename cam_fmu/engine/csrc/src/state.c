@@ -92,17 +92,21 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
         return cam_error(err, CAM_ERR_SIMULATION, "state has an energy account, but the %s drive keeps none",
                          d->form->name);
     if (m->free_follower) {
-        double contact = s[CAM_S_SPEED + 4];
+        CamSpeedState saved;   /* the entry as the drive's struct (a run of doubles: checked above) */
+        double contact, left, sigma;
+        memcpy(&saved, s + CAM_S_SPEED, sizeof saved);
+        contact = saved.contact, left = saved.left, sigma = saved.sigma;
         if (!(contact == 0.0 || contact == 1.0 || (contact == -1.0 && m->closure == CAM_CHOICE_CLOSURE_FORM)))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
                              "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
                              ? " or -1 (on the groove's other flank)" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && s[CAM_S_SPEED + 8] != 1.0 && s[CAM_S_SPEED + 8] != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
+        if (m->formulation == CAM_FORM_CONSISTENT && left != 1.0
+            && left != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %s: allowed +1%s",
-                             cam_num(s[CAM_S_SPEED + 8], a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && !(s[CAM_S_SPEED + 9] == 0.0 || fabs(s[CAM_S_SPEED + 9]) == 1.0))
+                             cam_num(left, a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
+        if (m->formulation == CAM_FORM_CONSISTENT && !(sigma == 0.0 || fabs(sigma) == 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower direction in flight %s: allowed -1, 0, +1",
-                             cam_num(s[CAM_S_SPEED + 9], a));
+                             cam_num(sigma, a));
     }
     if (m->formulation != CAM_FORM_CONSISTENT)
         return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */
