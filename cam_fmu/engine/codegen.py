@@ -222,6 +222,10 @@ def contract_header() -> str:
              "/* Slots of the continuous state x; a rigid drive carries the first CAM_NX_RIGID. */", "enum {"]
     lines += [f"    CAM_{name} = {k},   /* Model Exchange's {state} */" for k, (name, state) in enumerate(contract.X_SLOTS)]
     lines += [f"    CAM_NX = {contract.NX}, CAM_NX_RIGID = {contract.NX_RIGID}", "};", "",
+              "/* Model Exchange's states after x[CAM_NX] (the voltage drive's free follower), then their count. */",
+              "enum {"]
+    lines += [f"    CAM_ME_{name} = {contract.NX + k},   /* {state} */" for k, (name, state) in enumerate(contract.ME_SLOTS)]
+    lines += [f"    CAM_ME_NX = {contract.NX + len(contract.ME_SLOTS)}", "};", "",
               "/* Event codes (physics/formulations/consistent.py EVENT_NAMES, in order; names: cam_event_name). */",
               "enum {"]
     lines += [f"    {contract.event_c_name(name)} = {k}," for k, name in enumerate(contract.event_names())]
@@ -245,6 +249,10 @@ def contract_header() -> str:
     lines += ["/* The saved state: CAM_STATE_LEN doubles, entry CAM_S_<name> from index CAM_S_<name> on. */", "enum {"]
     lines += [f"    CAM_S_{name} = {index}," for name, index in slots.items() if name != "END"]
     lines += [f"    CAM_S_END = {slots['END']}", "};",
+              "/* How many doubles each entry holds (CAM_S_<name>_N). */", "enum {"]
+    lines += [f"    CAM_S_{name}_N = {count}," for name, count in contract.STATE_LAYOUT]
+    lines[-1] = lines[-1].rstrip(",")
+    lines += ["};",
               f"#define CAM_STATE_VERSION {contract.STATE_VERSION!r}   /* the layout's format version */",
               f"#define CAM_STATE_LEN {contract.STATE_LEN}   /* CAM_S_END and room for entries a later version adds */",
               "", "/* The name of event code `code` (\"stop\"), or NULL. */", "const char *cam_event_name(int code);",

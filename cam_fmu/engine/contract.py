@@ -19,6 +19,9 @@ from ..physics.variables import STATES
 X_SLOTS: tuple[tuple[str, str], ...] = (("THETA", "x_theta"), ("OMEGA", "x_omega"), ("CURRENT", "x_i"),
                                         ("TWIST", "x_twist"), ("OMEGA_M", "x_omega_m"))
 NX = len(X_SLOTS)
+# Model Exchange's states after x (physics.variables.STATES, in order): the voltage drive's free follower's gap to
+# the flank it left last and the gap's rate (docs/model.md 13.6), held at 0 in contact and without one.
+ME_SLOTS: tuple[tuple[str, str], ...] = (("GAP", "x_gap"), ("RATE", "x_gap_rate"))
 NX_RIGID = 3
 MAX_EVENTS = 3          # event functions a mode has active at once at most (cam_event_codes)
 MESSAGE_LEN = 1024      # bytes of an error's message
@@ -148,5 +151,6 @@ def structure(name: str) -> type:
 
 
 def check_states() -> None:
-    """X_SLOTS name Model Exchange's first states, in order (physics.variables.STATES)."""
-    assert [s[1] for s in X_SLOTS] == [row[0] for row in STATES[:NX]], "X_SLOTS and physics.variables.STATES"
+    """X_SLOTS then ME_SLOTS name Model Exchange's states, in order (physics.variables.STATES)."""
+    assert [s[1] for s in X_SLOTS + ME_SLOTS] == [row[0] for row in STATES], \
+        "X_SLOTS, ME_SLOTS and physics.variables.STATES"

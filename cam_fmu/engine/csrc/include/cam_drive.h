@@ -155,7 +155,7 @@ typedef struct CamDrive {
  * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
  * follower's states, events and transitions are its formulation's hooks (CamExchangeHooks, voltage_follower_events.c);
  * exchange.c drives them. */
-enum { CAM_ME_GAP = CAM_NX, CAM_ME_RATE = CAM_NX + 1, CAM_ME_NX = CAM_NX + 2, CAM_VF_ME_EVENTS = 3,
+enum { CAM_VF_ME_EVENTS = 3,   /* (CAM_ME_GAP, CAM_ME_RATE, CAM_ME_NX: generated, engine/contract.py ME_SLOTS) */
        CAM_VF_BREAK_AWAY = EV_BREAK_AWAY /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);

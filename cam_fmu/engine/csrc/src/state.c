@@ -1,58 +1,55 @@
 /* The drive's state as a flat, versioned array of doubles (the CAM_S_* slots of cam_drive.h), and its
  * restoration with every entry checked before use (DriveSimulator.get_state/set_state in engine/simulator.py). */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "cam_drive.h"
 
+/* The saved state's entries that are the drive's doubles as they stand (engine/contract.py STATE_LAYOUT): slot,
+ * member, doubles; the energy account's comes last (restored only with an account). */
+typedef struct {
+    int slot, count;
+    size_t offset;
+} StateEntry;
+#define ENTRY_OF(name, member) {CAM_S_##name, CAM_S_##name##_N, offsetof(CamDrive, member)}
+static const StateEntry PLAIN[] = {
+    ENTRY_OF(TIME, time), ENTRY_OF(U, u), ENTRY_OF(OMEGA_REF, omega_ref), ENTRY_OF(OMEGA_DOT_REF, omega_dot_ref),
+    ENTRY_OF(H_NEXT, solver.h_next), ENTRY_OF(X, x), ENTRY_OF(FORM_U, form_u), ENTRY_OF(PAPER, paper),
+    ENTRY_OF(SPEED, speed), {CAM_S_WORK_IN, CAM_S_E_MAG0 + 1 - CAM_S_WORK_IN, offsetof(CamDrive, budget.work_in)}};
+#define N_PLAIN ((int)(sizeof PLAIN / sizeof PLAIN[0]))
+/* the members the layout copies as runs of doubles are such runs (a compile error otherwise) */
+typedef char layout_matches_drive[(sizeof(CamPaperState) == CAM_S_PAPER_N * sizeof(double)
+                                   && sizeof(CamSpeedState) == CAM_S_SPEED_N * sizeof(double)
+                                   && sizeof(((CamDrive *)0)->x) == CAM_S_X_N * sizeof(double)
+                                   && offsetof(CamEnergy, e_mag0) - offsetof(CamEnergy, work_in)
+                                          == (CAM_S_E_MAG0 - CAM_S_WORK_IN) * sizeof(double)) ? 1 : -1];
+
+/* Copy entries [first, last) of PLAIN from the drive into the saved state (into_state), or back. */
+static void copy_plain(const void *from, void *to, int first, int last, int into_state)
+{
+    int k;
+    for (k = first; k < last; k++) {
+        size_t drive_at = PLAIN[k].offset, state_at = (size_t)PLAIN[k].slot * sizeof(double);
+        memcpy((char *)to + (into_state ? state_at : drive_at),
+               (const char *)from + (into_state ? drive_at : state_at), (size_t)PLAIN[k].count * sizeof(double));
+    }
+}
+
 void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
 {
-    const CamPaperState *p = &d->paper;
     memset(s, 0, sizeof(double) * CAM_STATE_LEN);
     s[CAM_S_VERSION] = CAM_STATE_VERSION;
     s[CAM_S_FORMULATION] = (double)d->model.formulation;
-    s[CAM_S_TIME] = d->time;
-    s[CAM_S_U] = d->u;
-    s[CAM_S_OMEGA_REF] = d->omega_ref;
-    s[CAM_S_OMEGA_DOT_REF] = d->omega_dot_ref;
-    s[CAM_S_H_NEXT] = d->solver.h_next;
     s[CAM_S_STEPS_TAKEN] = (double)d->steps_taken;
-    memcpy(s + CAM_S_X, d->x, sizeof d->x);
+    copy_plain(d, s, 0, N_PLAIN, 1);
     s[CAM_S_STUCK] = d->mode.stuck ? 1.0 : 0.0;
     s[CAM_S_DIRECTION] = d->mode.direction;
     s[CAM_S_CONTACT] = (double)d->mode.contact;
     s[CAM_S_S_FREE] = d->mode.s_free;
     s[CAM_S_SIDE] = d->mode.side;
-    s[CAM_S_FORM_U] = d->form_u;
     s[CAM_S_HAVE_BUDGET] = d->have_budget ? 1.0 : 0.0;
-    s[CAM_S_WORK_IN] = d->budget.work_in;
-    s[CAM_S_WORK_ABS] = d->budget.work_abs;
-    s[CAM_S_BUDGET_THETA] = d->budget.theta;
-    s[CAM_S_BUDGET_I] = d->budget.i;
-    s[CAM_S_E_MECH0] = d->budget.e_mech0;
-    s[CAM_S_E_MAG0] = d->budget.e_mag0;
-    s[CAM_S_PAPER + 0] = p->theta;
-    s[CAM_S_PAPER + 1] = p->omega;
-    s[CAM_S_PAPER + 2] = p->i;
-    s[CAM_S_PAPER + 3] = p->J;
-    s[CAM_S_PAPER + 4] = p->M;
-    s[CAM_S_PAPER + 5] = p->s;
-    s[CAM_S_PAPER + 6] = p->v;
-    s[CAM_S_PAPER + 7] = p->a;
-    s[CAM_S_PAPER + 8] = p->alpha;
-    s[CAM_S_PAPER + 9] = p->voltage;
-    s[CAM_S_PAPER + 10] = p->M_l;
-    s[CAM_S_SPEED + 0] = d->speed.theta;
-    s[CAM_S_SPEED + 1] = d->speed.s;
-    s[CAM_S_SPEED + 2] = d->speed.speed;
-    s[CAM_S_SPEED + 3] = d->speed.v;
-    s[CAM_S_SPEED + 4] = d->speed.contact;
-    s[CAM_S_SPEED + 5] = d->speed.impacts;
-    s[CAM_S_SPEED + 6] = d->speed.rebound;
-    s[CAM_S_SPEED + 7] = d->speed.fresh;
-    s[CAM_S_SPEED + 8] = d->speed.left;
-    s[CAM_S_SPEED + 9] = d->speed.sigma;
 }
 
 static const char *const ENTRY[] = {"version", "formulation", "time", "u", "omega_ref", "omega_dot_ref", "h_next",
@@ -62,47 +59,15 @@ static const char *const ENTRY[] = {"version", "formulation", "time", "u", "omeg
 static void apply_state(CamDrive *d, const double s[CAM_STATE_LEN], const CamMode *mode)
 {
     d->stale = 1;
-    d->time = s[CAM_S_TIME];
-    d->u = s[CAM_S_U];
-    d->omega_ref = s[CAM_S_OMEGA_REF];
-    d->omega_dot_ref = s[CAM_S_OMEGA_DOT_REF];
-    d->solver.h_next = s[CAM_S_H_NEXT];
+    copy_plain(s, d, 0, N_PLAIN - 1, 0);
     d->solver.k1_valid = 0;
     d->steps_taken = (long)s[CAM_S_STEPS_TAKEN];
-    memcpy(d->x, s + CAM_S_X, sizeof d->x);
     d->mode = *mode;
-    d->form_u = s[CAM_S_FORM_U];
-    d->paper.theta = s[CAM_S_PAPER + 0];
-    d->paper.omega = s[CAM_S_PAPER + 1];
-    d->paper.i = s[CAM_S_PAPER + 2];
-    d->paper.J = s[CAM_S_PAPER + 3];
-    d->paper.M = s[CAM_S_PAPER + 4];
-    d->paper.s = s[CAM_S_PAPER + 5];
-    d->paper.v = s[CAM_S_PAPER + 6];
-    d->paper.a = s[CAM_S_PAPER + 7];
-    d->paper.alpha = s[CAM_S_PAPER + 8];
-    d->paper.voltage = s[CAM_S_PAPER + 9];
-    d->paper.M_l = s[CAM_S_PAPER + 10];
-    d->speed.theta = s[CAM_S_SPEED + 0];
-    d->speed.s = s[CAM_S_SPEED + 1];
-    d->speed.speed = s[CAM_S_SPEED + 2];
-    d->speed.v = s[CAM_S_SPEED + 3];
-    d->speed.contact = s[CAM_S_SPEED + 4];
-    d->speed.impacts = s[CAM_S_SPEED + 5];
-    d->speed.rebound = s[CAM_S_SPEED + 6];
-    d->speed.fresh = s[CAM_S_SPEED + 7];
-    d->speed.left = s[CAM_S_SPEED + 8];
-    d->speed.sigma = s[CAM_S_SPEED + 9];
     d->have_budget = s[CAM_S_HAVE_BUDGET] != 0.0;
     if (d->have_budget) {
         const double *out = cam_drive_outputs(d);
         cam_energy_init(&d->budget, &d->model, out);
-        d->budget.work_in = s[CAM_S_WORK_IN];
-        d->budget.work_abs = s[CAM_S_WORK_ABS];
-        d->budget.theta = s[CAM_S_BUDGET_THETA];
-        d->budget.i = s[CAM_S_BUDGET_I];
-        d->budget.e_mech0 = s[CAM_S_E_MECH0];
-        d->budget.e_mag0 = s[CAM_S_E_MAG0];
+        copy_plain(s, d, N_PLAIN - 1, N_PLAIN, 0);
     }
 }
 
@@ -127,17 +92,21 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
         return cam_error(err, CAM_ERR_SIMULATION, "state has an energy account, but the %s drive keeps none",
                          d->form->name);
     if (m->free_follower) {
-        double contact = s[CAM_S_SPEED + 4];
+        CamSpeedState saved;   /* the entry as the drive's struct (a run of doubles: checked above) */
+        double contact, left, sigma;
+        memcpy(&saved, s + CAM_S_SPEED, sizeof saved);
+        contact = saved.contact, left = saved.left, sigma = saved.sigma;
         if (!(contact == 0.0 || contact == 1.0 || (contact == -1.0 && m->closure == CAM_CHOICE_CLOSURE_FORM)))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
                              "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
                              ? " or -1 (on the groove's other flank)" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && s[CAM_S_SPEED + 8] != 1.0 && s[CAM_S_SPEED + 8] != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
+        if (m->formulation == CAM_FORM_CONSISTENT && left != 1.0
+            && left != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %s: allowed +1%s",
-                             cam_num(s[CAM_S_SPEED + 8], a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && !(s[CAM_S_SPEED + 9] == 0.0 || fabs(s[CAM_S_SPEED + 9]) == 1.0))
+                             cam_num(left, a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
+        if (m->formulation == CAM_FORM_CONSISTENT && !(sigma == 0.0 || fabs(sigma) == 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower direction in flight %s: allowed -1, 0, +1",
-                             cam_num(s[CAM_S_SPEED + 9], a));
+                             cam_num(sigma, a));
     }
     if (m->formulation != CAM_FORM_CONSISTENT)
         return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */
