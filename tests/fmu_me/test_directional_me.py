@@ -267,27 +267,40 @@ def test_directional_derivatives_match_central_differences(engine_fmu_path, case
     rng = np.random.default_rng(42)
     me = Me(engine_fmu_path, CASES[case])
     stuck = CASES[case].get("omega0", 1.0) == 0.0
-    checked = 0
+
+    def draw() -> None:
+        random_states(me, rng, stuck)
+
+    def mode_holds(analytic: np.ndarray) -> None:
+        if case in FOLLOWER:   # the mode the case is named for: the gap's rate moves the gap only in flight
+            gap_by_rate = analytic[[row[0] for row in STATES].index("x_gap"), NX - 1]
+            assert gap_by_rate == (1.0 if case in FLIGHT else 0.0), (case, gap_by_rate)
+        assert np.abs(analytic).max() > 0.0
+
     try:
-        for _ in range(40):
-            random_states(me, rng, stuck)
-            fd = smooth_differences(me)
-            if fd is None:
-                continue
-            analytic = me.jacobian()
-            if case in FOLLOWER:   # the mode the case is named for: the gap's rate moves the gap only in flight
-                gap_by_rate = analytic[[row[0] for row in STATES].index("x_gap"), NX - 1]
-                assert gap_by_rate == (1.0 if case in FLIGHT else 0.0), (case, gap_by_rate)
-            scale = np.abs(fd).max(axis=1, keepdims=True)
-            err = np.abs(analytic - fd)
-            assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
-            assert np.abs(analytic).max() > 0.0
-            checked += 1
-            if checked == 4:
-                break
+        assert_matches_differences(me, case, draw, mode_holds)
     finally:
         me.close()
-    assert checked == 4
+
+
+def assert_matches_differences(me: Me, case: str, draw, check_analytic) -> None:
+    """At 4 of up to 40 states that draw() sets, where differences at two steps agree (away from events and
+    breakpoints): the analytic Jacobian against them to RTOL of each row's largest entry, and check_analytic on it."""
+    checked = 0
+    for _ in range(40):
+        draw()
+        fd = smooth_differences(me)
+        if fd is None:
+            continue
+        analytic = me.jacobian()
+        check_analytic(analytic)
+        scale = np.abs(fd).max(axis=1, keepdims=True)
+        err = np.abs(analytic - fd)
+        assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
+        checked += 1
+        if checked == 4:
+            return
+    raise AssertionError(f"{case}: fewer than 4 states away from events and breakpoints")
 
 
 @pytest.mark.parametrize("case", list(FOLLOWER_CASES))
@@ -299,26 +312,18 @@ def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_pa
     start, mode, speed = FOLLOWER_CASES[case]
     rng = np.random.default_rng(11)
     me = Me(engine_fmu_path, start)
-    checked = 0
+    def draw() -> None:
+        random_follower_state(me, rng, mode, start.get("c", 1e-3))
+        assert_follower_mode(me.x(), me.f()[:NX], mode)
+
+    def moving(analytic: np.ndarray) -> None:
+        assert np.abs(analytic[NX - 1 if mode == "flight" else slice(None)]).max() > 0.0
+
     try:
         enter_follower_mode(me, mode, speed)
-        for _ in range(40):
-            random_follower_state(me, rng, mode, start.get("c", 1e-3))
-            assert_follower_mode(me.x(), me.f()[:NX], mode)
-            fd = smooth_differences(me)
-            if fd is None:
-                continue
-            analytic = me.jacobian()
-            scale = np.abs(fd).max(axis=1, keepdims=True)
-            err = np.abs(analytic - fd)
-            assert np.all(err <= RTOL * scale + 1e-12), (case, np.argwhere(err > RTOL * scale + 1e-12))
-            assert np.abs(analytic[NX - 1 if mode == "flight" else slice(None)]).max() > 0.0
-            checked += 1
-            if checked == 4:
-                break
+        assert_matches_differences(me, case, draw, moving)
     finally:
         me.close()
-    assert checked == 4
 
 
 def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
