@@ -231,13 +231,15 @@ class DriveModel:
         g = self.guide_terms(theta, omega, torque - self.M_f * direction, direction, side)
         return g.n0 + g.sigma * g.kappa * g.f
 
-    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
+    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True,
+             axial: float = 0.0) -> LoadState:
         """Load torque, inertia and follower motion for a known omega_dot [rad/s2] (docs/model.md 4.1-4.3).
 
         v = s' omega, a = s'' omega^2 + s' omega_dot; the guide friction with
         kappa = tan(alpha) (omega_dot given, no coupling left); M = M_f d +
         (m a - F_gx + sigma f) s' and the normal force N = (m a - F_gx + sigma f) / cos(alpha).
-        Free in the gap (``engaged`` False): only M_f d and J_m, N = 0.
+        Free in the gap (``engaged`` False): only M_f d and J_m, N = 0. ``axial`` [N] is a further force on the
+        follower against X (the follower train's F_train, docs/model.md 14.6), added to m a - F_gx.
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (self.r_b + s)
@@ -249,6 +251,8 @@ class DriveModel:
         a = s2 * omega * omega + s1 * omega_dot
         sigma = sign(s1 * direction)
         push = self.m * a - self.F_gx  # N, axial force without friction
+        if axial:
+            push += axial
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
         M = shaft + (push + sigma * f) * s1
         J = self.J_0 + self.m * s1 * s1

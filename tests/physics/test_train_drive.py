@@ -1,0 +1,123 @@
+"""The follower train inside the speed drive's reference (docs/model.md 14.6), against independent sources: the
+residual's closed form, the energy balance, the rigid drive with the end mass added to the follower, and today's
+reference with no train."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import simpson
+
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.parameters import ParameterError
+from cam_fmu.physics.signals import constant
+from cam_fmu.physics.train import G_N, Train
+from cam_fmu.reference import simulate_reference
+
+OMEGA = 10.0  # rad/s, the imposed speed
+RISE = math.pi / 2  # rad
+T_R = RISE / OMEGA  # s, the rise time
+TURN = 2.0 * math.pi / OMEGA  # s
+# Cycloidal rise over 90 deg, then dwells and a cycloidal return: speed drive, horizontal mounting unless said.
+SCENE = dict(drive="speed", rise_law="cycloidal", return_law="cycloidal", rise_angle=RISE, upper_dwell=RISE,
+             return_angle=RISE, lower_dwell=RISE, gravity=False)
+VERTICAL = dict(SCENE, gravity=True, gamma=math.pi / 2, beta=0.0)  # X points along gravity: the weights pull along X
+
+
+def cycloidal_residual(r: float) -> float:
+    """The undamped residual / lift after a cycloidal rise, |sin(pi r)| / (pi r |r^2 - 1|) (1/2 at r = 1)."""
+    return 0.5 if r == 1.0 else abs(math.sin(math.pi * r)) / (math.pi * r * abs(r * r - 1.0))
+
+
+@pytest.mark.parametrize("r", [1.0, 1.5, 2.0, 2.5, 3.3, 4.0, 4.75, 6.0])
+def test_residual_after_a_cycloidal_rise_is_the_closed_form(r):
+    """Undamped: the end mass rings freely in the dwell; its amplitude sqrt(e^2 + (v_end / w_n)^2), e = s_end - h,
+    read at the dwell's end, over the lift, is the closed form (to 1e-9 here; the issue asks 1e-4)."""
+    w_n = 2.0 * math.pi * r / T_R
+    train = Train(k_train=w_n * w_n * 2.0, m_end=2.0)
+    out = simulate_reference(SCENE, 2.0 * T_R, T_R / 10, omega_ref=constant(OMEGA), train=train)
+    h = DriveModel(SCENE).params["lift"]
+    assert out["s"][-1] == pytest.approx(h, abs=1e-15)  # in the dwell
+    e, v = out["s_end"][-1] - h, out["v_end"][-1]
+    assert abs(math.hypot(e, v / w_n) / h - cycloidal_residual(r)) < 1e-9
+
+
+def test_train_energy_balance_and_the_motor_does_the_work():
+    """Damped (zeta 0.05), under gravity, over a turn: the train's energy, end mass's kinetic + spring - the end
+    mass's weight's potential + the damper's loss, changes by the work the follower does on it (W_train); and that
+    work is what the load torque adds, int (M - M_rigid) omega dt (Simpson on the outputs), M_rigid the same drive
+    without the train (no guide friction, which the train's force would change)."""
+    scene = dict(VERTICAL, guide_friction=False)
+    m_e, w_n = 0.5, 2.0 * math.pi * 2.5 / T_R
+    k = m_e * w_n * w_n
+    train = Train(k_train=k, d_train=2.0 * 0.05 * math.sqrt(k * m_e), m_end=m_e)
+    dt = TURN / 20000
+    out = simulate_reference(scene, TURN, dt, omega_ref=constant(OMEGA), train=train)
+    rigid = simulate_reference(scene, TURN, dt, omega_ref=constant(OMEGA))
+    F_ex = m_e * G_N
+    stored = (0.5 * m_e * out["v_end"] ** 2 + 0.5 * k * (out["s"] - out["s_end"]) ** 2 - F_ex * out["s_end"]
+              + out["E_train_damp"])
+    scale = np.max(np.abs(out["W_train"]))
+    assert scale > 1.0  # J: the train does work
+    assert out["E_train_damp"][-1] > 1e-3 * scale  # the damper dissipates
+    assert np.max(np.abs(stored - stored[0] - out["W_train"])) < 1e-9 * scale
+    motor_work = simpson((out["M"] - rigid["M"]) * OMEGA, x=out["time"])
+    assert motor_work == pytest.approx(out["W_train"][-1], rel=1e-6, abs=1e-8 * scale)
+    assert np.array_equal(out["theta"], rigid["theta"])
+
+
+def test_stiff_train_converges_to_the_rigid_drive_with_the_end_mass_on_the_follower():
+    """k_train -> infinity: the drive with the end mass m_end carried by the follower (m + m_end, weight G + m_end
+    g_n). Over the rise the load torque's difference is m_end (a_end - a) s', and a_end - a = -j0 sin(w_n t) / w_n
+    + O(1/w_n^2): the cycloidal's jerk jumps from 0 to j0 = 4 pi^2 h / t_r^3 at the start and rings the train,
+    so the torque converges as k^-1/2; the end mass's lag behind the follower is the spring's static deflection
+    m_end a / k: as 1/k."""
+    m_e = 0.5
+    model = DriveModel(VERTICAL)
+    p = model.params
+    rigid = simulate_reference(dict(VERTICAL, m=p["m"] + m_e, G=p["G"] + m_e * G_N), T_R, T_R / 400,
+                               omega_ref=constant(OMEGA))
+    j0 = 4.0 * math.pi ** 2 * p["lift"] / T_R ** 3
+    torque, lag = [], []
+    for k in (1e6, 1e7, 1e8):
+        out = simulate_reference(VERTICAL, T_R, T_R / 400, omega_ref=constant(OMEGA),
+                                 train=Train(k_train=k, m_end=m_e))
+        w_n, t = math.sqrt(k / m_e), out["time"]
+        s1 = np.array([model.program.derivatives(theta)[1] for theta in out["theta"]])
+        dM = out["M"] - rigid["M"]
+        lead = -m_e * j0 * np.sin(w_n * t) / w_n * s1
+        assert np.max(np.abs(dM - lead)) < 1e4 / w_n ** 2  # the next order (measured 5.0e3 .. 7.0e3 / w_n^2)
+        torque.append(np.max(np.abs(dM)))
+        lag.append(np.max(np.abs(out["s_end"] - rigid["s"])))
+    for a, b in zip(torque[:-1], torque[1:]):
+        assert b / a == pytest.approx(10 ** -0.5, rel=0.03)
+    for a, b in zip(lag[:-1], lag[1:]):
+        assert b / a == pytest.approx(0.1, rel=0.03)
+
+
+@pytest.mark.parametrize("drive", ["speed", "voltage"])
+def test_no_train_is_the_rigid_reference_bit_for_bit(drive):
+    """Train() (k_train = 0) and no train give today's reference, every output bit for bit."""
+    scene = dict(VERTICAL, drive=drive)
+    kwargs = dict(omega_ref=constant(OMEGA), u=constant(12.0))
+    plain = simulate_reference(scene, TURN / 4, TURN / 50, **kwargs)
+    zero = simulate_reference(scene, TURN / 4, TURN / 50, train=Train(d_train=3.0, m_end=1.0), **kwargs)
+    assert plain.keys() == zero.keys() and "F_train" not in plain
+    for name in plain:
+        assert np.array_equal(plain[name], zero[name]), name
+
+
+@pytest.mark.parametrize("fields, word", [(dict(k_train=-1.0), "k_train"), (dict(d_train=math.nan), "d_train"),
+                                          (dict(k_train=1e6, m_end=0.0), "m_end")])
+def test_bad_train_is_refused_by_name(fields, word):
+    with pytest.raises(ParameterError, match=word):
+        Train(**fields)
+
+
+@pytest.mark.parametrize("scene, word", [(dict(SCENE, drive="voltage"), "drive"),
+                                         (dict(SCENE, closure="spring"), "closure"),
+                                         (dict(SCENE, backlash=True, c=1e-4), "'c'")])
+def test_train_where_the_reference_cannot_run_it_is_refused(scene, word):
+    with pytest.raises(ParameterError, match=word):
+        simulate_reference(scene, T_R, T_R / 10, omega_ref=constant(OMEGA), train=Train(k_train=1e6, m_end=1.0))
