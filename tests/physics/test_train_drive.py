@@ -121,3 +121,22 @@ def test_bad_train_is_refused_by_name(fields, word):
 def test_train_where_the_reference_cannot_run_it_is_refused(scene, word):
     with pytest.raises(ParameterError, match=word):
         simulate_reference(scene, T_R, T_R / 10, omega_ref=constant(OMEGA), train=Train(k_train=1e6, m_end=1.0))
+
+
+def test_inductance_voltage_carries_the_trains_force_rate():
+    """Speed drive with L > 0: the voltage needed is R i + c_e omega + L di/dt, with i carrying F_train s' / c_m; the
+    L di/dt part, (voltage - R i - c_e omega) / L, equals the current's slope by central differences on the outputs
+    (damped train, under gravity, during the rise: the train's force changes in time, not only with theta). No
+    guide friction: where its side force changes sign the current has a kink, which central differences straddle."""
+    scene = dict(VERTICAL, inductance=True, L=5e-3, guide_friction=False)
+    model = DriveModel(scene)
+    m_e, w_n = 0.5, 2.0 * math.pi * 2.5 / T_R
+    k = m_e * w_n * w_n
+    train = Train(k_train=k, d_train=2.0 * 0.05 * math.sqrt(k * m_e), m_end=m_e)
+    dt = T_R / 4000
+    out = simulate_reference(scene, T_R, dt, omega_ref=constant(OMEGA), train=train)
+    i, u = out["i"], out["voltage"]
+    slope = (i[2:] - i[:-2]) / (2.0 * dt)  # A/s, O(dt^2)
+    rate = (u - model.R * i - model.c_e * OMEGA) / model.L
+    assert np.max(np.abs(slope)) > 10.0  # the current does change
+    assert np.max(np.abs(rate[1:-1] - slope)) < 1e-5 * np.max(np.abs(slope))

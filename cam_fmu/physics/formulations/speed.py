@@ -30,8 +30,11 @@ def speed_drive_outputs(model: DriveModel, theta: float, omega: float, omega_dot
         dM = (model.load(theta + d, omega, omega_dot, direction, engaged, axial).M
               - model.load(theta - d, omega, omega_dot, direction, engaged, axial).M) / (2 * d)
         voltage += model.L * omega * dM / model.c_m
-        if axial_rate:  # the train's force changes in time too: M = ... + F_train s'
-            voltage += model.L * axial_rate * model.program.derivatives(theta)[1] / model.c_m
+        if axial_rate:  # the train's force changes in time too: dM/dF_train = s' (1 + sigma df/dF_train), linear
+            e = 1e-6 * max(1.0, abs(axial))  # on the friction's branch: the central difference is exact there
+            dM_dF = (model.load(theta, omega, omega_dot, direction, engaged, axial + e).M
+                     - model.load(theta, omega, omega_dot, direction, engaged, axial - e).M) / (2 * e)
+            voltage += model.L * axial_rate * dM_dF / model.c_m
     s_cam = model.program.derivatives(theta)[0]
     return output_record(omega=omega, theta=theta, s=s, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
                          alpha=load.alpha, s_cam=s_cam, voltage=voltage, N_contact=load.N,
