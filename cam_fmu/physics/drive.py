@@ -178,17 +178,21 @@ class DriveModel:
             check_self_locking(self.program, self.mu, self.r_b)
 
     # ----------------------------------------------------------- mechanics
-    def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float) -> GuideTerms:
+    def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float,
+                    axial: float = 0.0) -> GuideTerms:
         """The consistent equation's terms at theta [rad], omega [rad/s] (docs/model.md 4.4 and 5.1).
 
         ``drive`` is the shaft's torque c_m i - M_f d [N m]. Without guide friction
         the terms after x0 are 0; with it, f solves the coupling of f and omega_dot
-        exactly (``solve_guide_friction`` with kappa' = (J_m / J) tan(alpha)).
+        exactly (``solve_guide_friction`` with kappa' = (J_m / J) tan(alpha)). ``axial`` [N]: a further force on
+        the follower against X that does not depend on omega_dot (the follower train's F_train, docs/model.md 14.6).
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         m = self.m
         J = self.J_0 + m * s1 * s1
         inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
+        if axial:
+            inertial += axial
         x0 = (drive - inertial * s1) / J
         if self.mu == 0.0:
             return GuideTerms(J, s1, x0, 0.0, 0.0, 0.0, 0.0)
@@ -200,7 +204,7 @@ class DriveModel:
         return GuideTerms(J, s1, x0, sigma, f, n0, kappa)
 
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
-                  side: float = 0.0) -> float:
+                  side: float = 0.0, axial: float = 0.0) -> float:
         """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5.1).
 
         omega_dot = (c_m i - M_f d - (m s'' omega^2 - F_gx) s' - sigma f s') / (J_m + m s'^2).
@@ -209,12 +213,13 @@ class DriveModel:
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
         False means the follower is free in the backlash gap (J = J_m, no load).
         ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
-        branch, held between events so the right-hand side is smooth); 0 chooses it.
+        branch, held between events so the right-hand side is smooth); 0 chooses it. ``axial`` [N]: the follower
+        train's force on the follower, against X (docs/model.md 14.6).
         """
         drive = torque - self.M_f * direction
-        if not (engaged and self.follower):
+        if not (engaged and (self.follower or axial)):
             return drive / self.J_0
-        g = self.guide_terms(theta, omega, drive, direction, side)
+        g = self.guide_terms(theta, omega, drive, direction, side, axial)
         if self.mu == 0.0:
             return g.x0
         return g.x0 - g.sigma * g.f * g.s1 / g.J

@@ -34,6 +34,7 @@ from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .train_speed import speed_train_reference
+from .train_voltage import voltage_train_reference
 from .voltage_flight import follower_voltage_reference
 
 
@@ -53,17 +54,19 @@ def simulate_reference(
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
 
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6); None or k_train = 0 is the rigid drive,
-    bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS (the speed drive only, so far)."""
+    bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS (the speed drive; the voltage drive
+    without friction, reference/train_voltage.py)."""
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
     grid = _grid(stop_time, output_interval)
-    if train is not None and train.active:
-        if formulation_name(model) != "speed":
-            raise ParameterError("the follower train runs in the speed drive only so far (parameter 'drive' = "
-                                 "'speed'): the voltage drive with a train is not modelled yet")
-        return speed_train_reference(model, grid, omega_ref, train, rtol, atol)
     options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
+    if train is not None and train.active:
+        run = TRAIN_REFERENCES.get(formulation_name(model))
+        if run is None:
+            raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
+                                 f"(parameter 'formulation' = {model.formulation!r})")
+        return run(model, grid, u, omega_ref, train, options)
     return REFERENCES[formulation_name(model)](model, grid, u, omega_ref, options)
 
 
@@ -245,6 +248,18 @@ def _speed_rows(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> list[
     return rows
 
 
+def _speed_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
+                 options: dict) -> dict[str, np.ndarray]:
+    return speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
+
+
+def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
+                   options: dict) -> dict[str, np.ndarray]:
+    return voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
+
+
+# The reference with a follower train, by formulation (docs/model.md 14.6; the paper's scheme has none).
+TRAIN_REFERENCES = {"consistent": _voltage_train, "speed": _speed_train}
 # The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/tools/test_layout.py).
 REFERENCES = {"consistent": _consistent, "paper": _paper, "speed": _speed}
 

@@ -136,7 +136,9 @@ def test_bad_train_is_refused_by_name(fields, word):
         Train(**fields)
 
 
-@pytest.mark.parametrize("scene, word", [(dict(SCENE, drive="voltage"), "drive"),
+@pytest.mark.parametrize("scene, word", [(dict(SCENE, drive="voltage"), "'M_f'"),
+                                         (dict(SCENE, drive="voltage", shaft_friction=False), "'mu'"),
+                                         (dict(SCENE, drive="voltage", formulation="paper"), "formulation"),
                                          (dict(SCENE, closure="spring"), "closure"),
                                          (dict(SCENE, backlash=True, c=1e-4), "'c'")])
 def test_train_where_the_reference_cannot_run_it_is_refused(scene, word):
@@ -161,3 +163,44 @@ def test_inductance_voltage_carries_the_trains_force_rate():
     rate = (u - model.R * i - model.c_e * OMEGA) / model.L
     assert np.max(np.abs(slope)) > 10.0  # the current does change
     assert np.max(np.abs(rate[1:-1] - slope)) < 1e-5 * np.max(np.abs(slope))
+
+
+# The voltage drive without friction, the motor a lossless converter (c_e = c_m: section 9's converter term is 0).
+VOLTAGE = dict(VERTICAL, drive="voltage", shaft_friction=False, guide_friction=False, c_e=0.015 * 9.80665)
+
+
+@pytest.mark.parametrize("inductance", [False, True])
+def test_voltage_drive_with_a_train_balances_the_motors_work(inductance):
+    """Damped train, under gravity, the voltage jumping from 12 V to -6 V (the cam reverses) over 1 s: the drive's
+    stored energy (1/2 J omega^2 + 1/2 L i^2 - F_gx s, DriveModel.energy) plus the train's (end mass kinetic + spring
+    - its weight's potential + damper loss) changes by the electrical work less the copper loss, E_in - E_copper
+    (section 9's balance with the train's spring and damper)."""
+    scene = dict(VOLTAGE, inductance=inductance, L=2e-3)
+    model = DriveModel(scene)
+    m_e, k = 0.5, 1e6
+    train = Train(k_train=k, d_train=2.0 * 0.02 * math.sqrt(k * m_e), m_end=m_e)
+    u = Signal((0.0, 0.3, 0.3, 1.0), (12.0, 12.0, -6.0, -6.0))
+    out = simulate_reference(scene, 1.0, 1e-3, u=u, train=train)
+    drive = np.array([model.energy(*state) for state in zip(out["theta"], out["omega"], out["i"])])
+    stored = drive + (0.5 * m_e * out["v_end"] ** 2 + 0.5 * k * (out["s"] - out["s_end"]) ** 2
+                      - m_e * G_N * out["s_end"] + out["E_train_damp"])
+    work = out["E_in"] - out["E_copper"]
+    assert out["omega"].min() < -50.0 < 50.0 < out["omega"].max()  # rad/s: it turns both ways
+    assert out["E_train_damp"][-1] > 0.0
+    assert np.max(np.abs(stored - stored[0] - work)) < 1e-9 * np.max(np.abs(out["E_in"]))  # measured 1.5e-12
+
+
+def test_voltage_drive_stiff_train_converges_to_the_rigid_drive():
+    """6 V over 0.15 s (about a turn): k_train -> infinity gives the rigid drive with m + m_end and G + m_end g_n.
+    The cam's angle converges as 1/k_train: the torque's k^-1/2 ringing (see the speed drive's test) averages out
+    in the angle, integrated twice, to O(1/k), and the static deflection is O(1/k) too."""
+    model = DriveModel(VOLTAGE)
+    p, m_e = model.params, 0.5
+    rigid = simulate_reference(dict(VOLTAGE, m=p["m"] + m_e, G=p["G"] + m_e * G_N), 0.15, 1e-3, u=constant(6.0))
+    assert rigid["theta"][-1] > 0.5 * RISE  # rad: through the rise
+    errors = []
+    for k in (1e6, 1e7, 1e8):
+        out = simulate_reference(VOLTAGE, 0.15, 1e-3, u=constant(6.0), train=Train(k_train=k, m_end=m_e))
+        errors.append(np.max(np.abs(out["theta"] - rigid["theta"])))
+    for a, b in zip(errors[:-1], errors[1:]):
+        assert b / a == pytest.approx(0.1, rel=0.05)  # measured 0.097, 0.0998
