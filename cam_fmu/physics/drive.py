@@ -178,17 +178,21 @@ class DriveModel:
             check_self_locking(self.program, self.mu, self.r_b)
 
     # ----------------------------------------------------------- mechanics
-    def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float) -> GuideTerms:
+    def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float,
+                    axial: float = 0.0) -> GuideTerms:
         """The consistent equation's terms at theta [rad], omega [rad/s] (docs/model.md 4.4 and 5.1).
 
         ``drive`` is the shaft's torque c_m i - M_f d [N m]. Without guide friction
         the terms after x0 are 0; with it, f solves the coupling of f and omega_dot
-        exactly (``solve_guide_friction`` with kappa' = (J_m / J) tan(alpha)).
+        exactly (``solve_guide_friction`` with kappa' = (J_m / J) tan(alpha)). ``axial`` [N]: a further force on
+        the follower against X that does not depend on omega_dot (the follower train's F_train, docs/model.md 14.6).
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         m = self.m
         J = self.J_0 + m * s1 * s1
         inertial = m * s2 * omega * omega - self.F_gx  # N, axial force of the profile's curvature and gravity
+        if axial:
+            inertial += axial
         x0 = (drive - inertial * s1) / J
         if self.mu == 0.0:
             return GuideTerms(J, s1, x0, 0.0, 0.0, 0.0, 0.0)
@@ -200,7 +204,7 @@ class DriveModel:
         return GuideTerms(J, s1, x0, sigma, f, n0, kappa)
 
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
-                  side: float = 0.0) -> float:
+                  side: float = 0.0, axial: float = 0.0) -> float:
         """Angular acceleration [rad/s2], consistent formulation (docs/model.md section 5.1).
 
         omega_dot = (c_m i - M_f d - (m s'' omega^2 - F_gx) s' - sigma f s') / (J_m + m s'^2).
@@ -209,12 +213,13 @@ class DriveModel:
         or the trial direction of motion when omega = 0 (stiction); ``engaged``
         False means the follower is free in the backlash gap (J = J_m, no load).
         ``side`` +1/-1 fixes the sign of the guide's side force N_r (the friction
-        branch, held between events so the right-hand side is smooth); 0 chooses it.
+        branch, held between events so the right-hand side is smooth); 0 chooses it. ``axial`` [N]: the follower
+        train's force on the follower, against X (docs/model.md 14.6).
         """
         drive = torque - self.M_f * direction
-        if not (engaged and self.follower):
+        if not (engaged and (self.follower or axial)):
             return drive / self.J_0
-        g = self.guide_terms(theta, omega, drive, direction, side)
+        g = self.guide_terms(theta, omega, drive, direction, side, axial)
         if self.mu == 0.0:
             return g.x0
         return g.x0 - g.sigma * g.f * g.s1 / g.J
@@ -231,13 +236,15 @@ class DriveModel:
         g = self.guide_terms(theta, omega, torque - self.M_f * direction, direction, side)
         return g.n0 + g.sigma * g.kappa * g.f
 
-    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True) -> LoadState:
+    def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True,
+             axial: float = 0.0) -> LoadState:
         """Load torque, inertia and follower motion for a known omega_dot [rad/s2] (docs/model.md 4.1-4.3).
 
         v = s' omega, a = s'' omega^2 + s' omega_dot; the guide friction with
         kappa = tan(alpha) (omega_dot given, no coupling left); M = M_f d +
         (m a - F_gx + sigma f) s' and the normal force N = (m a - F_gx + sigma f) / cos(alpha).
-        Free in the gap (``engaged`` False): only M_f d and J_m, N = 0.
+        Free in the gap (``engaged`` False): only M_f d and J_m, N = 0. ``axial`` [N] is a further force on the
+        follower against X (the follower train's F_train, docs/model.md 14.6), added to m a - F_gx.
         """
         s, s1, s2, _ = self.program.derivatives(theta)
         tan_a = s1 / (self.r_b + s)
@@ -249,6 +256,8 @@ class DriveModel:
         a = s2 * omega * omega + s1 * omega_dot
         sigma = sign(s1 * direction)
         push = self.m * a - self.F_gx  # N, axial force without friction
+        if axial:
+            push += axial
         f = solve_guide_friction(push * tan_a + self.G_y, tan_a, sigma, self.mu, self.N_g, 0.0)
         M = shaft + (push + sigma * f) * s1
         J = self.J_0 + self.m * s1 * s1

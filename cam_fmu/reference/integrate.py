@@ -28,9 +28,13 @@ from ..physics.formulations.consistent import EVENT_NAME, EVENTS, HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.modes import Event
+from ..physics.parameters import ParameterError
+from ..physics.train import Train
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
+from .train_speed import speed_train_reference
+from .train_voltage import voltage_train_reference
 from .voltage_flight import follower_voltage_reference
 
 
@@ -45,13 +49,24 @@ def simulate_reference(
     atol: float = 1e-13,
     energy: bool = False,
     method: str | None = None,
+    train: Train | None = None,
 ) -> dict[str, np.ndarray]:
-    """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s]."""
+    """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
+
+    ``train``: the follower train (physics.train.Train, docs/model.md 14.6); None or k_train = 0 is the rigid drive,
+    bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS (the speed drive; the voltage drive
+    without friction, reference/train_voltage.py)."""
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
     grid = _grid(stop_time, output_interval)
     options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
+    if train is not None and train.active:
+        run = TRAIN_REFERENCES.get(formulation_name(model))
+        if run is None:
+            raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
+                                 f"(parameter 'formulation' = {model.formulation!r})")
+        return run(model, grid, u, omega_ref, train, options)
     return REFERENCES[formulation_name(model)](model, grid, u, omega_ref, options)
 
 
@@ -196,9 +211,14 @@ def _paper(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
 
 def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, options: dict) -> dict[str, np.ndarray]:
     """Imposed speed: theta = theta0 + int omega_ref dt (exact for piecewise-linear signals)."""
-    p = model.params
     if model.free_follower:  # the follower's own state
         return follower_speed_reference(model, grid, omega_ref, options["rtol"], options["atol"])
+    return collect(_speed_rows(model, grid, omega_ref), grid)
+
+
+def _speed_rows(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> list[dict[str, float]]:
+    """The speed drive's output rows on ``grid`` (the follower on the cam)."""
+    p = model.params
     theta = p["theta0"]
     s = model.program.derivatives(theta)[0]
 
@@ -225,9 +245,21 @@ def _speed(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, op
         rows.append(speed_drive_outputs(model, theta, omega, omega_dot, s, engaged, sign(motion)))
         if omega_ref.value(t) == 0.0:  # at rest from t on (a stop): there from the next interval, as the FMU's input
             s = rest_position(model.program.derivatives(theta)[0], model.c, model.F_gx, s)
-    return collect(rows, grid)
+    return rows
 
 
+def _speed_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
+                 options: dict) -> dict[str, np.ndarray]:
+    return speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
+
+
+def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
+                   options: dict) -> dict[str, np.ndarray]:
+    return voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
+
+
+# The reference with a follower train, by formulation (docs/model.md 14.6; the paper's scheme has none).
+TRAIN_REFERENCES = {"consistent": _voltage_train, "speed": _speed_train}
 # The reference of each formulation (the keys of physics.formulations.FORMULATIONS; checked by tests/tools/test_layout.py).
 REFERENCES = {"consistent": _consistent, "paper": _paper, "speed": _speed}
 

@@ -1,0 +1,206 @@
+"""The follower train inside the speed drive's reference (docs/model.md 14.6), against independent sources: the
+residual's closed form, the energy balance, the rigid drive with the end mass added to the follower, and today's
+reference with no train."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import simpson
+
+from cam_fmu.physics.drive import DriveModel
+from cam_fmu.physics.parameters import ParameterError
+from cam_fmu.physics.signals import Signal, constant
+from cam_fmu.physics.train import G_N, Train
+from cam_fmu.reference import simulate_reference
+
+OMEGA = 10.0  # rad/s, the imposed speed
+RISE = math.pi / 2  # rad
+T_R = RISE / OMEGA  # s, the rise time
+TURN = 2.0 * math.pi / OMEGA  # s
+# Cycloidal rise over 90 deg, then dwells and a cycloidal return: speed drive, horizontal mounting unless said.
+SCENE = dict(drive="speed", rise_law="cycloidal", return_law="cycloidal", rise_angle=RISE, upper_dwell=RISE,
+             return_angle=RISE, lower_dwell=RISE, gravity=False)
+VERTICAL = dict(SCENE, gravity=True, gamma=math.pi / 2, beta=0.0)  # X points along gravity: the weights pull along X
+
+
+def cycloidal_residual(r: float) -> float:
+    """The undamped residual / lift after a cycloidal rise, |sin(pi r)| / (pi r |r^2 - 1|) (1/2 at r = 1)."""
+    return 0.5 if r == 1.0 else abs(math.sin(math.pi * r)) / (math.pi * r * abs(r * r - 1.0))
+
+
+@pytest.mark.parametrize("r", [1.0, 1.5, 2.0, 2.5, 3.3, 4.0, 4.75, 6.0])
+def test_residual_after_a_cycloidal_rise_is_the_closed_form(r):
+    """Undamped: the end mass rings freely in the dwell; its amplitude sqrt(e^2 + (v_end / w_n)^2), e = s_end - h,
+    read at the dwell's end, over the lift, is the closed form (to 1e-9 here; the issue asks 1e-4)."""
+    w_n = 2.0 * math.pi * r / T_R
+    train = Train(k_train=w_n * w_n * 2.0, m_end=2.0)
+    out = simulate_reference(SCENE, 2.0 * T_R, T_R / 10, omega_ref=constant(OMEGA), train=train)
+    h = DriveModel(SCENE).params["lift"]
+    assert out["s"][-1] == pytest.approx(h, abs=1e-15)  # in the dwell
+    e, v = out["s_end"][-1] - h, out["v_end"][-1]
+    assert abs(math.hypot(e, v / w_n) / h - cycloidal_residual(r)) < 1e-9
+
+
+def test_train_energy_balance_and_the_motor_does_the_work():
+    """Damped (zeta 0.05), under gravity, over a turn: the train's energy, end mass's kinetic + spring - the end
+    mass's weight's potential + the damper's loss, changes by the work the follower does on it (W_train); and that
+    work is what the load torque adds, int (M - M_rigid) omega dt (Simpson on the outputs), M_rigid the same drive
+    without the train (no guide friction, which the train's force would change)."""
+    scene = dict(VERTICAL, guide_friction=False)
+    m_e, w_n = 0.5, 2.0 * math.pi * 2.5 / T_R
+    k = m_e * w_n * w_n
+    train = Train(k_train=k, d_train=2.0 * 0.05 * math.sqrt(k * m_e), m_end=m_e)
+    dt = TURN / 20000
+    out = simulate_reference(scene, TURN, dt, omega_ref=constant(OMEGA), train=train)
+    rigid = simulate_reference(scene, TURN, dt, omega_ref=constant(OMEGA))
+    F_ex = m_e * G_N
+    stored = (0.5 * m_e * out["v_end"] ** 2 + 0.5 * k * (out["s"] - out["s_end"]) ** 2 - F_ex * out["s_end"]
+              + out["E_train_damp"])
+    scale = np.max(np.abs(out["W_train"]))
+    assert scale > 1.0  # J: the train does work
+    assert out["E_train_damp"][-1] > 1e-3 * scale  # the damper dissipates
+    assert np.max(np.abs(stored - stored[0] - out["W_train"])) < 1e-9 * scale
+    motor_work = simpson((out["M"] - rigid["M"]) * OMEGA, x=out["time"])
+    assert motor_work == pytest.approx(out["W_train"][-1], rel=1e-6, abs=1e-8 * scale)
+    assert np.array_equal(out["theta"], rigid["theta"])
+
+
+def test_train_energy_balance_through_ramps_a_reversal_and_a_stop():
+    """omega_ref ramps up, holds, ramps through 0 into reverse (a zero crossing inside an input piece) and jumps to
+    a stop, from a start in the lower dwell: the train's balance holds across every piece (the follower's velocity
+    jumps at the stop, the damper's force with it), and the cam's motion is the rigid reference's, bit for bit."""
+    omega_ref = Signal((0.0, 0.1, 0.3, 0.4, 0.5, 0.5, 0.6), (0.0, 10.0, 10.0, -6.0, -6.0, 0.0, 0.0))
+    scene = dict(VERTICAL, theta0=-0.3)
+    m_e, w_n = 0.5, 2.0 * math.pi * 40.0
+    k = m_e * w_n * w_n
+    train = Train(k_train=k, d_train=2.0 * 0.02 * math.sqrt(k * m_e), m_end=m_e)
+    out = simulate_reference(scene, 0.6, 1e-3, omega_ref=omega_ref, train=train)
+    rigid = simulate_reference(scene, 0.6, 1e-3, omega_ref=omega_ref)
+    stored = (0.5 * m_e * out["v_end"] ** 2 + 0.5 * k * (out["s"] - out["s_end"]) ** 2 - m_e * G_N * out["s_end"]
+              + out["E_train_damp"])
+    scale = np.max(np.abs(out["W_train"]))
+    assert scale > 0.1  # J
+    assert np.max(np.abs(stored - stored[0] - out["W_train"])) < 1e-9 * scale  # measured 6e-11
+    assert out["theta"][500] < out["theta"][400]  # it did reverse
+    for name in ("theta", "s", "omega"):
+        assert np.array_equal(out[name], rigid[name]), name
+
+
+def test_stiff_train_converges_to_the_rigid_drive_with_the_end_mass_on_the_follower():
+    """k_train -> infinity: the drive with the end mass m_end carried by the follower (m + m_end, weight G + m_end
+    g_n). Over the rise the load torque's difference is m_end (a_end - a) s', and a_end - a = -j0 sin(w_n t) / w_n
+    + O(1/w_n^2): the cycloidal's jerk jumps from 0 to j0 = 4 pi^2 h / t_r^3 at the start and rings the train,
+    so the torque converges as k^-1/2; the end mass's lag behind the follower is the spring's static deflection
+    m_end a / k: as 1/k."""
+    m_e = 0.5
+    model = DriveModel(VERTICAL)
+    p = model.params
+    rigid = simulate_reference(dict(VERTICAL, m=p["m"] + m_e, G=p["G"] + m_e * G_N), T_R, T_R / 400,
+                               omega_ref=constant(OMEGA))
+    j0 = 4.0 * math.pi ** 2 * p["lift"] / T_R ** 3
+    torque, lag = [], []
+    for k in (1e6, 1e7, 1e8):
+        out = simulate_reference(VERTICAL, T_R, T_R / 400, omega_ref=constant(OMEGA),
+                                 train=Train(k_train=k, m_end=m_e))
+        w_n, t = math.sqrt(k / m_e), out["time"]
+        s1 = np.array([model.program.derivatives(theta)[1] for theta in out["theta"]])
+        dM = out["M"] - rigid["M"]
+        lead = -m_e * j0 * np.sin(w_n * t) / w_n * s1
+        assert np.max(np.abs(dM - lead)) < 1e4 / w_n ** 2  # the next order (measured 5.0e3 .. 7.0e3 / w_n^2)
+        torque.append(np.max(np.abs(dM)))
+        lag.append(np.max(np.abs(out["s_end"] - rigid["s"])))
+    for a, b in zip(torque[:-1], torque[1:]):
+        assert b / a == pytest.approx(10 ** -0.5, rel=0.03)
+    for a, b in zip(lag[:-1], lag[1:]):
+        assert b / a == pytest.approx(0.1, rel=0.03)
+
+
+@pytest.mark.parametrize("drive", ["speed", "voltage"])
+def test_no_train_is_the_rigid_reference_bit_for_bit(drive):
+    """Train() (k_train = 0) and no train give today's reference, every output bit for bit."""
+    scene = dict(VERTICAL, drive=drive)
+    kwargs = dict(omega_ref=constant(OMEGA), u=constant(12.0))
+    plain = simulate_reference(scene, TURN / 4, TURN / 50, **kwargs)
+    zero = simulate_reference(scene, TURN / 4, TURN / 50, train=Train(d_train=3.0, m_end=1.0), **kwargs)
+    assert plain.keys() == zero.keys() and "F_train" not in plain
+    for name in plain:
+        assert np.array_equal(plain[name], zero[name]), name
+
+
+@pytest.mark.parametrize("fields, word", [(dict(k_train=-1.0), "k_train"), (dict(d_train=math.nan), "d_train"),
+                                          (dict(k_train=1e6, m_end=0.0), "m_end")])
+def test_bad_train_is_refused_by_name(fields, word):
+    with pytest.raises(ParameterError, match=word):
+        Train(**fields)
+
+
+@pytest.mark.parametrize("scene, word", [(dict(SCENE, drive="voltage"), "'M_f'"),
+                                         (dict(SCENE, drive="voltage", shaft_friction=False), "'mu'"),
+                                         (dict(SCENE, drive="voltage", formulation="paper"), "formulation"),
+                                         (dict(SCENE, closure="spring"), "closure"),
+                                         (dict(SCENE, backlash=True, c=1e-4), "'c'")])
+def test_train_where_the_reference_cannot_run_it_is_refused(scene, word):
+    with pytest.raises(ParameterError, match=word):
+        simulate_reference(scene, T_R, T_R / 10, omega_ref=constant(OMEGA), train=Train(k_train=1e6, m_end=1.0))
+
+
+def test_inductance_voltage_carries_the_trains_force_rate():
+    """Speed drive with L > 0: the voltage needed is R i + c_e omega + L di/dt, with i carrying F_train s' / c_m; the
+    L di/dt part, (voltage - R i - c_e omega) / L, equals the current's slope by central differences on the outputs
+    (damped train, under gravity, during the rise: the train's force changes in time, not only with theta). No
+    guide friction: where its side force changes sign the current has a kink, which central differences straddle."""
+    scene = dict(VERTICAL, inductance=True, L=5e-3, guide_friction=False)
+    model = DriveModel(scene)
+    m_e, w_n = 0.5, 2.0 * math.pi * 2.5 / T_R
+    k = m_e * w_n * w_n
+    train = Train(k_train=k, d_train=2.0 * 0.05 * math.sqrt(k * m_e), m_end=m_e)
+    dt = T_R / 4000
+    out = simulate_reference(scene, T_R, dt, omega_ref=constant(OMEGA), train=train)
+    i, u = out["i"], out["voltage"]
+    slope = (i[2:] - i[:-2]) / (2.0 * dt)  # A/s, O(dt^2)
+    rate = (u - model.R * i - model.c_e * OMEGA) / model.L
+    assert np.max(np.abs(slope)) > 10.0  # the current does change
+    assert np.max(np.abs(rate[1:-1] - slope)) < 1e-5 * np.max(np.abs(slope))
+
+
+# The voltage drive without friction, the motor a lossless converter (c_e = c_m: section 9's converter term is 0).
+VOLTAGE = dict(VERTICAL, drive="voltage", shaft_friction=False, guide_friction=False, c_e=0.015 * 9.80665)
+
+
+@pytest.mark.parametrize("inductance", [False, True])
+def test_voltage_drive_with_a_train_balances_the_motors_work(inductance):
+    """Damped train, under gravity, the voltage jumping from 12 V to -6 V (the cam reverses) over 1 s: the drive's
+    stored energy (1/2 J omega^2 + 1/2 L i^2 - F_gx s, DriveModel.energy) plus the train's (end mass kinetic + spring
+    - its weight's potential + damper loss) changes by the electrical work less the copper loss, E_in - E_copper
+    (section 9's balance with the train's spring and damper)."""
+    scene = dict(VOLTAGE, inductance=inductance, L=2e-3)
+    model = DriveModel(scene)
+    m_e, k = 0.5, 1e6
+    train = Train(k_train=k, d_train=2.0 * 0.02 * math.sqrt(k * m_e), m_end=m_e)
+    u = Signal((0.0, 0.3, 0.3, 1.0), (12.0, 12.0, -6.0, -6.0))
+    out = simulate_reference(scene, 1.0, 1e-3, u=u, train=train)
+    drive = np.array([model.energy(*state) for state in zip(out["theta"], out["omega"], out["i"])])
+    stored = drive + (0.5 * m_e * out["v_end"] ** 2 + 0.5 * k * (out["s"] - out["s_end"]) ** 2
+                      - m_e * G_N * out["s_end"] + out["E_train_damp"])
+    work = out["E_in"] - out["E_copper"]
+    assert out["omega"].min() < -50.0 < 50.0 < out["omega"].max()  # rad/s: it turns both ways
+    assert out["E_train_damp"][-1] > 0.0
+    assert np.max(np.abs(stored - stored[0] - work)) < 1e-9 * np.max(np.abs(out["E_in"]))  # measured 1.5e-12
+
+
+def test_voltage_drive_stiff_train_converges_to_the_rigid_drive():
+    """6 V over 0.15 s (about a turn): k_train -> infinity gives the rigid drive with m + m_end and G + m_end g_n.
+    The cam's angle converges as 1/k_train: the torque's k^-1/2 ringing (see the speed drive's test) averages out
+    in the angle, integrated twice, to O(1/k), and the static deflection is O(1/k) too."""
+    model = DriveModel(VOLTAGE)
+    p, m_e = model.params, 0.5
+    rigid = simulate_reference(dict(VOLTAGE, m=p["m"] + m_e, G=p["G"] + m_e * G_N), 0.15, 1e-3, u=constant(6.0))
+    assert rigid["theta"][-1] > 0.5 * RISE  # rad: through the rise
+    errors = []
+    for k in (1e6, 1e7, 1e8):
+        out = simulate_reference(VOLTAGE, 0.15, 1e-3, u=constant(6.0), train=Train(k_train=k, m_end=m_e))
+        errors.append(np.max(np.abs(out["theta"] - rigid["theta"])))
+    for a, b in zip(errors[:-1], errors[1:]):
+        assert b / a == pytest.approx(0.1, rel=0.05)  # measured 0.097, 0.0998
