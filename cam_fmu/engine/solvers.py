@@ -6,7 +6,7 @@
 resolution limits keep a run within, measured at 100 and 400 V against the
 reference (docs/performance.md); an adaptive method promises about its rtol instead.
 ``taylor_order``: a fixed-step explicit Runge-Kutta method whose step multiplies a linear mode e^(lambda t) by the
-Taylor polynomial of e^z of that degree (z = h lambda; vibration/train_step.py); 0 for the others.
+Taylor polynomial of e^z of that degree (z = h lambda; train_step.py); 0 for the others.
 """
 from __future__ import annotations
 

@@ -4,7 +4,7 @@
 segment), ``train`` integrates the train's equation of motion over the rise and the dwell (scipy, with its
 energy balance), ``limit`` finds the smallest ratio r (the top speed) at which a residual tolerance holds,
 ``optimize`` shapes the harmonic-trapezoid law's split points against the residual over a band of r,
-``polydyne`` corrects the cam for the train at one speed (a motion table), ``train_step`` the largest fixed step
-that resolves the train's ringing (the solver registry's stability polynomials).
-docs/model.md section 14 has the equations. Imports ``kinematics``, ``engine.solvers``, numpy and scipy.
+``polydyne`` corrects the cam for the train at one speed (a motion table); the largest fixed step that resolves
+the train's ringing is the solvers' (``engine.train_step``).
+docs/model.md section 14 has the equations. Imports ``kinematics``, numpy and scipy.
 """

@@ -1,4 +1,4 @@
-"""The largest fixed step that resolves the train (cam_fmu/vibration/train_step.py) against closed forms and
+"""The largest fixed step that resolves the train (cam_fmu/engine/train_step.py) against closed forms and
 against the methods run step by step on the train's free ringing (independent of the stability polynomials)."""
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from cam_fmu.vibration.train_step import check_step, largest_step
+from cam_fmu.engine.train_step import check_step, largest_step
 
 K, M = 4.0e5, 0.1  # N/m, kg: omega_n = 2000 rad/s
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 import cmath
 import math
 
-from ..engine.solvers import SOLVERS
+from .solvers import SOLVERS
 
 __all__ = ["train_rates", "amplification", "period_error", "largest_step", "check_step", "TOL"]
 
