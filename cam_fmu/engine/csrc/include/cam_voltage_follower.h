@@ -14,6 +14,9 @@
 #define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
 
 
+/* N m: what drives the cam side (the motor's torque, or a compliant shaft's) less the shaft's friction against the
+ * direction dir (0: the drive alone). */
+double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, double dir);
 /* m: a groove's clearance (closure 'form'), 0 for a spring's one flank. */
 double cam_vf_clearance(const CamModel *m);
 /* The flying follower's direction sgn(v), or at a halt where the net force pushes it (0: held by friction). */

@@ -25,14 +25,6 @@ static Tangents drive_tangents(const CamModel *m, const double seed[CAM_ME_NX], 
     return t;
 }
 
-/* N m: the torque on the cam side before the shaft's friction (the shaft's or the motor's). */
-static double drive_torque(const CamModel *m, const double y[NY], double u)
-{
-    if (m->compliant)
-        return m->k_shaft * y[Y_TWIST] + m->d_shaft * (y[Y_ROTOR] - y[1]);
-    return m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R;
-}
-
 void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
                        double ddx[CAM_ME_NX], double dout[])
 {
@@ -59,8 +51,8 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
         dF = m->k_spring * p[1] * dtheta;   /* the closing force at s = s_cam - contact c */
         if (!stuck) {
             double dq[4] = {dtheta, domega, g.drive, dF};
-            domega_dot = cam_flank_tangent(m, p, y[1], drive_torque(m, y, d->form_u), cam_follower_closing(m, y[3]),
-                                           y[Y_DIR], 0.0, dq, &f, &df);
+            domega_dot = cam_flank_tangent(m, p, y[1], cam_vf_torque_toward(m, y, d->form_u, 0.0),
+                                           cam_follower_closing(m, y[3]), y[Y_DIR], 0.0, dq, &f, &df);
             ddx[CAM_THETA] = domega;
             ddx[CAM_OMEGA] = domega_dot;
             cam_vf_on_flank(m, y, d->form_u, contact, p, &dy[1], &P);

@@ -63,7 +63,7 @@ static double shaft_direction(const double y[NY])
 
 /* N m: what drives the cam side, the motor's torque (rigid) or the shaft's, less the shaft's friction against the
  * direction `dir`. */
-static double torque_toward(const CamModel *m, const double y[NY], double u, double dir)
+double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, double dir)
 {
     double drive = m->compliant ? shaft_torque(m, y)
                    : (m->has_current ? m->c_m * y[2] : m->c_m * (u - m->c_e * y[1]) / m->R);
@@ -72,7 +72,7 @@ static double torque_toward(const CamModel *m, const double y[NY], double u, dou
 
 static double torque(const CamModel *m, const double y[NY], double u)
 {
-    return torque_toward(m, y, u, shaft_direction(y));
+    return cam_vf_torque_toward(m, y, u, shaft_direction(y));
 }
 
 /* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
@@ -91,7 +91,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
     cam_profile_eval(&m->profile, y[0], d);
     F = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
     if (m->mu == 0.0) {
-        *omega_dot = (torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
+        *omega_dot = (cam_vf_torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
         *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
         *n_r = 0.0;
@@ -99,7 +99,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
     }
     J = m->J_0 + m->m * d[1] * d[1];
     inertial = m->m * d[2] * omega * omega + F;
-    x0 = (torque_toward(m, y, u, dir) - inertial * d[1]) / J;
+    x0 = (cam_vf_torque_toward(m, y, u, dir) - inertial * d[1]) / J;
     sigma = sgn(d[1] * dir);
     tan_a = d[1] / (m->r_b + d[0]);
     n0 = (inertial + m->m * d[1] * x0) * tan_a + m->G_y;
@@ -134,8 +134,8 @@ double cam_vf_breakaway(const CamModel *m, const double y[NY], double u, int con
         flank_toward(m, y, u, contact, 1.0, d, &forward, &P, &n_r);
         flank_toward(m, y, u, contact, -1.0, d, &backward, &P, &n_r);
     } else {
-        forward = torque_toward(m, y, u, 1.0) / m->J_0;
-        backward = torque_toward(m, y, u, -1.0) / m->J_0;
+        forward = cam_vf_torque_toward(m, y, u, 1.0) / m->J_0;
+        backward = cam_vf_torque_toward(m, y, u, -1.0) / m->J_0;
     }
     backward = -backward;
     *dir = forward >= backward ? 1.0 : -1.0;
@@ -571,7 +571,8 @@ static void vf_outputs(CamDrive *d, double out[])
         int contact = (int)d->speed.contact;
         double tan_a = dd[1] / (m->r_b + dd[0]);
         cam_vf_on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
-        load.M = y[Y_DIR] == 0.0 ? torque_toward(m, y, d->form_u, 0.0)   /* stuck: static friction takes it all */
+        /* stuck: static friction takes it all */
+        load.M = y[Y_DIR] == 0.0 ? cam_vf_torque_toward(m, y, d->form_u, 0.0)
                  : m->M_f * shaft_direction(y) + P * dd[1];
         load.N = cam_normal_force(P, tan_a);   /* signed as contact */
         load.J = m->J_0 + m->m * dd[1] * dd[1];
