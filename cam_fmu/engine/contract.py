@@ -12,12 +12,15 @@ import ctypes
 from functools import lru_cache
 
 from ..physics.formulations.consistent import EVENT_NAMES
+from ..physics.train import G_N
 from ..physics.variables import STATES
 
 # The continuous state x (cam_model.h): C slot name and its Model Exchange variable (physics.variables.STATES, in
-# order). A rigid drive carries the first NX_RIGID; a compliant shaft adds its twist and the motor's speed.
+# order). A rigid drive carries the first NX_RIGID; a compliant shaft adds its twist and the motor's speed, a follower
+# train (docs/model.md 14.6) its end mass's position and velocity (a drive with either carries all NX).
 X_SLOTS: tuple[tuple[str, str], ...] = (("THETA", "x_theta"), ("OMEGA", "x_omega"), ("CURRENT", "x_i"),
-                                        ("TWIST", "x_twist"), ("OMEGA_M", "x_omega_m"))
+                                        ("TWIST", "x_twist"), ("OMEGA_M", "x_omega_m"), ("X_END", "x_end"),
+                                        ("V_END", "x_v_end"))
 NX = len(X_SLOTS)
 # Model Exchange's states after x (physics.variables.STATES, in order): the voltage drive's free follower's gap to
 # the flank it left last and the gap's rate (docs/model.md 13.6), held at 0 in contact and without one.
@@ -38,8 +41,8 @@ STATUSES: tuple[tuple[str, int, str, str], ...] = (
 # The saved state (cam_drive.h cam_drive_get_state): a flat array of doubles, its entries in this order, each a
 # name and how many doubles; STATE_LEN leaves room for entries a later version adds. Bump STATE_VERSION whenever
 # the layout changes: a state of another layout is refused by its version.
-STATE_VERSION = 2.0     # 2: the compliant shaft's two slots in x
-STATE_LEN = 48
+STATE_VERSION = 3.0     # 2: the compliant shaft's two slots in x; 3: the train's end mass's two
+STATE_LEN = 64
 STATE_LAYOUT: tuple[tuple[str, int], ...] = (
     ("VERSION", 1), ("FORMULATION", 1), ("TIME", 1), ("U", 1), ("OMEGA_REF", 1), ("OMEGA_DOT_REF", 1),
     ("H_NEXT", 1), ("STEPS_TAKEN", 1), ("X", NX),
@@ -126,7 +129,8 @@ def event_c_name(name: str) -> str:
 LAW_SEGMENTS, SEGMENT_FIELDS = 7, 7   # segments of one law; doubles per segment
 # The constants the structures' array sizes name, and the enumerations they use (C name, value).
 CONSTANTS = {"CAM_NX": NX, "CAM_MESSAGE_LEN": MESSAGE_LEN, "CAM_LAW_SEGMENTS": LAW_SEGMENTS,
-             "CAM_SEGMENT_FIELDS": SEGMENT_FIELDS}
+             "CAM_SEGMENT_FIELDS": SEGMENT_FIELDS,
+             "CAM_G_N": G_N}   # m/s2: standard gravity, the end mass's weight (physics/train.py)
 ENUMS: dict[str, tuple[tuple[str, int], ...]] = {"CamProgramKind": (("CAM_PROGRAM_LAWS", 0), ("CAM_PROGRAM_TABLE", 1))}
 _CTYPES = {"int": ctypes.c_int, "double": ctypes.c_double, "char": ctypes.c_char, "size_t": ctypes.c_size_t,
            "double*": ctypes.POINTER(ctypes.c_double), "CamStatus": ctypes.c_int, "CamProgramKind": ctypes.c_int}

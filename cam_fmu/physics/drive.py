@@ -21,6 +21,7 @@ from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
 from .parameters import ParameterError, law_spec, mounting_component, resolve
 from .rules import OWN_FOLLOWER, check_rules
+from .train import Train
 
 
 def sign(x: float) -> float:
@@ -173,6 +174,7 @@ class DriveModel:
         self.closure = p["closure"]
         self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
         check_rules(p)  # the cross-parameter rules (rules.RULES; C's are generated from the same table)
+        self.train = Train(p["k_train"], p["d_train"], p["m_end"])  # the follower train (14.6; k_train = 0: none)
         self.free_follower = own_follower(p)
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)

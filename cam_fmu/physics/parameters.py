@@ -191,7 +191,17 @@ FOLLOWER_PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("restitution", "1", 0.0, "coefficient of restitution of the follower's impacts on the cam (closures 'form' and "
        "'spring'; 0: plastic, 1: elastic)", low=0.0, high=1.0),
 )
-PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS
+# The follower train (docs/model.md 14.6): a spring-damper from the follower to an end mass, carried along X. The
+# drive runs it with the follower on the cam (closure 'kinematic', or 'form' without clearance) in the speed drive
+# and in the consistent voltage drive without friction, clearance or compliant shaft (physics/rules.py says why).
+TRAIN_PARAMETERS: tuple[ParameterSpec, ...] = (
+    _P("k_train", "N/m", 0.0, "stiffness of the follower train between the follower and its end mass m_end (0: no "
+       "train, the rigid drive; docs/model.md 14.6)", low=0.0, high=1e12),
+    _P("d_train", "N.s/m", 0.0, "damping of the follower train (used only with k_train > 0)", low=0.0, high=1e9),
+    _P("m_end", "kg", 0.0, "the train's end mass, moved by the train along X (used only with k_train > 0: a rigid "
+       "train's mass belongs in m)", low=0.0, high=1e4),
+)
+PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS + TRAIN_PARAMETERS
 BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
 
 

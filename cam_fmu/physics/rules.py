@@ -142,6 +142,9 @@ FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_F
 # clearance to fly across, the follower a mass to carry its momentum, and the formulation the follower's momentum.
 OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
+TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
+SHAFT_FRICTION = Where(Cmp(Num("shaft_friction"), "!="), Num("M_f"))   # N.m: M_f where the effect is on
+GUIDE_FRICTION = Where(Cmp(Num("guide_friction"), "!="), Num("mu"))    # 1: mu where the effect is on
 
 PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
            "consistent formulation)")
@@ -183,6 +186,30 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(COMPLIANT, Not(Cmp(Num("J_cam"), ">"))),
          "parameter 'J_cam' = {J_cam} [kg.m2]: a compliant shaft (k_shaft = {k_shaft} N.m/rad) needs the inertia of "
          "its cam side; allowed with k_shaft > 0: J_cam in (0, 100] kg.m2"),
+    Rule(AllOf(Not(TRAIN), AnyOf(Cmp(Num("d_train"), "!="), Cmp(Num("m_end"), "!="))),
+         "parameters 'd_train' = {d_train} N.s/m, 'm_end' = {m_end} kg with k_train = 0 (no train): they act only "
+         "through a train; allowed with it: 0 (a rigid train's mass belongs in m)"),
+    Rule(AllOf(TRAIN, Not(Cmp(Num("m_end"), ">"))),
+         "parameter 'm_end' = {m_end} kg: a follower train (k_train = {k_train} N/m) needs its end mass; allowed with "
+         "k_train > 0: m_end in (0, 1e4] kg"),
+    Rule(AllOf(TRAIN, Is("drive", ("speed",))),
+         "parameter 'k_train' = {k_train} N/m: the engine runs the follower train in the voltage drive so far; allowed "
+         "with drive 'speed': k_train = 0 (the scipy reference runs it: reference/train_speed.py)"),
+    Rule(AllOf(TRAIN, Is("solver", ("etdrk4",))),
+         "parameter 'k_train' = {k_train} N/m: solver 'etdrk4' integrates the rigid drive's electrical pole, not the "
+         "train's end mass; allowed with it: k_train = 0 (use solver 'rk4', 'rk23' or 'rk45')"),
+    Rule(AllOf(TRAIN, Is("formulation", ("paper",))),
+         "parameter 'k_train' = {k_train} N/m: the paper's formulation (steps 1-9) has no follower train; allowed "
+         "with it: k_train = 0, or formulation 'consistent' (docs/model.md 14.6)"),
+    Rule(AllOf(TRAIN, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="))),
+         "parameter 'k_train' = {k_train} N/m: the train runs with the follower on the cam (closure 'kinematic', or "
+         "'form' without clearance) so far; allowed with closure {closure} and c = {c} m: k_train = 0"),
+    Rule(AllOf(TRAIN, Not(Is("drive", ("speed",))),
+               AnyOf(Cmp(SHAFT_FRICTION, "!="), Cmp(GUIDE_FRICTION, "!="), COMPLIANT)),
+         "parameter 'k_train' = {k_train} N/m: in the voltage drive the train runs without shaft or guide friction "
+         "and with a rigid shaft so far (their events do not carry the train yet); allowed with M_f = {M_f} N.m, "
+         "mu = {mu}, k_shaft = {k_shaft} N.m/rad: k_train = 0 (or M_f = 0 or shaft_friction false, mu = 0 or "
+         "guide_friction false, k_shaft = 0)"),
     *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),

@@ -55,6 +55,7 @@ UNITS: dict[str, Unit] = {
     "N.m.s/rad": Unit("torsional damping", (("kg", 1), ("m", 2), ("s", -1), ("rad", -1))),
     "N": Unit("force", (("kg", 1), ("m", 1), ("s", -2)), (("kN", 1e-3, 0.0),)),
     "N/m": Unit("stiffness", (("kg", 1), ("s", -2)), (("N/mm", 1e-3, 0.0),)),
+    "N.s/m": Unit("damping", (("kg", 1), ("s", -1))),
     "kg": Unit("mass", (("kg", 1),), (("g", 1e3, 0.0),)),
     "m": Unit("length", (("m", 1),), (("mm", 1e3, 0.0), ("cm", 1e2, 0.0), ("um", 1e6, 0.0)), display="mm"),
     "m/s": Unit("velocity", (("m", 1), ("s", -1)), (("mm/s", 1e3, 0.0),)),

@@ -31,6 +31,11 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("N_contact", "N", "the cam's normal force on the follower's roller along the contact normal (pressure angle "
      "alpha): > 0 where the cam pushes along the rise, < 0 where a groove's other flank pushes; 0 off the cam or "
      "free in the clearance"),
+    ("s_end", "m", "the follower train's end mass position along X (docs/model.md 14.6; without a train: s)"),
+    ("v_end", "m/s", "the end mass velocity (without a train: v)"),
+    ("a_end", "m/s2", "the end mass acceleration (without a train: a)"),
+    ("F_train", "N", "the train's force k_train (s - s_end) + d_train (v - v_end), on the end mass along X (without a "
+     "train: 0)"),
 )
 # The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
 # section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
@@ -53,8 +58,10 @@ FOLLOWER_UNITS: dict[str, str] = {row[0]: row[1] for row in FOLLOWER_COLUMNS}
 
 
 def output_record(**values: Any) -> dict[str, float]:
-    """Every output, in table order, from keyword values (a missing one is a KeyError)."""
-    return {name: values[name] for name in OUTPUT_NAMES}
+    """Every output, in table order, from keyword values (a missing one is a KeyError; without a train the end mass's
+    columns are the follower's s, v, a and F_train = 0 unless given)."""
+    rigid = {"s_end": values["s"], "v_end": values["v"], "a_end": values["a"], "F_train": 0.0}
+    return {name: values[name] if name in values else rigid[name] for name in OUTPUT_NAMES}
 
 # Model Exchange's states: the engine's x[CAM_NX] (cam_model.h's slots, in order), then a free follower's gap and
 # its rate (cam_contract.h CAM_ME_GAP, generated from engine/contract.py ME_SLOTS; docs/model.md 13.6), each with
@@ -67,6 +74,9 @@ STATES: tuple[tuple[str, str, str, str], ...] = (
     ("x_i", "A", "A/s", "continuous state: the armature current (held at 0 when L = 0: i is then quasi-static)"),
     ("x_twist", "rad", "rad/s", "continuous state: the shaft's twist theta_m - theta (held at 0 when k_shaft = 0)"),
     ("x_omega_m", "rad/s", "rad/s2", "continuous state: the motor's speed (held when k_shaft = 0: omega_m = omega)"),
+    ("x_end", "m", "m/s", "continuous state: the follower train's end mass position (= output s_end; held at 0 "
+     "without a train, k_train = 0)"),
+    ("x_v_end", "m/s", "m/s2", "continuous state: the end mass velocity (= output v_end; held at 0 without a train)"),
     ("x_gap", "m", "m/s", "continuous state: a free follower's gap to the flank it left last, in flight (closures "
      "'form', 'spring'; held at 0 in contact and without one)"),
     ("x_gap_rate", "m/s", "m/s2", "continuous state: the rate of x_gap (held at 0 in contact and without a free "
@@ -75,7 +85,7 @@ STATES: tuple[tuple[str, str, str, str], ...] = (
 # The outputs that depend directly on an input at a fixed state in Model Exchange, and those inputs: the
 # quasi-static current (L = 0) and the voltage follow u, the load torque, the follower's acceleration and
 # the contact force follow the cam's acceleration, hence u (tests/fmu_me/test_engine_fmu_me.py measures it both ways).
-FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage", "N_contact")
+FEEDTHROUGH: tuple[str, ...] = ("i", "M", "a", "voltage", "N_contact", "a_end")
 FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # Model Exchange's ModelStructure: what each state derivative and output may depend on at a fixed mode (the knowns of
 # fmi2GetDirectionalDerivative: the states and the inputs; omega_ref and omega_dot_ref drive no Model Exchange run),
@@ -84,14 +94,18 @@ FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # exactly these. In flight (voltage_follower_events.c) der(x_gap) = x_gap_rate, and der(x_gap_rate), s and a depend on
 # the gap through the spring at the follower's position, not on its rate (the guide's friction keeps the flight's
 # direction over the mode); the load M and N_contact never depend on the gap (0 and M_f in flight).
-_CAM = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "u")
-_FLIGHT = _CAM + ("x_gap",)
+_TRAIN = ("x_end", "x_v_end")     # the train's force pulls the cam's follower (docs/model.md 14.6)
+_SHAFT = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "u")
+_CAM = _SHAFT + _TRAIN
+_FLIGHT = _SHAFT + ("x_gap",)   # a follower of its own carries no train (physics/rules.py)
 DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "der(x_theta)": ("x_omega",),
     "der(x_omega)": _CAM,
     "der(x_i)": ("x_omega", "x_i", "x_omega_m", "u"),
     "der(x_twist)": ("x_omega", "x_omega_m"),
     "der(x_omega_m)": ("x_omega", "x_i", "x_twist", "x_omega_m", "u"),
+    "der(x_end)": ("x_v_end",),
+    "der(x_v_end)": ("x_theta", "x_omega") + _TRAIN,
     "der(x_gap)": ("x_gap_rate",),
     "der(x_gap_rate)": _FLIGHT,
     "omega": ("x_omega",),
@@ -101,7 +115,7 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "M": _CAM,
     "J": ("x_theta",),
     "v": ("x_theta", "x_omega", "x_gap_rate"),
-    "a": _FLIGHT,
+    "a": _FLIGHT + _TRAIN,
     "alpha": ("x_theta",),
     "s_cam": ("x_theta",),
     "voltage": ("u",),
@@ -109,6 +123,10 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "omega_m": ("x_omega", "x_omega_m"),
     "M_shaft": ("x_omega", "x_twist", "x_omega_m"),
     "N_contact": _CAM,
+    "s_end": ("x_theta", "x_end", "x_gap"),   # without a train the end is the follower: s's
+    "v_end": ("x_theta", "x_omega", "x_v_end", "x_gap_rate"),
+    "a_end": _FLIGHT + _TRAIN,
+    "F_train": ("x_theta", "x_omega") + _TRAIN,
 }
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).

@@ -53,7 +53,8 @@ def simulate_reference(
 ) -> dict[str, np.ndarray]:
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
 
-    ``train``: the follower train (physics.train.Train, docs/model.md 14.6); None or k_train = 0 is the rigid drive,
+    ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
+    m_end); k_train = 0 is the rigid drive,
     bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS (the speed drive; the voltage drive
     without friction, reference/train_voltage.py)."""
     model = DriveModel(params)
@@ -61,7 +62,8 @@ def simulate_reference(
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
     grid = _grid(stop_time, output_interval)
     options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
-    if train is not None and train.active:
+    train = model.train if train is None else train   # the parameters' (k_train, d_train, m_end) unless given
+    if train.active:
         run = TRAIN_REFERENCES.get(formulation_name(model))
         if run is None:
             raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "

@@ -106,7 +106,7 @@ static int load(void)
 }
 #endif
 
-#define NX 7   /* the engine's five slots, a free follower's gap and rate; a drive holds the slots it does not carry */
+#define NX 9   /* the engine's seven slots, a free follower's gap and rate; a drive holds the slots it does not carry */
 #define NZ 4
 #define MAX_VARS 200
 

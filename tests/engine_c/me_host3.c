@@ -15,7 +15,7 @@
 
 #include "fmi3Functions.h"
 
-#define NX 7
+#define NX 9   /* the engine's seven slots, a free follower's gap and rate */
 #define NZ 4
 
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message)

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from cam_fmu.physics import parameters  # the pytest process may import cam_fmu: it never loads the FMU
+from cam_fmu.physics.variables import STATES
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -81,7 +82,7 @@ def test_model_description_complete(md_root):
     assert listed == {index_of[n] for n in outputs}
     # Model Exchange: the states and their derivatives are initial unknowns too (calculated)
     states = {n for n, v in by_name.items() if v.get("causality") == "local"}
-    assert initial == listed | {index_of[n] for n in states} and len(states) == 14
+    assert initial == listed | {index_of[n] for n in states} and len(states) == 2 * len(STATES)
     assert by_name["omega"].find("Real").get("unit") == "rad/s"
 
 

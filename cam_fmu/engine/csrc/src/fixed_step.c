@@ -59,11 +59,15 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt_
                 snprintf(c, sizeof c, "%.4g", it->work.x_new[CAM_OMEGA]);
                 snprintf(e, sizeof e, "%g", method->max_sweep);
                 snprintf(f, sizeof f, "%.3g", method->max_sweep / fastest);
+                char g[120] = "";
+                if (m->train)   /* cam_profile_rate: a radian of the train's phase counts as a feature */
+                    snprintf(g, sizeof g, " (with the follower train's %.4g rad/s: k_train, d_train, m_end)",
+                             m->train_rate);
                 return cam_error(err, CAM_ERR_SIMULATION,
                                  "solver '%s' with h_max = %s s turns the cam through %s of the profile's finest "
-                                 "feature in one step (omega = %s rad/s), more than %s: its first-order error is "
+                                 "feature in one step (omega = %s rad/s%s), more than %s: its first-order error is "
                                  "large there; reduce h_max below %s s or use solver 'rk4' or 'rk45'",
-                                 method->name, a, b, c, e, f);
+                                 method->name, a, b, c, g, e, f);
             }
             memcpy(it->x_end, it->work.x_new, sizeof it->x_end);
             return CAM_OK;

@@ -85,7 +85,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
         dt = m->h_max;
     ensure_k1(d, u);
     for (;;) {
-        it->exponential = m->has_current && !m->compliant && dt * m->R / m->L > CAM_POLE_LIMIT;
+        it->exponential = m->has_current && m->slots == CAM_NX_RIGID && dt * m->R / m->L > CAM_POLE_LIMIT;
         method_step(d, it, dt, u);
         if (cam_step_control(cam_error_norm(m, d->x, &it->work), it->method->tableau->error_exponent, remaining, &dt,
                              &d->solver.h_next)) {
@@ -114,7 +114,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
 /* The state tau [s] into the current step, into it->work.x_new (moving: a step; stuck: exact). */
 static void trial(CamDrive *d, CamIntegrator *it, double tau, double u)
 {
-    if (d->mode.stuck && !d->model.compliant) {
+    if (d->mode.stuck && d->model.slots == CAM_NX_RIGID) {
         it->work.x_new[CAM_THETA] = d->x[CAM_THETA];
         it->work.x_new[CAM_OMEGA] = 0.0;
         it->work.x_new[CAM_CURRENT] = cam_current_at_rest(&d->model, d->x[CAM_CURRENT], u, tau);
@@ -292,7 +292,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         d->solver.k1_valid = 0;
     it->n_events = cam_event_codes(m, &d->mode, it->codes);
     while (h - t > 1e-12 * h) {
-        if (d->mode.stuck && !m->has_current && !m->compliant)
+        if (d->mode.stuck && !m->has_current && m->slots == CAM_NX_RIGID)
             break;   /* nothing evolves until the input changes */
         steps += 1;
         if (steps > m->max_steps) {
@@ -302,7 +302,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         remaining = h - t;
         next_valid = 0;   /* does it->f_end hold f at the step's end? */
         it->exponential = 0;
-        if (d->mode.stuck && !m->compliant) {   /* only the current moves, exactly (a shaft: the solver) */
+        if (d->mode.stuck && m->slots == CAM_NX_RIGID) {   /* only the current moves, exactly (shaft, train: solver) */
             dt = remaining;
             it->x_end[CAM_THETA] = d->x[CAM_THETA];
             it->x_end[CAM_OMEGA] = 0.0;

@@ -62,14 +62,15 @@ double cam_flank_tangent(const CamModel *m, const double d[4], double omega, dou
 }
 
 /* The tangent of omega_dot [rad/s3 per seed] at (theta, omega) under the drive torque T with tangents dtheta,
- * domega, dT (cam_omega_dot, model.c's load_terms): on the flank the closing force is gravity's, -F_gx. */
+ * domega, dT (cam_omega_dot, model.c's load_terms): on the flank the closing force is gravity's, -F_gx, and the
+ * train's F [N] (tangent dF). */
 static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const double d[4], double omega, double T,
-                                double dtheta, double domega, double dT)
+                                double dtheta, double domega, double dT, double F, double dF)
 {
-    double dq[4] = {dtheta, domega, dT, 0.0}, f, df;
+    double dq[4] = {dtheta, domega, dT, dF}, f, df;
     if (!(mode->contact != 0 && m->follower))
         return dT / m->J_0;
-    return cam_flank_tangent(m, d, omega, T, -m->F_gx, mode->direction, m->guide_side ? mode->side : 0.0, dq, &f,
+    return cam_flank_tangent(m, d, omega, T, F - m->F_gx, mode->direction, m->guide_side ? mode->side : 0.0, dq, &f,
                              &df);
 }
 
@@ -89,17 +90,26 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     double domega = seed[CAM_OMEGA], di = m->has_current ? seed[CAM_CURRENT] : 0.0;
     double dtwist = m->compliant ? seed[CAM_TWIST] : 0.0, domega_m = m->compliant ? seed[CAM_OMEGA_M] : domega;
     double dT_motor = torque_tangent(m, domega_m, di, du), dT, omega_dot = 0.0, domega_dot = 0.0;
-    double w, dw, s1, ds1, t, dt, a, da, push, root, i_dot, sigma, f, df, along, dalong;
+    double w, dw, s1, ds1, t, dt, a, da, push, root, i_dot, sigma, f, df, along, dalong, F, dF = 0.0;
     int k, engaged = mode->contact != 0, moving = !mode->stuck;
     cam_rhs(m, mode, x, u, dx);
     cam_profile_eval(&m->profile, theta, d);
     for (k = 0; k < CAM_NX; k++)
         ddx[k] = 0.0;
+    /* the train's force k (s - x_e) + d (s' omega - v_e) at the cam's speed (0 while stuck) and its tangent */
+    F = cam_train_force_at(m, x, moving ? omega : 0.0);
+    if (m->train) {
+        dF = m->k_train * (d[1] * dtheta - seed[CAM_X_END])
+             + m->d_train * (d[2] * dtheta * (moving ? omega : 0.0) + d[1] * (moving ? domega : 0.0) - seed[CAM_V_END]);
+        ddx[CAM_X_END] = seed[CAM_V_END];
+        ddx[CAM_V_END] = dF / m->m_end;
+    }
     /* the torque on the cam: the shaft's k twist + d (omega_m - omega) (the cam's speed 0 while stuck), else the motor's */
     dT = m->compliant ? m->k_shaft * dtwist + m->d_shaft * (domega_m - (moving ? domega : 0.0)) : dT_motor;
     if (moving) {
         omega_dot = dx[CAM_OMEGA];
-        domega_dot = omega_dot_tangent(m, mode, d, omega, cam_drive_torque(m, x, omega, u), dtheta, domega, dT);
+        domega_dot = omega_dot_tangent(m, mode, d, omega, cam_drive_torque(m, x, omega, u), dtheta, domega, dT, F,
+                                       dF);
         ddx[CAM_THETA] = domega;
         ddx[CAM_OMEGA] = domega_dot;
     }
@@ -129,11 +139,11 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     if (engaged) {
         a = d[2] * w * w + s1 * omega_dot;
         da = d[2] * dtheta * w * w + 2.0 * d[2] * w * dw + ds1 * omega_dot + s1 * domega_dot;
-        push = m->m * a - m->F_gx;   /* cam_load: the friction at the axial force, on the branch that holds */
+        push = m->m * a - m->F_gx + F;   /* cam_load: the friction at the axial force, on the branch that holds */
         sigma = sign_of(s1 * (moving ? mode->direction : 0.0));
-        f = friction_tangent(m, push * t + m->G_y, m->m * da * t + push * dt, t, dt, sigma, 0.0, &df);
+        f = friction_tangent(m, push * t + m->G_y, (m->m * da + dF) * t + push * dt, t, dt, sigma, 0.0, &df);
         along = push + sigma * f;
-        dalong = m->m * da + sigma * df;
+        dalong = m->m * da + dF + sigma * df;
         dout[CAM_O_J] = 2.0 * m->m * s1 * ds1;
         dout[CAM_O_V] = ds1 * w + s1 * dw;
         dout[CAM_O_A] = da;
@@ -145,5 +155,9 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     dout[CAM_O_THETA_M] = dtheta + dtwist;
     dout[CAM_O_OMEGA_M] = domega_m;
     dout[CAM_O_M_SHAFT] = m->compliant ? dT : 0.0;
+    dout[CAM_O_S_END] = m->train ? seed[CAM_X_END] : dout[CAM_O_S];   /* without a train: the follower's */
+    dout[CAM_O_V_END] = m->train ? seed[CAM_V_END] : dout[CAM_O_V];
+    dout[CAM_O_A_END] = m->train ? dF / m->m_end : dout[CAM_O_A];
+    dout[CAM_O_F_TRAIN] = dF;
     return CAM_OK;
 }

@@ -93,4 +93,8 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     dout[CAM_O_THETA_M] = dtheta + (m->compliant ? seed[CAM_TWIST] : 0.0);
     dout[CAM_O_OMEGA_M] = g.omega_m;
     dout[CAM_O_M_SHAFT] = m->compliant ? g.shaft : 0.0;
+    dout[CAM_O_S_END] = ds;   /* no train on a follower of its own (physics/rules.py): the end is the follower */
+    dout[CAM_O_V_END] = dv;
+    dout[CAM_O_A_END] = da;
+    dout[CAM_O_F_TRAIN] = 0.0;
 }

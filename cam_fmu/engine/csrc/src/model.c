@@ -43,7 +43,7 @@ double cam_guide_friction(double n0, double kappa, double sigma, double mu, doub
 
 /* x0 = the frictionless omega_dot [rad/s2]; with guide friction J, sigma, f, n0, kappa too. */
 static void load_terms(const CamModel *m, double theta, double omega, double drive, double direction, double side,
-                       Terms *t)
+                       double axial, Terms *t)
 {
     double s, s1, mass, J, inertial, tan_a;
     cam_profile_eval(&m->profile, theta, t->d);
@@ -51,7 +51,7 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
     s1 = t->d[1];
     mass = m->m;
     J = m->J_0 + mass * s1 * s1;
-    inertial = mass * t->d[2] * omega * omega - m->F_gx;   /* N: the profile's curvature and gravity */
+    inertial = mass * t->d[2] * omega * omega - m->F_gx + axial;   /* N: the profile's curvature, gravity, train */
     t->J = J;
     t->x0 = (drive - inertial * s1) / J;
     if (m->mu == 0.0)
@@ -64,24 +64,25 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
 }
 
 double cam_omega_dot(const CamModel *m, double theta, double omega, double torque, double direction, int engaged,
-                     double side)
+                     double side, double axial)
 {
     Terms t;
     double drive = torque - m->M_f * direction;
     if (!(engaged && m->follower))
         return drive / m->J_0;
-    load_terms(m, theta, omega, drive, direction, side, &t);
+    load_terms(m, theta, omega, drive, direction, side, axial, &t);
     if (m->mu == 0.0)
         return t.x0;
     return t.x0 - t.sigma * t.f * t.d[1] / t.J;
 }
 
-double cam_side_force(const CamModel *m, double theta, double omega, double torque, double direction, double side)
+double cam_side_force(const CamModel *m, double theta, double omega, double torque, double direction, double side,
+                      double axial)
 {
     Terms t;
     if (m->mu == 0.0 || !m->follower)
         return 0.0;
-    load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, &t);
+    load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, axial, &t);
     return t.n0 + t.sigma * t.kappa * t.f;
 }
 
@@ -104,6 +105,28 @@ double cam_drive_torque(const CamModel *m, const double x[CAM_NX], double omega,
     return cam_torque(m, omega, x[CAM_CURRENT], u);
 }
 
+double cam_train_force(const CamModel *m, const double x[CAM_NX], double s, double v)
+{
+    return m->train ? m->k_train * (s - x[CAM_X_END]) + m->d_train * (v - x[CAM_V_END]) : 0.0;
+}
+
+double cam_train_force_at(const CamModel *m, const double x[CAM_NX], double omega)
+{
+    double d[4];
+    if (!m->train)
+        return 0.0;
+    cam_profile_eval(&m->profile, x[CAM_THETA], d);
+    return cam_train_force(m, x, d[0], d[1] * omega);
+}
+
+/* The end mass's rates (docs/model.md 14.6) into dx: x_e' = v_e, m_end v_e' = F_train + F_ex; held at 0 without a
+ * train. */
+static void train_rhs(const CamModel *m, const double x[CAM_NX], double F, double dx[CAM_NX])
+{
+    dx[CAM_X_END] = m->train ? x[CAM_V_END] : 0.0;
+    dx[CAM_V_END] = m->train ? (F + m->F_ex) / m->m_end : 0.0;
+}
+
 double cam_current_at_rest(const CamModel *m, double i, double u, double dt)
 {
     double target = u / m->R;
@@ -122,8 +145,9 @@ static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x
     } else {
         dx[CAM_THETA] = omega;
         dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, shaft, mode->direction, mode->contact != 0,
-                                      m->guide_side ? mode->side : 0.0);
+                                      m->guide_side ? mode->side : 0.0, 0.0);
     }
+    train_rhs(m, x, 0.0, dx);   /* a compliant shaft carries no train (physics/rules.py) */
     dx[CAM_TWIST] = omega_motor - omega;
     dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - shaft) / m->J_m;
     dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
@@ -131,24 +155,29 @@ static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x
 
 void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT];
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], F;
     if (m->compliant) {
         compliant_rhs(m, mode, x, u, dx);
         return;
     }
+    F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;
         dx[CAM_OMEGA] = 0.0;
     } else {
         dx[CAM_THETA] = omega;
         dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_torque(m, omega, i, u), mode->direction,
-                                      mode->contact != 0, m->guide_side ? mode->side : 0.0);
+                                      mode->contact != 0, m->guide_side ? mode->side : 0.0, F);
     }
     dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega) / m->L : 0.0;
+    if (m->slots == CAM_NX) {   /* a train: its end mass moves, the rigid shaft's slots are held */
+        dx[CAM_TWIST] = dx[CAM_OMEGA_M] = 0.0;
+        train_rhs(m, x, F, dx);
+    }
 }
 
 void cam_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
-              CamLoad *out)
+              double axial, CamLoad *out)
 {
     double d[4], s, s1, tan_a, shaft, v, a, sigma, push, f;
     cam_profile_eval(&m->profile, theta, d);
@@ -167,7 +196,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     v = s1 * omega;
     a = d[2] * omega * omega + s1 * omega_dot;
     sigma = sign_of(s1 * direction);
-    push = m->m * a - m->F_gx;   /* N: axial force without friction */
+    push = m->m * a - m->F_gx + axial;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;
     out->N = cam_normal_force(push + sigma * f, tan_a);
@@ -178,11 +207,11 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
 }
 
 double cam_breakaway_direction(const CamModel *m, double theta, double torque, int engaged_forward,
-                               int engaged_backward)
+                               int engaged_backward, double axial)
 {
-    if (cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged_forward, 0.0) > 0.0)
+    if (cam_omega_dot(m, theta, 0.0, torque, 1.0, engaged_forward, 0.0, axial) > 0.0)
         return 1.0;
-    if (cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged_backward, 0.0) < 0.0)
+    if (cam_omega_dot(m, theta, 0.0, torque, -1.0, engaged_backward, 0.0, axial) < 0.0)
         return -1.0;
     return 0.0;
 }
@@ -340,12 +369,19 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->mu = v[CAM_P_GUIDE_FRICTION] != 0.0 ? v[CAM_P_MU] : 0.0;
     model->r_b = v[CAM_P_R_B];
     model->c = v[CAM_P_BACKLASH] != 0.0 ? v[CAM_P_C] : 0.0;
-    model->follower = model->m != 0.0 || model->F_gx != 0.0 || model->mu != 0.0;
+    model->k_train = v[CAM_P_K_TRAIN];   /* the follower train (docs/model.md 14.6; rules: the follower on the cam) */
+    model->train = model->k_train > 0.0;
+    model->d_train = model->train ? v[CAM_P_D_TRAIN] : 0.0;
+    model->m_end = model->train ? v[CAM_P_M_END] : 0.0;
+    model->F_ex = v[CAM_P_GRAVITY] != 0.0 ? model->m_end * CAM_G_N * mounting(sin(v[CAM_P_GAMMA]), v[CAM_P_GAMMA])
+                                             * mounting(cos(v[CAM_P_BETA]), v[CAM_P_BETA]) : 0.0;   /* N: its weight */
+    model->train_rate = model->train ? sqrt(model->k_train / model->m_end) + model->d_train / model->m_end : 0.0;
+    model->follower = model->m != 0.0 || model->F_gx != 0.0 || model->mu != 0.0 || model->train;
     model->has_current = model->L > 0.0;
     model->backlash = model->c > 0.0;
     model->guide_side = model->mu > 0.0 && model->follower;
-    model->nx = (model->has_current ? 3 : 2) + (model->compliant ? 2 : 0);
-    model->slots = model->compliant ? CAM_NX : CAM_NX_RIGID;
+    model->nx = (model->has_current ? 3 : 2) + (model->compliant ? 2 : 0) + (model->train ? 2 : 0);
+    model->slots = model->compliant || model->train ? CAM_NX : CAM_NX_RIGID;
     model->formulation = (int)v[CAM_P_DRIVE] == CAM_CHOICE_DRIVE_SPEED ? CAM_FORM_SPEED
                          : (CamFormulationId)(int)v[CAM_P_FORMULATION];
     model->solver = (int)v[CAM_P_SOLVER];

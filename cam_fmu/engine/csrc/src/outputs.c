@@ -10,9 +10,10 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA];
     double i = m->has_current ? x[CAM_CURRENT] : (u - m->c_e * cam_motor_speed(m, x)) / m->R;
     int engaged = mode->contact != 0;
+    double F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
     CamLoad load;
     if (mode->stuck) {
-        cam_load(m, theta, 0.0, 0.0, 0.0, engaged, &load);
+        cam_load(m, theta, 0.0, 0.0, 0.0, engaged, F, &load);
         load.M = m->compliant ? cam_drive_torque(m, x, 0.0, u) : m->c_m * i;   /* static friction takes it all */
         load.v = load.a = 0.0;
     } else {
@@ -21,9 +22,15 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
             cam_rhs(m, mode, x, u, dx);
             omega_dot = dx[CAM_OMEGA];
         }
-        cam_load(m, theta, omega, omega_dot, mode->direction, engaged, &load);
+        cam_load(m, theta, omega, omega_dot, mode->direction, engaged, F, &load);
     }
     cam_record_outputs(&load, omega, theta, engaged ? load.s_cam - m->c * mode->contact : mode->s_free, i, u, out);
+    if (m->train) {   /* the end mass (docs/model.md 14.6) */
+        out[CAM_O_S_END] = x[CAM_X_END];
+        out[CAM_O_V_END] = x[CAM_V_END];
+        out[CAM_O_A_END] = (F + m->F_ex) / m->m_end;
+        out[CAM_O_F_TRAIN] = F;
+    }
     if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too, as a rigid drive's does */
         out[CAM_O_J] = load.J + m->J_m;
         out[CAM_O_THETA_M] = theta + x[CAM_TWIST];
@@ -50,6 +57,10 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
     out[CAM_O_OMEGA_M] = omega;
     out[CAM_O_M_SHAFT] = 0.0;
     out[CAM_O_N_CONTACT] = load->N;
+    out[CAM_O_S_END] = s;   /* without a train the end is the follower (outputs.c cam_outputs sets a train's) */
+    out[CAM_O_V_END] = load->v;
+    out[CAM_O_A_END] = load->a;
+    out[CAM_O_F_TRAIN] = 0.0;
 }
 
 /* E_mech [J] of published outputs: kinetic + gravity potential; compliant: the cam side's and the rotor's
@@ -64,6 +75,11 @@ static double mechanical(const CamEnergy *e, const double out[])
             return own;
         twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];   /* and a compliant shaft's rotor and elastic energy */
         return own + 0.5 * e->J_m * out[CAM_O_OMEGA_M] * out[CAM_O_OMEGA_M] + 0.5 * e->k_shaft * twist * twist;
+    }
+    if (e->k_train > 0.0) {   /* a rigid shaft (physics/rules.py): and the train's end mass and spring */
+        double stretch = out[CAM_O_S] - out[CAM_O_S_END];
+        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S] + 0.5 * e->m_end * out[CAM_O_V_END]
+               * out[CAM_O_V_END] + 0.5 * e->k_train * stretch * stretch - e->F_ex * out[CAM_O_S_END];
     }
     if (e->k_shaft == 0.0)
         return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S];
@@ -90,6 +106,9 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
     e->m = m->m;
     e->k_spring = m->k_spring;
     e->F_spring0 = m->F_spring0;
+    e->k_train = m->k_train;
+    e->m_end = m->m_end;
+    e->F_ex = m->F_ex;
     e->theta = out[CAM_O_THETA_M];
     e->i = i;
     e->e_mech0 = mechanical(e, out);

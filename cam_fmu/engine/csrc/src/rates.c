@@ -32,7 +32,7 @@ double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x
     } else {
         rate += electrical_rate(m, J);
     }
-    return rate;
+    return rate + m->train_rate;   /* the end mass on the train (0 without one) */
 }
 
 double cam_shaft_rate(const CamModel *m, double J)
@@ -43,7 +43,7 @@ double cam_shaft_rate(const CamModel *m, double J)
 
 double cam_profile_rate(const CamModel *m, const double x[CAM_NX])
 {
-    return fabs(x[CAM_OMEGA]) / m->feature_angle;
+    return fabs(x[CAM_OMEGA]) / m->feature_angle + m->train_rate;   /* a train: a radian of its phase a feature */
 }
 
 double cam_torque_gain(const CamModel *m, const CamMode *mode, const double x[CAM_NX])

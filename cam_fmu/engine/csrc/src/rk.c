@@ -118,7 +118,7 @@ static inline void rk_step_slots(const CamMethod *method, const CamModel *m, con
 void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u,
                  double h, CamStepWork *w)
 {
-    if (m->compliant)
+    if (m->slots == CAM_NX)
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX);
     else
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_RIGID);

@@ -163,13 +163,13 @@ static void speed_outputs(CamDrive *d, double out[])
         return;
     }
     on = engaged(m, theta, st->s, direction, omega_dot);
-    cam_load(m, theta, omega, omega_dot, direction, on, &load);
+    cam_load(m, theta, omega, omega_dot, direction, on, 0.0, &load);
     i = (m->J_0 * omega_dot + load.M) / m->c_m;
     voltage = m->R * i + m->c_e * omega;
     if (m->L > 0.0 && omega != 0.0) {
         double step = 1e-6, dM;
-        cam_load(m, theta + step, omega, omega_dot, direction, on, &ahead);
-        cam_load(m, theta - step, omega, omega_dot, direction, on, &behind);
+        cam_load(m, theta + step, omega, omega_dot, direction, on, 0.0, &ahead);
+        cam_load(m, theta - step, omega, omega_dot, direction, on, 0.0, &behind);
         dM = (ahead.M - behind.M) / (2.0 * step);
         voltage += m->L * omega * dM / m->c_m;
     }

@@ -88,6 +88,10 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
         return cam_error(err, CAM_ERR_SIMULATION, "state twist %s rad and rotor speed %s rad/s, but this drive's "
                          "shaft is rigid (k_shaft = 0: their slots hold 0)", cam_num(x[CAM_TWIST], a),
                          cam_num(x[CAM_OMEGA_M], b));
+    if (!m->train && (x[CAM_X_END] != 0.0 || x[CAM_V_END] != 0.0))
+        return cam_error(err, CAM_ERR_SIMULATION, "state end mass position %s m and velocity %s m/s, but this drive "
+                         "has no follower train (k_train = 0: their slots hold 0)", cam_num(x[CAM_X_END], a),
+                         cam_num(x[CAM_V_END], b));
     if (s[CAM_S_HAVE_BUDGET] != 0.0 && !d->form->energy_bounded)
         return cam_error(err, CAM_ERR_SIMULATION, "state has an energy account, but the %s drive keeps none",
                          d->form->name);

@@ -36,10 +36,11 @@ int cam_engaged_toward(const CamModel *m, const CamMode *mode, double theta, dou
     return !(mode->contact * d[1] * direction < 0.0);
 }
 
-double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double torque)
+double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta, double torque, double axial)
 {
-    double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, cam_engaged_toward(m, mode, theta, 1.0), 0.0);
-    double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, cam_engaged_toward(m, mode, theta, -1.0), 0.0);
+    double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, cam_engaged_toward(m, mode, theta, 1.0), 0.0, axial);
+    double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, cam_engaged_toward(m, mode, theta, -1.0), 0.0,
+                                     axial);
     return backward > forward ? backward : forward;
 }
 
@@ -50,10 +51,10 @@ double cam_event_value(const CamModel *m, const CamMode *mode, int code, const d
         return omega * mode->direction;
     if (code == CAM_EV_SIDE_FORCE)
         return mode->side * cam_side_force(m, theta, omega, cam_drive_torque(m, x, omega, u), mode->direction,
-                                           mode->side)
+                                           mode->side, cam_train_force_at(m, x, omega))
                + CAM_SIDE_HYSTERESIS;
     if (code == CAM_EV_BREAK_AWAY)
-        return -cam_breakaway_margin(m, mode, theta, cam_drive_torque(m, x, 0.0, u));
+        return -cam_breakaway_margin(m, mode, theta, cam_drive_torque(m, x, 0.0, u), cam_train_force_at(m, x, 0.0));
     cam_profile_eval(&m->profile, theta, d);
     if (code == CAM_EV_ENGAGE_UP)
         return mode->s_free - (d[0] - m->c);
@@ -71,6 +72,13 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
     x[CAM_CURRENT] = m->has_current ? i0 : 0.0;
     x[CAM_TWIST] = 0.0;   /* a compliant shaft starts relaxed, the rotor at the cam's speed */
     x[CAM_OMEGA_M] = m->compliant ? omega0 : 0.0;
+    x[CAM_X_END] = x[CAM_V_END] = 0.0;
+    if (m->train) {   /* the end mass at rest relative to the follower, the spring at its static deflection */
+        double d[4];
+        cam_profile_eval(&m->profile, theta0, d);
+        x[CAM_X_END] = d[0] + m->F_ex / m->k_train;
+        x[CAM_V_END] = d[1] * omega0;
+    }
     mode->stuck = omega0 == 0.0;
     mode->direction = omega0 >= 0.0 ? 1.0 : -1.0;
     mode->contact = 1;
@@ -88,7 +96,7 @@ void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], d
 {
     if (m->guide_side && mode->contact != 0 && !mode->stuck) {
         double n_r = cam_side_force(m, x[CAM_THETA], x[CAM_OMEGA], cam_drive_torque(m, x, x[CAM_OMEGA], u),
-                                    mode->direction, 0.0);
+                                    mode->direction, 0.0, cam_train_force_at(m, x, x[CAM_OMEGA]));
         if (fabs(n_r) > CAM_SIDE_HYSTERESIS)
             mode->side = n_r < 0.0 ? -1.0 : 1.0;
     }
@@ -100,13 +108,14 @@ void cam_choose_side(const CamModel *m, CamMode *mode, const double x[CAM_NX], d
 static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], double u, int at_threshold)
 {
     double theta = x[CAM_THETA], torque = cam_drive_torque(m, x, x[CAM_OMEGA], u), direction, d[4];
+    double axial = cam_train_force_at(m, x, 0.0);   /* N: the train's pull at rest (0 without one) */
     int forward_engaged, backward_engaged, leaves = 0;
     if (!mode->stuck) {
         if (x[CAM_OMEGA] != 0.0)
             return;
         /* at rest but marked as moving: it goes on unless it now accelerates backwards */
         if (mode->direction * cam_omega_dot(m, theta, 0.0, torque, mode->direction,
-                                            cam_engaged_toward(m, mode, theta, mode->direction), 0.0) >= 0.0)
+                                            cam_engaged_toward(m, mode, theta, mode->direction), 0.0, axial) >= 0.0)
             return;
         mode->stuck = 1;
     }
@@ -114,10 +123,10 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
      * test, so a break-away it locates always starts the shaft (no event that fires without effect) */
     forward_engaged = cam_engaged_toward(m, mode, theta, 1.0);
     backward_engaged = cam_engaged_toward(m, mode, theta, -1.0);
-    direction = cam_breakaway_direction(m, theta, torque, forward_engaged, backward_engaged);
+    direction = cam_breakaway_direction(m, theta, torque, forward_engaged, backward_engaged, axial);
     if (direction == 0.0 && at_threshold) {
-        double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, forward_engaged, 0.0);
-        double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, backward_engaged, 0.0);
+        double forward = cam_omega_dot(m, theta, 0.0, torque, 1.0, forward_engaged, 0.0, axial);
+        double backward = -cam_omega_dot(m, theta, 0.0, torque, -1.0, backward_engaged, 0.0, axial);
         if (forward == backward && (m->has_current || m->compliant)) {
             /* a tie (no shaft friction, zero torque as the current or the twist passes through 0): the
              * shaft goes where the torque is heading */
@@ -138,7 +147,7 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
         leaves = mode->contact * d[1] * direction < 0.0;   /* the cam would leave the follower */
         /* starting that way is consistent only if the shaft, rid of the follower, still accelerates
          * that way; else it stays at rest instead of chattering */
-        if (leaves && direction * cam_omega_dot(m, theta, 0.0, torque, direction, 0, 0.0) <= 0.0)
+        if (leaves && direction * cam_omega_dot(m, theta, 0.0, torque, direction, 0, 0.0, 0.0) <= 0.0)
             return;
     }
     mode->stuck = 0;

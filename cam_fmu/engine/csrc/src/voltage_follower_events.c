@@ -247,6 +247,7 @@ void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM
     dx[CAM_CURRENT] = dy[2];
     dx[CAM_TWIST] = dy[Y_TWIST];
     dx[CAM_OMEGA_M] = dy[Y_ROTOR];
+    dx[CAM_X_END] = dx[CAM_V_END] = 0.0;   /* no train on a follower of its own (physics/rules.py): held */
     dx[CAM_ME_GAP] = dx[CAM_ME_RATE] = 0.0;
     if (d->speed.contact != 0.0)
         return;

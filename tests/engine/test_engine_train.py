@@ -1,0 +1,110 @@
+"""The follower train in the C engine (docs/model.md 14.6): the end mass as two states of the consistent voltage
+drive, under every solver that runs it, against the scipy reference (reference/train_voltage.py, written apart);
+the saved state carries it; without a train its outputs are the follower's; what the engine does not run yet is
+refused by name."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cam_fmu.engine.simulator import DriveSimulator
+from cam_fmu.physics.parameters import ParameterError
+from cam_fmu.physics.parameters import defaults
+from cam_fmu.reference.integrate import simulate_reference
+
+STOP, STEP, U = 1.0, 0.01, 3.5
+# a 50 Hz train (sqrt(2e4 / 0.2) = 316 rad/s) with light damping on the paper's cam, without friction
+TRAIN = dict(k_train=2e4, d_train=2.0, m_end=0.2, M_f=0.0, mu=0.0)
+NAMES = ("theta", "omega", "i", "M", "N_contact", "s_end", "v_end", "a_end", "F_train")
+
+
+def engine_run(params: dict, stop: float = STOP, step: float = STEP) -> dict[str, np.ndarray]:
+    sim = DriveSimulator(params)
+    rows = [sim.outputs()]
+    for k in range(int(round(stop / step))):
+        sim.do_step(k * step, step, u=U)
+        rows.append(sim.outputs())
+    return {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+
+def worst(engine: dict, reference: dict, name: str) -> float:
+    """max |engine - reference| over the grid, relative to the reference's largest |value|."""
+    return float(np.max(np.abs(engine[name] - reference[name])) / np.max(np.abs(reference[name])))
+
+
+# (case, extra parameters, bound on every NAMES' relative difference): measured 1e-9 .. 2e-7 (rk45 at the engine's
+# default rtol 1e-10), 3e-7 .. 2e-6 (rk4 at h_max 1 ms, a tenth of a radian of the train's phase a step)
+CASES = {
+    "rk45": (dict(), 2e-6),
+    "rk45-no-L": (dict(inductance=False), 2e-6),
+    "rk45-tilted": (dict(gamma=1.0, beta=0.3), 2e-6),
+    "rk4": (dict(solver="rk4"), 2e-5),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_the_engine_runs_the_train_as_the_reference_does(case):
+    extra, bound = CASES[case]
+    params = dict(defaults(), **TRAIN, **extra)
+    engine = engine_run(params)
+    reference = simulate_reference(params, STOP, STEP, u=None)
+    for name in NAMES:
+        assert worst(engine, reference, name) < bound, (name, worst(engine, reference, name))
+    # the train rings: its force swings through both signs (the cam lets it go at the rise's end)
+    assert engine["F_train"].min() < -1.0 < 1.0 < engine["F_train"].max()
+
+
+def test_rk23_and_rk45_converge_to_the_reference_as_rtol_tightens():
+    params = dict(defaults(), **TRAIN)
+    reference = simulate_reference(params, STOP, STEP)
+    for solver in ("rk23", "rk45"):
+        errors = [worst(engine_run(dict(params, solver=solver, rtol=r, atol=r * 1e-3)), reference, "s_end")
+                  for r in (1e-6, 1e-8)]
+        assert errors[1] < errors[0] / 5.0, (solver, errors)
+
+
+def test_the_train_moves_the_motor_against_the_rigid_drive():
+    """The train's reaction reaches the shaft: the motor runs measurably apart from the drive without one, and a very
+    stiff train (k_train -> infinity, positions as 1/k) approaches the rigid drive with the end mass in m."""
+    base = dict(defaults(), M_f=0.0, mu=0.0)
+    rigid = engine_run(dict(base, m=base["m"] + TRAIN["m_end"]), stop=0.5)
+    soft = engine_run(dict(base, **TRAIN), stop=0.5)
+    stiff = engine_run(dict(base, **dict(TRAIN, k_train=2e8, d_train=2e3)), stop=0.5)
+    assert np.max(np.abs(soft["theta"] - rigid["theta"])) > 1e-4
+    assert np.max(np.abs(stiff["theta"] - rigid["theta"])) < 1e-3 * np.max(np.abs(soft["theta"] - rigid["theta"]))
+    assert np.max(np.abs(stiff["s_end"] - stiff["s"])) < 1e-6
+
+
+def test_without_a_train_the_end_is_the_follower():
+    out = engine_run(defaults(), stop=0.2)
+    assert np.array_equal(out["s_end"], out["s"]) and np.array_equal(out["v_end"], out["v"])
+    assert np.array_equal(out["a_end"], out["a"]) and not out["F_train"].any()
+
+
+def test_the_saved_state_carries_the_end_mass():
+    params = dict(defaults(), **TRAIN)
+    a = DriveSimulator(params)
+    for k in range(30):
+        a.do_step(k * STEP, STEP, u=U)
+    saved = a.get_state()
+    a.do_step(30 * STEP, STEP, u=U)
+    b = DriveSimulator(params)
+    b.set_state(saved)
+    b.do_step(30 * STEP, STEP, u=U)
+    assert a.outputs() == b.outputs() and a.outputs()["F_train"] != 0.0
+    rigid = DriveSimulator(dict(defaults(), M_f=0.0, mu=0.0))
+    with pytest.raises(Exception, match="has 2"):   # the named state: its length
+        rigid.set_state(saved)
+    with pytest.raises(Exception, match="no follower train"):   # the flat one: the engine's own check
+        rigid.set_state_array(a.state_array())
+
+
+@pytest.mark.parametrize("extra, named", [
+    (dict(M_f=0.012), "M_f"), (dict(mu=0.001), "mu"), (dict(k_shaft=100.0, J_cam=1e-4), "k_shaft"),
+    (dict(drive="speed"), "drive 'speed'"), (dict(solver="etdrk4"), "etdrk4"), (dict(c=1e-3, closure="kinematic"), "c"),
+    (dict(m_end=0.0), "m_end"), (dict(formulation="paper"), "paper"),
+])
+def test_what_the_engine_does_not_run_with_a_train_is_refused_by_name(extra, named):
+    with pytest.raises(ParameterError, match="k_train|m_end") as info:
+        DriveSimulator(dict(defaults(), **dict(TRAIN, **extra)))
+    assert named in str(info.value)

@@ -1,0 +1,56 @@
+"""The follower train in cam.fmu (FMI 2.0 co-simulation and Model Exchange under fmpy's CVode) and cam3.fmu (FMI 3.0
+co-simulation): the end mass's outputs and the motor's against the scipy reference (reference/train_voltage.py),
+written apart from the engine (docs/model.md 14.6)."""
+from __future__ import annotations
+
+import fmpy
+import numpy as np
+import pytest
+
+from cam_fmu.physics.parameters import defaults
+from cam_fmu.reference.integrate import simulate_reference
+
+STOP, STEP, U = 0.6, 0.01, 3.5
+TRAIN = {"k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "M_f": 0.0, "mu": 0.0, "u": U}
+NAMES = ["theta", "omega", "M", "s_end", "v_end", "a_end", "F_train"]
+# max |FMU - reference| / max |reference| measured: co-simulation 2e-7 (the engine at its rtol 1e-10), Model Exchange
+# 3e-7 .. 4e-6 with CVode at rtol 1e-10 (a_end, F_train the largest: the train's force is a small difference)
+BOUNDS = {"CoSimulation": 2e-6, "ModelExchange": 4e-5}
+
+
+@pytest.fixture(scope="module")
+def reference() -> dict:
+    return simulate_reference(dict(defaults(), **{k: v for k, v in TRAIN.items() if k != "u"}), STOP, STEP)
+
+
+@pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
+def test_cam_fmu_runs_the_train_as_the_reference_does(engine_fmu_path, reference, fmi_type):
+    options = {"relative_tolerance": 1e-10} if fmi_type == "ModelExchange" else {}
+    result = fmpy.simulate_fmu(str(engine_fmu_path), fmi_type=fmi_type, start_values=TRAIN, stop_time=STOP,
+                               output_interval=STEP, output=NAMES, **options)
+    rows = [np.nonzero(np.isclose(result["time"], t, rtol=0.0, atol=1e-9))[0][-1] for t in reference["time"]]
+    for name in NAMES:
+        got = result[name][rows]
+        error = np.max(np.abs(got - reference[name])) / np.max(np.abs(reference[name]))
+        assert error < BOUNDS[fmi_type], (fmi_type, name, error)
+    assert result["F_train"].min() < -1.0 < 1.0 < result["F_train"].max()   # the train rings through both signs
+
+
+def test_cam3_fmu_runs_the_train_as_the_reference_does(cam3_fmu_path, reference):
+    result = fmpy.simulate_fmu(str(cam3_fmu_path), start_values=TRAIN, stop_time=STOP, output_interval=STEP,
+                               output=NAMES)
+    for name in NAMES:
+        error = np.max(np.abs(result[name] - reference[name])) / np.max(np.abs(reference[name]))
+        assert error < BOUNDS["CoSimulation"], (name, error)
+
+
+def test_a_train_the_engine_cannot_run_is_an_fmi_error_with_its_reason(engine_fmu_path):
+    logged: list[str] = []
+
+    def logger(*args):
+        logged.append(args[-1].decode() if isinstance(args[-1], bytes) else str(args[-1]))
+
+    with pytest.raises(Exception):
+        fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(TRAIN, M_f=0.012), stop_time=0.1,
+                          output_interval=0.01, logger=logger)
+    assert any("k_train" in text and "M_f" in text for text in logged), logged
