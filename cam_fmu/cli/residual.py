@@ -11,9 +11,10 @@ carried back to the dwell's start by exp(zeta w_n dt)) and the largest differenc
 polynomial law is not a cam program's law: it has the closed form only. ``--limit X``: the ratio r_limit above
 which the residual stays within X (the top speed: in 1/min for the scene's rise angle with ``--train-hz`` or the
 scene's train). Writes DIR/<scene>_residual.png (no --no-plot). ``--json`` prints one object: scene, zeta,
-train_hz, rise_angle [rad], r, and per law its residual (closed form), drive_checked_at (the ratios run through
-the drive), drive_residual (the drive's residual there, null for a polynomial law), drive_max_difference (the
-largest |drive - closed form|, null without a drive run) and (with --limit) r_limit and rpm_max.
+train_hz, drive_train_hz (the train's frequency in the drive runs [Hz]: train_hz, else 50), rise_angle [rad], r,
+and per law its residual (closed form), drive_checked_at (the ratios run through the drive), drive_residual (the
+drive's residual there, null for a polynomial law), drive_max_difference (the largest |drive - closed form|, null
+without a drive run) and (with --limit) r_limit and rpm_max.
 """
 from __future__ import annotations
 
@@ -21,6 +22,9 @@ import argparse
 import json
 import math
 import sys
+
+
+DRIVE_HZ = 50.0  # Hz, the train's frequency in the drive runs without one given (the residual does not depend on it)
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -90,7 +94,9 @@ def run(args) -> int:
     laws = laws_of(label, law, args.laws)
     r = check_ratios(np.linspace(r1, r2, args.points))
     r_check = np.linspace(r1, r2, args.check) if args.check else np.empty(0)
-    out = {"scene": scene.name, "zeta": zeta, "train_hz": train_hz, "rise_angle": float(params["rise_angle"]),
+    drive_hz = train_hz or DRIVE_HZ
+    out = {"scene": scene.name, "zeta": zeta, "train_hz": train_hz, "drive_train_hz": drive_hz,
+           "rise_angle": float(params["rise_angle"]),
            "r": r.tolist(), "laws": {}}
     for name, item in laws.items():
         R = residual(item, r, zeta)
@@ -98,7 +104,7 @@ def run(args) -> int:
                  "drive_max_difference": None, "r_limit": None, "rpm_max": None}
         overrides = drive_overrides(name, item)
         if r_check.size and overrides is not None:
-            driven = np.array([drive_residual({**params, **overrides}, float(x), zeta, train_hz or 50.0).residual
+            driven = np.array([drive_residual({**params, **overrides}, float(x), zeta, drive_hz).residual
                                for x in r_check])
             entry.update(drive_checked_at=r_check.tolist(), drive_residual=driven.tolist(),
                          drive_max_difference=float(np.max(np.abs(driven - residual(item, r_check, zeta)))))

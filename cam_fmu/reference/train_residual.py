@@ -2,8 +2,9 @@
 reference with the follower train, the cam turned at the constant speed that makes the rise last r natural
 periods of the train, the end mass's free ringing read in the following dwell.
 
-The run: the scene's parameters (its law, lift, rise angle, mounting) in the speed drive, the follower on the cam
-(closure 'kinematic', c = 0: the train's reference runs no follower of its own); a scene without an upper dwell
+The run: the scene's parameters (its law, lift, rise angle, mounting) in the speed drive (a rigid shaft: k_shaft
+= 0), the follower on the cam (closure 'kinematic', c = 0, no return spring nor restitution: the train's reference
+runs no follower of its own, and 14.1's residual is that of a follower kept on the cam); a scene without an upper dwell
 gets one (the rest of the turn split between the upper dwell and the return, the rise unchanged). The train: an
 end mass ``m_end`` on k_train = m_end w_n^2, w_n = 2 pi ``train_hz``, damping d_train = 2 zeta sqrt(k_train m_end);
 the cam speed omega = rise_angle / (r T_n), T_n = 1 / train_hz, from theta = 0 (the rise's start).
@@ -47,12 +48,15 @@ class DriveResidual:
 
 
 def residual_scene(params: Mapping[str, Any]) -> dict[str, Any]:
-    """The scene's parameters for the measurement: speed drive, follower on the cam, from the rise's start, and an
-    upper dwell after the rise (the rest of the turn split with the return when the scene has none)."""
+    """The scene's parameters for the measurement: speed drive (rigid shaft), follower on the cam (no clearance,
+    return spring or restitution), from the rise's start, and an upper dwell after the rise (the rest of the turn
+    split with the return when the scene has none)."""
     p = dict(DriveModel(params).params)
     if p.get("motion_table"):
         raise ParameterError("the residual through the drive needs a rise law: parameter 'motion_table' must be empty")
-    p.update(drive="speed", closure="kinematic", c=0.0, theta0=0.0, omega0=0.0)
+    # The cam's motion imposed (a rigid shaft), the follower on it: no clearance, no return spring, no restitution.
+    p.update(drive="speed", closure="kinematic", c=0.0, k_shaft=0.0, k_spring=0.0, F_spring0=0.0, restitution=0.0,
+             theta0=0.0, omega0=0.0)
     if p["upper_dwell"] <= 0.0:
         rest = 2.0 * math.pi - p["rise_angle"]
         back = max(0.5 * rest, 1e-3)

@@ -38,6 +38,7 @@ def test_residual_json_the_scene_law_first_and_the_cycloidal_closed_form(tmp_pat
     cyc = out["laws"]["scene: cycloidal"]
     assert np.max(np.abs(np.asarray(cyc["residual"]) - want)) < 1e-11
     # the drive run at the 4 check ratios (the scene in the speed drive with the train): the closed form to 1e-9
+    assert out["drive_train_hz"] == 50.0   # --train-hz
     r_check = np.asarray(cyc["drive_checked_at"])
     assert r_check.tolist() == pytest.approx(np.linspace(1.1, 6, 4).tolist(), abs=1e-15)
     want_check = np.abs(np.sin(np.pi * r_check)) / (np.pi * r_check * np.abs(r_check ** 2 - 1))

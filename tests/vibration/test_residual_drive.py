@@ -98,3 +98,18 @@ def test_a_scene_without_a_dwell_gets_one_after_the_rise():
 def test_bad_input_is_refused_by_name(kwargs, word):
     with pytest.raises(ValueError, match=re.escape(word)):
         drive_residual(dict(SCENE, rise_law="cycloidal"), **kwargs)
+
+
+@pytest.mark.parametrize("name", ["spring_bounce", "compliant_shaft", "groove_voltage", "tilted"])
+def test_shipped_scenes_run_with_the_follower_kept_on_the_cam(name):
+    """A spring-closed, a compliant-shaft, a groove with restitution and a tilted scene: the measurement keeps the
+    follower on the cam in the speed drive, and its residual is the one the scene's law has in closed form (the
+    route tests/vibration/test_residual_routes.py checks against quadrature), damped or not."""
+    from cam_fmu.experiments.scenes import find_scene
+    from cam_fmu.physics.parameters import law_spec
+    from cam_fmu.vibration.spectral import residual
+
+    params = find_scene(name).primary.params
+    law = named_law(law_spec(params, "rise"))
+    for r, zeta in ((1.3, 0.0), (2.6, 0.1)):
+        assert drive_residual(params, r, zeta).residual == pytest.approx(float(residual(law, r, zeta)[0]), abs=1e-9)
