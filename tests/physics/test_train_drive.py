@@ -188,7 +188,7 @@ def test_voltage_drive_with_a_train_balances_the_motors_work(inductance):
     work = out["E_in"] - out["E_copper"]
     assert out["omega"].min() < -50.0 < 50.0 < out["omega"].max()  # rad/s: it turns both ways
     assert out["E_train_damp"][-1] > 0.0
-    assert np.max(np.abs(stored - stored[0] - work)) < 1e-9 * np.max(np.abs(out["E_in"]))  # measured 1.0e-12, 3.3e-13 (L)
+    assert np.max(np.abs(stored - stored[0] - work)) < 1e-9 * np.max(np.abs(out["E_in"]))  # measured 1e-12, 3e-13
 
 
 def test_voltage_drive_stiff_train_converges_to_the_rigid_drive():
