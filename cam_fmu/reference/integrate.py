@@ -54,9 +54,8 @@ def simulate_reference(
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
 
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
-    m_end); k_train = 0 is the rigid drive,
-    bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS (the speed drive; the voltage drive
-    without friction, reference/train_voltage.py)."""
+    m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS
+    (the speed drive; the voltage drive, with its friction, reference/train_voltage.py)."""
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])

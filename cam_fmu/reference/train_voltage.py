@@ -1,126 +1,238 @@
-"""The voltage drive with the follower train (docs/model.md 14.6), without friction: the cam, the motor and the end
-mass integrated together by scipy.
+"""The voltage drive with the follower train (docs/model.md 14.6): the cam, the motor and the end mass integrated
+together by scipy, with the shaft's and the guide's Coulomb friction.
 
-y = (theta, omega, i, x_e, v_e, W_train, E_train_damp, E_in, E_copper): the rigid drive's equation (5.1) with the
-train's force F_train on the follower (``DriveModel.omega_dot``'s ``axial``), i a state with L > 0 (held, and
-quasi-static, with L = 0), the end mass's two states and four energy integrals: W_train = int F_train v dt,
-E_train_damp = int d_train (v - v_e)^2 dt, E_in = int u i dt, E_copper = int R i^2 dt. Without friction the shaft
-never sticks and nothing switches but the profile (s'', s''' jump at its breakpoints) and the input's breaks: DOP853
-(Radau with a fast electrical pole, as the rigid reference) stops at those and where omega crosses 0 (the way the
-next breakpoint lies turns there). Friction (shaft or guide), a clearance, a compliant shaft and a follower of its
-own are refused with that reason: their events do not carry the train yet.
+y = (theta, omega, i, x_e, v_e, W_train, E_train_damp, E_in, E_copper, E_shaft, E_guide): the rigid drive's
+equation (5.1) with the train's force F_train on the follower (``DriveModel.omega_dot``'s ``axial``: it enters the
+axial force, so the guide's side force N_r and its friction f), i a state with L > 0 (held, and quasi-static,
+with L = 0), the end mass's two states and six energy integrals: W_train = int F_train v dt, E_train_damp =
+int d_train (v - v_e)^2 dt, E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide =
+int f |v| dt. The run is reference/hybrid.py's loop with the consistent drive's modes (physics/formulations/
+consistent.py, section 10): turning one way (friction against it, the guide's friction on the branch of N_r's
+sign) or stuck (omega = 0 while the torque on the held cam, F_train's included, stays within static friction: the
+end mass rings on and the current runs). Events: the stop (omega reaches 0: stuck, or on the other way by the
+break-away rule), the break-away (the stuck shaft's torque, which the ringing train changes, overcomes static
+friction), the side force's sign, and the profile's breakpoints (s'', s''' jump there). DOP853, or Radau with a
+fast electrical pole, as the rigid reference. A clearance, a compliant shaft and a follower of its own are refused
+with that reason (their events do not carry the train yet).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..physics.drive import DriveModel
+from ..physics.formulations.consistent import SIDE_HYSTERESIS
+from ..physics.modes import Event
 from ..physics.parameters import ParameterError
 from ..physics.signals import Signal
 from ..physics.train import Train, end_weight
 from ..physics.variables import output_record
-from .hybrid import collect, next_breakpoint
+from .hybrid import VoltageRun, event, next_breakpoint, piece_input
 
-__all__ = ["voltage_train_reference"]
+__all__ = ["voltage_train_reference", "TRAIN_ENERGY"]
 
 THETA, OMEGA, CURRENT, X_E, V_E = range(5)
+# rad/s: the stop fires where omega has passed 0 by this much. A shaft started at a located break-away (its
+# acceleration 0 to rounding there, then growing) may dip a rounding the wrong way first: a stop at 0 itself fired
+# there at once and the run stalled between the two events (L > 0, at a voltage step to 0). The kinetic energy the
+# stop then drops, J (1e-12)^2 / 2, is nothing.
+STOP_SLACK = 1e-12
+# J: the energy integrals after the five states, in this order.
+TRAIN_ENERGY = ("W_train", "E_train_damp", "E_in", "E_copper", "E_shaft", "E_guide")
 
 
 def _check(model: DriveModel) -> None:
-    refused = [name for name, on in (("'M_f' (shaft friction)", model.M_f != 0.0),
-                                     ("'mu' (guide friction)", model.mu != 0.0), ("'c' (clearance)", model.c != 0.0),
+    refused = [name for name, on in (("'c' (clearance)", model.c != 0.0),
                                      ("'k_shaft' (compliant shaft)", model.compliant),
                                      ("'closure' (a follower of its own)", model.free_follower)) if on]
     if refused:
-        raise ParameterError(f"the follower train in the voltage drive runs without friction, clearance, compliant "
-                             f"shaft or follower of its own so far: parameters {', '.join(refused)} must be off "
+        raise ParameterError(f"the follower train in the voltage drive runs without clearance, compliant shaft or "
+                             f"follower of its own so far: parameters {', '.join(refused)} must be off "
                              f"(their events do not carry the train yet)")
+
+
+@dataclass
+class _Mode:
+    """Stuck, or turning toward ``direction``; ``side``: the sign of the guide's side force N_r (the friction's
+    branch) while turning."""
+
+    stuck: bool
+    direction: float
+    side: float = 1.0
+
+
+class _VoltageTrain(VoltageRun):
+    label = "train reference"
+
+    def __init__(self, model: DriveModel, u: Signal, train: Train, rtol: float, atol: float,
+                 method: str | None) -> None:
+        super().__init__(model, u, rtol, atol, True, method)
+        self.model, self.train = model, train
+        self.F_ex = end_weight(train, model.params)
+        self.guide = model.mu > 0.0  # the side force's sign is an event
+        self.target = math.nan       # rad, the breakpoint ahead of the piece
+
+    def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
+        p, k = self.model.params, self.train.k_train
+        theta0, omega0 = p["theta0"], p["omega0"]
+        s0, s1_0 = self.model.program.derivatives(theta0)[:2]
+        y = [theta0, omega0, p["i0"] if self.model.L > 0.0 else 0.0, s0 + self.F_ex / k, s1_0 * omega0]
+        mode = _Mode(stuck=omega0 == 0.0, direction=1.0 if omega0 >= 0.0 else -1.0)
+        return self.pieces(grid, 0.0, y + [0.0] * len(TRAIN_ENERGY), mode,
+                           [b for b in self.u.breaks if 0.0 < b < float(grid[-1])])
+
+    # ------------------------------------------------------------ the drive at one instant
+    def _current(self, y, u_t: float) -> float:
+        return y[CURRENT] if self.model.L > 0.0 else self.model.motor.quasi_static_current(u_t, y[OMEGA])
+
+    def _force(self, y, omega: float) -> tuple[float, float]:
+        """(F_train [N], the follower's v [m/s]) at y with the cam at omega [rad/s]."""
+        s, s1 = self.model.program.derivatives(y[THETA])[:2]
+        v = s1 * omega
+        return self.train.force(s, v, y[X_E], y[V_E]), v
+
+    def _omega_dot(self, y, u_t: float, direction: float, side: float, omega: float) -> float:
+        F, _ = self._force(y, omega)
+        return self.model.omega_dot(y[THETA], omega, self.model.c_m * self._current(y, u_t), direction, True, side, F)
+
+    def _side_force(self, y, u_t: float, mode: _Mode, side: float) -> float:
+        """N_r [N] on the branch ``side`` (0: the one that holds), the train's force in the axial force."""
+        model, omega = self.model, y[OMEGA]
+        F, _ = self._force(y, omega)
+        drive = model.c_m * self._current(y, u_t) - model.M_f * mode.direction
+        g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
+        return g.n0 + g.sigma * g.kappa * g.f
+
+    def _margin(self, y, u_t: float) -> float:
+        """> 0 when the held shaft would start [rad/s2]: the larger acceleration either way, friction against it."""
+        return max(self._omega_dot(y, u_t, 1.0, 0.0, 0.0), -self._omega_dot(y, u_t, -1.0, 0.0, 0.0))
+
+    def _rates(self, y, u_t: float, mode: _Mode) -> list[float]:
+        model, train = self.model, self.train
+        omega = 0.0 if mode.stuck else y[OMEGA]
+        i = self._current(y, u_t)
+        F, v = self._force(y, omega)
+        slip = v - y[V_E]
+        di = model.motor.current_rate(u_t, i, omega) if model.L > 0.0 else 0.0
+        rates = [0.0, 0.0, di, y[V_E], (F + self.F_ex) / train.m_end, F * v, train.d_train * slip * slip,
+                 u_t * i, model.R * i * i, 0.0, 0.0]
+        if not mode.stuck:
+            side = mode.side if self.guide else 0.0
+            rates[THETA] = omega
+            rates[OMEGA] = model.omega_dot(y[THETA], omega, model.c_m * i, mode.direction, True, side, F)
+            # The friction's power as the mode applies it, M_f d omega and sigma f v (= M_f |omega|, f |v| while
+            # d = sgn(omega)): smooth up to the stop that ends the piece, where |omega| would put a kink inside the
+            # integrator's last step and its interpolant at the stop (measured: 7.5e-10 J off the balance).
+            rates[9] = model.M_f * mode.direction * omega
+            if self.guide:
+                drive = model.c_m * i - model.M_f * mode.direction
+                g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
+                rates[10] = g.sigma * g.f * v
+        return rates
+
+    # ------------------------------------------------------------ the hybrid run's parts
+    def _piece(self, t: float, y: list, mode: _Mode):
+        u_at = piece_input(self.u, self.piece_end)
+
+        def rhs(t, y):
+            return self._rates(y, u_at(t)[0], mode)
+
+        if mode.stuck:
+            return [event(Event.BREAK_AWAY, lambda t, y: -self._margin(y, u_at(t)[0]))], rhs, {"method": self.method,
+                                                                                               "atol": self.atol}
+        direction = mode.direction
+        target = next_breakpoint(self.breakpoints, y[THETA], direction)
+        self.target = target
+        events = [event(Event.STOP, lambda t, y: direction * y[OMEGA] + STOP_SLACK),
+                  event(Event.BREAKPOINT, lambda t, y: direction * (target - y[THETA]))]
+        if self.guide:
+            events.append(event(Event.SIDE, lambda t, y: self._side_value(y, u_at(t)[0], mode)))
+        return events, rhs, {"method": self.method, "atol": self.atol}
+
+    def _side_value(self, y, u_t: float, mode: _Mode) -> float:
+        """> 0 while the guide's friction branch ``mode.side`` holds."""
+        return mode.side * self._side_force(y, u_t, mode, mode.side) + SIDE_HYSTERESIS
+
+    def _rows_first(self, t: float, after_event: bool) -> bool:
+        # At an input's break the outputs due there are its left limit (as the rigid reference's, model.md 8.1).
+        return not after_event and t > 0.0 and t in self.u.breaks
+
+    def _settle(self, t: float, y: list, mode: _Mode, after_event: bool):
+        """At the start and at an input's break the break-away rule (the torque may have jumped with u); then the
+        friction branch, whose side force may have jumped (at a breakpoint s'' does)."""
+        u_t = self.u.value(t)
+        if not after_event:
+            self._start(y, u_t, mode, False)
+        if self.guide and not mode.stuck and self._side_value(y, u_t, mode) < 0.0:
+            mode.side = -mode.side
+        return mode, y
+
+    def _start(self, y: list, u_t: float, mode: _Mode, at_threshold: bool) -> None:
+        """At rest (omega = 0): stay stuck, or turn the way the torque beats static friction (at a located
+        break-away, toward the larger acceleration); then the friction branch."""
+        if not mode.stuck:
+            if y[OMEGA] != 0.0 or mode.direction * self._omega_dot(y, u_t, mode.direction, 0.0, 0.0) >= 0.0:
+                return
+            mode.stuck = True
+        forward = self._omega_dot(y, u_t, 1.0, 0.0, 0.0)
+        backward = -self._omega_dot(y, u_t, -1.0, 0.0, 0.0)
+        if forward > 0.0 or backward > 0.0 or at_threshold:  # a located break-away: its margin is 0 to rounding
+            mode.stuck, mode.direction = False, 1.0 if forward >= backward else -1.0
+            y[OMEGA] = 0.0
+            n_r = self._side_force(y, u_t, mode, 0.0) if self.guide else 0.0
+            if abs(n_r) > SIDE_HYSTERESIS:
+                mode.side = 1.0 if n_r > 0.0 else -1.0
+
+    def _stop(self, t: float, y: list, mode: _Mode, kind: Event):
+        y[OMEGA] = 0.0
+        mode.stuck = True
+        self._start(y, self.u.value(t), mode, False)
+        return mode, y
+
+    def _break_away(self, t: float, y: list, mode: _Mode, kind: Event):
+        self._start(y, self.u.value(t), mode, True)
+        return mode, y
+
+    def _flip_side(self, t: float, y: list, mode: _Mode, kind: Event):
+        mode.side = -mode.side  # N_r passed through zero: the other friction branch
+        return mode, y
+
+    def _breakpoint(self, t: float, y: list, mode: _Mode, kind: Event):
+        # on from just past it, as the rigid reference (s'' and s''' of the piece ahead)
+        y[THETA] = self.target + mode.direction * 1e-15 * max(1.0, abs(self.target))
+        return mode, y
+
+    TRANSITIONS = {Event.STOP: _stop, Event.BREAK_AWAY: _break_away, Event.SIDE: _flip_side,
+                   Event.BREAKPOINT: _breakpoint}
+
+    def _row(self, t: float, y, mode: _Mode, left: bool) -> dict[str, float]:
+        model, train = self.model, self.train
+        u_t = self.u.left_value(t) if left else self.u.value(t)
+        theta = float(y[THETA])
+        omega = 0.0 if mode.stuck else float(y[OMEGA])
+        i = self._current(y, u_t)
+        F, _ = self._force(y, omega)
+        if mode.stuck:
+            load = model.load(theta, 0.0, 0.0, 0.0, True, F)
+            load.M = model.c_m * i  # static friction takes whatever the motor applies
+            load.v = load.a = 0.0
+        else:
+            side = mode.side if self.guide else 0.0
+            omega_dot = model.omega_dot(theta, omega, model.c_m * i, mode.direction, True, side, F)
+            load = model.load(theta, omega, omega_dot, mode.direction, True, F)
+        row = output_record(omega=omega, theta=theta, s=load.s_cam, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
+                            alpha=load.alpha, s_cam=load.s_cam, voltage=u_t, N_contact=load.N, theta_m=theta,
+                            omega_m=omega, M_shaft=0.0)
+        return row | {"s_end": float(y[X_E]), "v_end": float(y[V_E]), "a_end": (F + self.F_ex) / train.m_end,
+                      "F_train": F} | {name: float(value) for name, value in zip(TRAIN_ENERGY, y[5:])}
 
 
 def voltage_train_reference(model: DriveModel, grid: np.ndarray, u: Signal, train: Train, rtol: float,
                             atol: float, method: str | None) -> dict[str, np.ndarray]:
-    """The voltage drive with ``train`` on ``grid`` [s]: the drive's outputs with F_train in the load, the train's
-    outputs (reference.train_speed.TRAIN_OUTPUTS) and E_in, E_copper [J]."""
-    from scipy.integrate import solve_ivp
-
+    """The voltage drive with ``train`` on ``grid`` [s]: the drive's outputs with F_train in the load (and in the
+    guide's friction), the train's outputs (reference.train_speed.TRAIN_OUTPUTS) and E_in, E_copper, E_shaft,
+    E_guide [J]."""
     _check(model)
-    p, program, motor = model.params, model.program, model.motor
-    L = model.L
-    method = method or ("Radau" if L > 0.0 and L / model.R < 1e-3 else "DOP853")
-    breakpoints = sorted(set(program.breakpoints()) | {0.0}) + [2.0 * math.pi]
-    F_ex = end_weight(train, p)
-    k, d, m_e = train.k_train, train.d_train, train.m_end
-    theta0, omega0 = p["theta0"], p["omega0"]
-    s0, s1_0 = program.derivatives(theta0)[:2]
-    y = np.array([theta0, omega0, p["i0"] if L > 0.0 else 0.0, s0 + F_ex / k, s1_0 * omega0, 0.0, 0.0, 0.0, 0.0])
-
-    def derivative(y, u_t):
-        theta, omega = y[THETA], y[OMEGA]
-        i = y[CURRENT] if L > 0.0 else motor.quasi_static_current(u_t, omega)
-        s, s1 = program.derivatives(theta)[:2]
-        v = s1 * omega
-        F = k * (s - y[X_E]) + d * (v - y[V_E])
-        omega_dot = model.omega_dot(theta, omega, model.c_m * i, 1.0, True, 0.0, F)
-        di = motor.current_rate(u_t, i, omega) if L > 0.0 else 0.0
-        return [omega, omega_dot, di, y[V_E], (F + F_ex) / m_e, F * v, d * (v - y[V_E]) ** 2, u_t * i,
-                model.R * i * i]
-
-    states = np.empty((len(grid), len(y)))
-    states[0] = y
-    stop = float(grid[-1])
-    times = sorted({0.0, stop, *(b for b in u.breaks if 0.0 < b < stop)})
-    for a, b in zip(times[:-1], times[1:]):
-        u_a, slope = u.value(a), u.slope(a)
-
-        def rhs(t, y, a=a, u_a=u_a, slope=slope):
-            return derivative(y, u_a + slope * (t - a))
-
-        def turning(t, y):
-            return y[OMEGA]
-        turning.terminal, turning.direction = True, 0
-        t = a
-        while t < b:
-            omega = y[OMEGA]
-            direction = math.copysign(1.0, omega if omega else rhs(t, y)[OMEGA] or 1.0)
-            target = next_breakpoint(breakpoints, y[THETA], direction)
-
-            def crossing(t, y, target=target, direction=direction):
-                return direction * (target - y[THETA])
-            crossing.terminal, crossing.direction = True, -1
-            events = [crossing] + ([turning] if omega else [])
-            sol = solve_ivp(rhs, (t, b), y, method=method, rtol=rtol, atol=atol, events=events, dense_output=True)
-            if sol.status < 0:
-                raise RuntimeError(f"train reference failed at t = {t} s: {sol.message}")
-            t_end = float(sol.t[-1])
-            done = (grid > t) & (grid <= t_end)
-            if done.any():
-                states[done] = sol.sol(grid[done]).T
-            y = sol.y[:, -1].copy()
-            if sol.status == 1 and len(sol.t_events[0]):  # at a breakpoint: on from just past it
-                y[THETA] = target + direction * 1e-15 * max(1.0, abs(target))
-            elif sol.status == 1:  # omega crossed 0: exactly 0 there, the next breakpoint lies the other way
-                y[OMEGA] = 0.0
-            t = t_end if t_end > t else b
-    rows = []
-    for t, y in zip(grid, states):
-        t = float(t)
-        u_t = u.left_value(t) if t > 0.0 and t in u.breaks else u.value(t)
-        rows.append(_row(model, train, F_ex, y, u_t))
-    return collect(rows, grid)
-
-
-def _row(model: DriveModel, train: Train, F_ex: float, y: np.ndarray, u_t: float) -> dict[str, float]:
-    theta, omega = float(y[THETA]), float(y[OMEGA])
-    i = float(y[CURRENT]) if model.L > 0.0 else model.motor.quasi_static_current(u_t, omega)
-    s, s1 = model.program.derivatives(theta)[:2]
-    F = train.force(s, s1 * omega, float(y[X_E]), float(y[V_E]))
-    direction = 1.0 if omega >= 0.0 else -1.0
-    omega_dot = model.omega_dot(theta, omega, model.c_m * i, direction, True, 0.0, F)
-    load = model.load(theta, omega, omega_dot, direction, True, F)
-    row = output_record(omega=omega, theta=theta, s=load.s_cam, i=i, M=load.M, J=load.J, v=load.v, a=load.a,
-                        alpha=load.alpha, s_cam=load.s_cam, voltage=u_t, N_contact=load.N, theta_m=theta,
-                        omega_m=omega, M_shaft=0.0)
-    return row | {"s_end": float(y[X_E]), "v_end": float(y[V_E]), "a_end": (F + F_ex) / train.m_end, "F_train": F,
-                  "W_train": float(y[5]), "E_train_damp": float(y[6]), "E_in": float(y[7]), "E_copper": float(y[8])}
+    return _VoltageTrain(model, u, train, rtol, atol, method).run(grid)

@@ -1,5 +1,6 @@
-"""`cam-fmu residual` and `cam-fmu optimize-law`: their numbers against the cycloidal's closed form and the
-integrated train, the law written as a scene's parameters that a scene accepts, the refusals."""
+"""`cam-fmu residual` and `cam-fmu optimize-law`: their numbers against the cycloidal's closed form, the drive
+run with the train and the integrated train, the law written as a scene's parameters that a scene accepts, the
+refusals."""
 from __future__ import annotations
 
 import json
@@ -36,7 +37,16 @@ def test_residual_json_the_scene_law_first_and_the_cycloidal_closed_form(tmp_pat
     want = np.abs(np.sin(np.pi * r)) / (np.pi * r * np.abs(r * r - 1))
     cyc = out["laws"]["scene: cycloidal"]
     assert np.max(np.abs(np.asarray(cyc["residual"]) - want)) < 1e-11
-    assert cyc["ode_max_difference"] < 1e-9 and len(cyc["ode_checked_at"]) == 4
+    # the drive run at the 4 check ratios (the scene in the speed drive with the train): the closed form to 1e-9
+    assert out["drive_train_hz"] == 50.0   # --train-hz
+    r_check = np.asarray(cyc["drive_checked_at"])
+    assert r_check.tolist() == pytest.approx(np.linspace(1.1, 6, 4).tolist(), abs=1e-15)
+    want_check = np.abs(np.sin(np.pi * r_check)) / (np.pi * r_check * np.abs(r_check ** 2 - 1))
+    drive = np.asarray(cyc["drive_residual"])
+    assert np.max(np.abs(drive - want_check)) < 1e-9
+    assert cyc["drive_max_difference"] == pytest.approx(np.max(np.abs(drive - want_check)), abs=1e-12)
+    poly = out["laws"]["polynomial_345"]   # not a cam program's law: the closed form only
+    assert poly["drive_residual"] is None and poly["drive_max_difference"] is None and poly["drive_checked_at"] == []
     # the top speed: the rise (paper_fig6: pi rad) lasting r_limit periods of the 50 Hz train
     assert 1 / (np.pi * cyc["r_limit"] * (cyc["r_limit"] ** 2 - 1)) >= 0.01 * (1 - 1e-9)
     omega = cyc["rpm_max"] * 2 * math.pi / 60

@@ -31,11 +31,20 @@ from ...physics.variables import STATES
 
 NX = len(STATES)
 RTOL, ATOL = 1e-6, 1e-8
+
+
+def slots(*names: str) -> list[int]:
+    """The indices of Model Exchange's states ``names`` (physics.variables.STATES)."""
+    order = [row[0] for row in STATES]
+    return [order.index(name) for name in names]
+
+
+
 # scene's parameters for the measured run; carried: the slots the drive integrates (the rest are held at 0)
 RUNS = {
-    "inductance": ({"gamma": np.pi, "L": 1e-3, "omega0": 20.0}, [0, 1, 2]),
+    "inductance": ({"gamma": np.pi, "L": 1e-3, "omega0": 20.0}, slots("x_theta", "x_omega", "x_i")),
     "compliant_shaft": ({"gamma": np.pi, "L": 1e-3, "omega0": 20.0, "J_m": 3e-5, "J_cam": 1.41e-5, "k_shaft": 50.0,
-                         "d_shaft": 1e-3}, [0, 1, 2, 3, 4]),
+                         "d_shaft": 1e-3}, slots("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m")),
 }
 
 
@@ -135,7 +144,8 @@ def stiff_run(fmu: Path, scene: str, method: str, analytic: bool, t_end: float) 
 
 # the run through events: the backlash scene's groove with a follower of its own, from rest; carried: theta, omega and
 # the follower's gap and its rate (L = 0: x_i held; a rigid shaft)
-EVENT_RUN = ({"gamma": np.pi, "backlash": True, "c": 5e-4, "closure": "form", "u": 3.5}, [0, 1, 5, 6])
+EVENT_RUN = ({"gamma": np.pi, "backlash": True, "c": 5e-4, "closure": "form", "u": 3.5},
+             slots("x_theta", "x_omega", "x_gap", "x_gap_rate"))
 LOCATE = 1e-12   # s: an event's bracket
 
 
