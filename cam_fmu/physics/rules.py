@@ -143,8 +143,6 @@ FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_F
 OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
 TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
-SHAFT_FRICTION = Where(Cmp(Num("shaft_friction"), "!="), Num("M_f"))   # N.m: M_f where the effect is on
-GUIDE_FRICTION = Where(Cmp(Num("guide_friction"), "!="), Num("mu"))    # 1: mu where the effect is on
 
 PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
            "consistent formulation)")
@@ -204,12 +202,9 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(TRAIN, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="))),
          "parameter 'k_train' = {k_train} N/m: the train runs with the follower on the cam (closure 'kinematic', or "
          "'form' without clearance) so far; allowed with closure {closure} and c = {c} m: k_train = 0"),
-    Rule(AllOf(TRAIN, Not(Is("drive", ("speed",))),
-               AnyOf(Cmp(SHAFT_FRICTION, "!="), Cmp(GUIDE_FRICTION, "!="), COMPLIANT)),
-         "parameter 'k_train' = {k_train} N/m: in the voltage drive the train runs without shaft or guide friction "
-         "and with a rigid shaft so far (their events do not carry the train yet); allowed with M_f = {M_f} N.m, "
-         "mu = {mu}, k_shaft = {k_shaft} N.m/rad: k_train = 0 (or M_f = 0 or shaft_friction false, mu = 0 or "
-         "guide_friction false, k_shaft = 0)"),
+    Rule(AllOf(TRAIN, COMPLIANT),
+         "parameter 'k_train' = {k_train} N/m: the train runs with a rigid shaft so far; allowed with k_shaft = "
+         "{k_shaft} N.m/rad: k_train = 0 (or k_shaft = 0)"),
     *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),

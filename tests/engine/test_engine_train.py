@@ -1,5 +1,6 @@
 """The follower train in the C engine (docs/model.md 14.6): the end mass as two states of the consistent voltage
-drive, under every solver that runs it, against the scipy reference (reference/train_voltage.py, written apart);
+drive, under every solver that runs it, with and without friction, against the scipy reference
+(reference/train_voltage.py, written apart);
 the saved state carries it; without a train its outputs are the follower's; what the engine does not run yet is
 refused by name."""
 from __future__ import annotations
@@ -10,6 +11,7 @@ import pytest
 from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.physics.parameters import defaults
+from cam_fmu.physics.signals import Signal
 from cam_fmu.reference.integrate import simulate_reference
 
 STOP, STEP, U = 1.0, 0.01, 3.5
@@ -52,6 +54,28 @@ def test_the_engine_runs_the_train_as_the_reference_does(case):
         assert worst(engine, reference, name) < bound, (name, worst(engine, reference, name))
     # the train rings: its force swings through both signs (the cam lets it go at the rise's end)
     assert engine["F_train"].min() < -1.0 < 1.0 < engine["F_train"].max()
+
+
+@pytest.mark.parametrize("inductance", [False, True])
+def test_with_friction_the_cam_stops_sticks_and_breaks_away_under_the_ringing_train_as_the_reference_does(inductance):
+    """Shaft and guide friction under gravity, 12 V then -6 V then 0 V: the cam reverses, stops and is broken away
+    again by the train's ringing alone (a break-away event while it is held), as in the reference; measured 1.2e-8 ..
+    5e-7 of each output's largest value."""
+    u = Signal((0.0, 0.3, 0.3, 0.63, 0.63), (12.0, 12.0, -6.0, -6.0, 0.0))
+    params = dict(defaults(), **dict(TRAIN, M_f=0.012, mu=0.1), gamma=0.5, inductance=inductance)
+    sim = DriveSimulator(params)
+    sim.set_inputs(u.value(0.0), 0.0)
+    rows = [sim.outputs()]
+    for k in range(int(round(STOP / STEP))):
+        sim.do_step(k * STEP, STEP, u=u.value(k * STEP))
+        rows.append(sim.outputs())
+    engine = {name: np.array([r[name] for r in rows]) for name in rows[0]}
+    reference = simulate_reference(params, STOP, STEP, u=u)
+    for name in NAMES:
+        assert worst(engine, reference, name) < 2e-6, (name, worst(engine, reference, name))
+    names = [e["name"] for e in sim.events()]
+    assert "stop" in names and "break_away" in names and "side_force" in names
+    assert np.any(engine["omega"][1:] == 0.0) and engine["omega"].min() < 0.0 < engine["omega"].max()
 
 
 def test_rk23_and_rk45_converge_to_the_reference_as_rtol_tightens():
@@ -100,7 +124,7 @@ def test_the_saved_state_carries_the_end_mass():
 
 
 @pytest.mark.parametrize("extra, named", [
-    (dict(M_f=0.012), "M_f"), (dict(mu=0.001), "mu"), (dict(k_shaft=100.0, J_cam=1e-4), "k_shaft"),
+    (dict(k_shaft=100.0, J_cam=1e-4), "k_shaft"),
     (dict(drive="speed"), "drive 'speed'"), (dict(solver="etdrk4"), "etdrk4"), (dict(c=1e-3, closure="kinematic"), "c"),
     (dict(m_end=0.0), "m_end"), (dict(formulation="paper"), "paper"),
 ])

@@ -50,6 +50,8 @@ CASES = {
     "train": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "M_f": 0.0, "mu": 0.0},
     "train_L": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "M_f": 0.0, "mu": 0.0, "L": 1e-3,
                 "gamma": 0.8},
+    "train_friction": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "mu": 0.05, "gamma": 1.2,
+                       "beta": 0.7},
     **FOLLOWER,
 }
 

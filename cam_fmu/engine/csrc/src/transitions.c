@@ -9,7 +9,8 @@ int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EV
 {
     int n = 0;
     if (mode->stuck) {
-        if (m->has_current || m->compliant)   /* the torque on the held cam changes: a current, a shaft */
+        if (m->has_current || m->compliant || m->train)   /* the torque on the held cam changes: a current, a
+                                                            * shaft, a train's ringing */
             codes[n++] = CAM_EV_BREAK_AWAY;
     } else if (m->backlash && mode->contact == 0) {
         codes[n++] = CAM_EV_STOP;
