@@ -1,0 +1,171 @@
+"""Followers of every kind in the drive's reference (docs/model.md 16), against independent sources: the load torque
+at constant speed from the law's closed form written here, the energy balance of docs/model.md 9 with friction and
+gravity, and today's reference for the translating roller, bit for bit."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cam_fmu.physics.follower_kind import FollowerKind
+from cam_fmu.physics.parameters import KGF, ParameterError, resolve
+from cam_fmu.physics.signals import Signal, constant
+from cam_fmu.physics.train import Train
+from cam_fmu.reference import simulate_reference
+
+OMEGA = 10.0  # rad/s
+RISE = math.pi / 2  # rad: cycloidal rise, dwell, cycloidal return, dwell, 90 deg each
+TURN = 2.0 * math.pi / OMEGA  # s
+H = 0.02  # m, the lift
+SCENE = dict(drive="speed", rise_law="cycloidal", return_law="cycloidal", rise_angle=RISE, upper_dwell=RISE,
+             return_angle=RISE, lower_dwell=RISE, lift=H, closure="kinematic", m=0.4, G=4.0)
+ARM = dict(arm_length=0.15, pivot_distance=0.18, J_arm=2e-3, m_arm=0.2, r_cm_arm=0.07, psi_0=0.3)
+KINDS = {"translating_flat": FollowerKind("translating_flat"),
+         "oscillating_roller": FollowerKind("oscillating_roller", lift_angle=0.3, **ARM),
+         "oscillating_flat": FollowerKind("oscillating_flat", lift_angle=0.15, **ARM)}
+
+
+def cycloidal(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(s, s', s'') of the scene's program: rise h (x - sin(2 pi x) / (2 pi)) over [0, b), dwell, the mirrored
+    return over [2 b, 3 b), dwell; x the fraction of the piece, b = RISE."""
+    theta = np.mod(theta, 2.0 * math.pi)
+    b = RISE
+    s, s1, s2 = np.zeros_like(theta), np.zeros_like(theta), np.zeros_like(theta)
+    rise, top, ret = theta < b, (theta >= b) & (theta < 2 * b), (theta >= 2 * b) & (theta < 3 * b)
+    x = theta[rise] / b
+    s[rise] = H * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
+    s1[rise] = H / b * (1.0 - np.cos(2 * math.pi * x))
+    s2[rise] = 2 * math.pi * H / b ** 2 * np.sin(2 * math.pi * x)
+    s[top] = H
+    x = (theta[ret] - 2 * b) / b
+    s[ret] = H - H * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
+    s1[ret] = -H / b * (1.0 - np.cos(2 * math.pi * x))
+    s2[ret] = -2 * math.pi * H / b ** 2 * np.sin(2 * math.pi * x)
+    return s, s1, s2
+
+
+@pytest.mark.parametrize("name", list(KINDS))
+def test_constant_speed_load_torque_is_the_closed_form(name):
+    """Friction and gravity off, omega constant: M = (J_arm + m L^2) psi' psi'' omega^2 (an arm, psi = lift_angle s / h)
+    and m s' s'' omega^2 (a translating face); J = J_0 + (J_arm + m L^2) psi'^2, resp. J_0 + m s'^2; psi, psi_dot."""
+    kind = KINDS[name]
+    scene = dict(SCENE, gravity=False, guide_friction=False, shaft_friction=False)
+    out = simulate_reference(scene, TURN, TURN / 997, omega_ref=constant(OMEGA), follower=kind)
+    s, s1, s2 = cycloidal(out["theta"])
+    J_0 = resolve(scene)["J_m"] + resolve(scene)["J_cam"]
+    if kind.oscillating:
+        k = kind.lift_angle / H
+        I_f, q, q1, q2 = kind.J_arm + 0.4 * kind.arm_length ** 2, k * s, k * s1, k * s2
+    else:
+        I_f, q, q1, q2 = 0.4, np.zeros_like(s), s1, s2
+    M = I_f * q1 * q2 * OMEGA ** 2
+    assert np.max(np.abs(M)) > 1e-3  # N m: the follower loads the cam
+    assert np.max(np.abs(out["M"] - M)) < 1e-12 * np.max(np.abs(M))
+    assert np.max(np.abs(out["J"] - (J_0 + I_f * q1 ** 2))) < 1e-14
+    assert np.max(np.abs(out["s"] - s)) < 1e-15 and np.max(np.abs(out["v"] - s1 * OMEGA)) < 1e-13
+    if kind.oscillating:
+        assert np.max(np.abs(out["psi"] - q)) < 1e-15
+        assert np.max(np.abs(out["psi_dot"] - q1 * OMEGA)) < 1e-13
+    else:
+        assert not np.any(out["psi"]) and not np.any(out["psi_dot"])
+
+
+@pytest.mark.parametrize("name", ["oscillating_roller", "oscillating_flat"])
+def test_constant_speed_arm_gravity_is_the_closed_form(name):
+    """Gravity on (a vertical cam plane), friction off: the arm's weight adds (G L + m_arm g_n r_cm) cos(psi + psi_0)
+    psi' to the torque: the follower's weight G at L, the arm's own at r_cm_arm."""
+    kind = KINDS[name]
+    scene = dict(SCENE, gravity=True, gamma=math.pi / 2, beta=0.0, guide_friction=False, shaft_friction=False)
+    out = simulate_reference(scene, TURN, TURN / 997, omega_ref=constant(OMEGA), follower=kind)
+    s, s1, s2 = cycloidal(out["theta"])
+    k = kind.lift_angle / H
+    psi, psi1, psi2 = k * s, k * s1, k * s2
+    moment = 4.0 * kind.arm_length + kind.m_arm * KGF * kind.r_cm_arm
+    M = (kind.J_arm + 0.4 * kind.arm_length ** 2) * psi1 * psi2 * OMEGA ** 2 + moment * np.cos(psi + kind.psi_0) * psi1
+    assert np.max(np.abs(out["M"] - M)) < 1e-12 * np.max(np.abs(M))
+
+
+def _stored(out: dict[str, np.ndarray], kind: FollowerKind, scene: dict) -> np.ndarray:
+    """(1/2) J omega^2 + (1/2) L i^2 + the potential [J], written from the outputs: an arm's
+    (G L + m_arm g_n r_cm) sin(psi + psi_0) (vertical plane), a translating face's G s (lifted against gravity)."""
+    p = resolve(scene)
+    if kind.oscillating:
+        V = (p["G"] * kind.arm_length + kind.m_arm * KGF * kind.r_cm_arm) * np.sin(out["psi"] + kind.psi_0)
+    else:
+        V = p["G"] * out["s"]
+    return 0.5 * out["J"] * out["omega"] ** 2 + 0.5 * p["L"] * out["i"] ** 2 + V
+
+
+VOLTAGE = dict(SCENE, drive="voltage", gravity=True, gamma=math.pi / 2, mu=0.05, M_f=0.012, inductance=True, L=1e-3,
+               J_cam=2e-4)
+
+
+@pytest.mark.parametrize("name", list(KINDS))
+@pytest.mark.parametrize("u, turns", [(constant(40.0), True), (Signal((0.0, 0.3, 0.3, 0.6, 0.6), (12.0, 12.0, -6.0, -6.0, 1.0), hold=True), False)])
+def test_voltage_drive_energy_balance_with_friction_and_gravity(name, u, turns):
+    """docs/model.md 9 with c_e = c_m: stored energy (from the outputs) - its start = E_in - E_copper - E_shaft -
+    E_guide (the kind's friction loss), to 1e-9 of the electrical work: the cam turning at 40 V (0.25 s, over a
+    turns), or driven forward, reversed and left to stall under gravity (1 s: stops, break-aways, the friction's branch
+    changing)."""
+    kind = KINDS[name]
+    scene = dict(VOLTAGE, c_e=resolve({})["c_m"], beta=0.0 if kind.oscillating else math.pi)
+    out = simulate_reference(scene, 0.25 if turns else 1.0, 1e-3, u=u, energy=True, follower=kind)
+    stored = _stored(out, kind, scene)
+    work = out["E_in"] - out["E_copper"] - out["E_shaft"] - out["E_guide"]
+    scale = np.max(np.abs(out["E_in"]))
+    assert out["E_guide"][-1] > 1e-4 * scale and out["E_shaft"][-1] > 1e-3 * scale  # both frictions act
+    assert np.ptp(stored) > 5e-3 * scale  # energy moves in and out of the follower
+    if turns:
+        assert out["theta"][-1] > 2.0 * math.pi
+    else:
+        assert np.any(out["omega"] < 0.0)
+    assert np.max(np.abs(stored - stored[0] - work)) < 1e-9 * scale
+
+
+@pytest.mark.parametrize("drive", ["speed", "voltage"])
+def test_translating_roller_and_no_kind_are_todays_reference_bit_for_bit(drive):
+    """follower=None, FollowerKind() and no argument: every output equal, the energy integrals too."""
+    scene = dict(SCENE, drive=drive, gravity=True, gamma=math.pi / 2, beta=math.pi, closure="form")
+    kwargs = dict(omega_ref=constant(OMEGA), u=constant(12.0), energy=drive == "voltage")
+    plain = simulate_reference(scene, TURN, TURN / 50, **kwargs)
+    for follower in (None, FollowerKind(), FollowerKind("translating_roller")):
+        same = simulate_reference(scene, TURN, TURN / 50, follower=follower, **kwargs)
+        assert same.keys() == plain.keys() and "psi" not in same
+        for name in plain:
+            assert np.array_equal(plain[name], same[name]), name
+
+
+@pytest.mark.parametrize("fields, word", [
+    (dict(follower_type="rocker"), "follower_type"),
+    (dict(follower_type="translating_flat", arm_length=0.1), "arm_length.*translating_flat"),
+    (dict(follower_type="translating_roller", J_arm=1e-3), "J_arm.*translating_roller"),
+    (dict(follower_type="oscillating_roller", arm_length=0.15, lift_angle=0.3), "pivot_distance"),
+    (dict(follower_type="oscillating_roller", arm_length=-0.15, pivot_distance=0.2, lift_angle=0.3), "arm_length"),
+    (dict(follower_type="oscillating_flat", arm_length=0.15, pivot_distance=0.2, lift_angle=4.0), "lift_angle"),
+    (dict(follower_type="oscillating_flat", arm_length=0.15, pivot_distance=0.2, lift_angle=0.1, J_arm=math.nan),
+     "J_arm"),
+])
+def test_bad_follower_kind_is_refused_by_name(fields, word):
+    with pytest.raises(ParameterError, match=word):
+        FollowerKind(**fields)
+
+
+@pytest.mark.parametrize("scene, kind, word", [
+    (dict(SCENE, backlash=True, c=1e-4, closure="form"), "translating_flat", "'c'"),
+    (dict(SCENE, closure="spring"), "oscillating_roller", "closure"),
+    (dict(SCENE, drive="voltage", formulation="paper"), "oscillating_flat", "formulation"),
+    (dict(SCENE, drive="voltage", k_shaft=100.0, J_cam=1e-4), "translating_flat", "k_shaft"),
+    (dict(SCENE, gravity=True, gamma=math.pi / 2, beta=1.0), "oscillating_roller", "beta"),
+    (dict(SCENE, r_b=0.2), "oscillating_flat", "pivot"),  # d = 0.18 m inside the base circle
+    (dict(SCENE, lift=0.1, r_b=0.01), "translating_flat", "r_b"),  # rho = r_b + s + s'' < 0: a cusp
+])
+def test_kind_where_the_reference_cannot_run_it_is_refused(scene, kind, word):
+    with pytest.raises(ParameterError, match=word):
+        simulate_reference(scene, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS[kind])
+
+
+def test_train_with_another_kind_is_refused():
+    with pytest.raises(ParameterError, match="train"):
+        simulate_reference(SCENE, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS["translating_flat"],
+                           train=Train(k_train=1e6, m_end=1.0))
