@@ -47,6 +47,8 @@ class KindLoad(LoadState):
 
     loss: float = 0.0
     P: float = 0.0
+    lever: float = 0.0  # lambda [m, or 1 for an arm]
+    speed: float = 0.0  # |omega| [rad/s]
 
 
 class KindDriveModel(DriveModel):
@@ -208,10 +210,15 @@ class KindDriveModel(DriveModel):
         elif kind.follower_type == "oscillating_flat":
             N = P * (1.0 - q1) / (kind.pivot_distance * math.cos(self._delta0 + q))
         return KindLoad(omega_dot, M, J, self.mu * abs(N), s1 * omega, s2 * omega * omega + s1 * omega_dot, alpha,
-                        s, N, loss=friction * abs(omega), P=P)
+                        s, N, loss=friction * abs(omega), P=P, lever=lam, speed=abs(omega))
 
-    def friction_power(self, load: LoadState) -> float:
-        """The follower's friction loss [W] (module doc)."""
+    def friction_power(self, load: LoadState, side: float = 0.0) -> float:
+        """The follower's friction loss mu |P| lambda |omega| [W] (module doc); with ``side`` (+1/-1, the branch the
+        integrator holds between side events) mu side P lambda |omega|: the power of the friction torque the drive
+        equation applies, which stays smooth through the located zero of P (|P| has a kink there that an integrator
+        step would cross before the event stops it)."""
+        if side:
+            return self.mu * side * load.P * load.lever * load.speed
         return load.loss
 
     def energy(self, theta: float, omega: float, i: float, engaged: bool = True) -> float:

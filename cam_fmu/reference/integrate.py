@@ -181,6 +181,7 @@ class _Consistent(VoltageRun):
     def _rhs(self, mode, base: float):
         hybrid, model, n = self.hybrid, self.model, self.hybrid.size
         energy, u_at = self.energy, piece_input(self.u, self.piece_end)
+        side = mode.side if hybrid.guide_side and not mode.stuck else 0.0  # the friction's branch held
 
         def rhs(t, y):
             u_t = u_at(t)[0]
@@ -191,7 +192,7 @@ class _Consistent(VoltageRun):
                 omega = 0.0 if mode.stuck else y[1]
                 load = model.load(state[0], omega, dy[1], mode.direction, mode.contact != 0)
                 slip = hybrid.motor_speed(state) - omega
-                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), model.friction_power(load),
+                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), model.friction_power(load, side),
                        model.d_shaft * slip * slip]
             return dy
 
