@@ -212,3 +212,34 @@ def test_friction_power_is_the_drive_equations_on_either_branch(name, side):
             else:
                 crossed += 1
     assert crossed > 0  # some states lie past P's zero on the held branch
+
+
+@pytest.mark.parametrize("name", ["translating_flat", "oscillating_flat"])
+def test_flat_face_friction_torque_from_the_envelopes_contact(name):
+    """Speed drive at 10 rad/s, gravity and shaft friction off, mu = 0.05: the friction's share of the torque,
+    M - P q', is mu |N| times the sliding speed over omega, taken from the contact point of the contour (the
+    envelope, kinematics/flat_cam.py) turned to the fixed frame: the cam's surface speed there along the face,
+    |omega| |(-y, x) . t| (the face's own points move across it: along a translating face not at all, an
+    oscillating face passes through its pivot), with N = P / l, l the contact's distance from the pivot (P along X
+    on a translating face); P = I_f q'' omega^2 at constant speed."""
+    from cam_fmu.physics.kind_drive import KindDriveModel
+
+    kind = KINDS[name]
+    scene = dict(SCENE, gravity=False, shaft_friction=False, mu=0.05)
+    cam = KindDriveModel(scene, kind).cam
+    out = simulate_reference(scene, TURN, TURN / 97, omega_ref=constant(OMEGA), follower=kind)
+    theta = out["theta"]
+    s, s1, s2 = cycloidal(theta)
+    cx, cy = cam.contour(theta)
+    x, y = np.cos(theta) * cx - np.sin(theta) * cy, np.sin(theta) * cx + np.cos(theta) * cy  # the fixed frame
+    if kind.oscillating:
+        k, d, r_b = kind.lift_angle / H, kind.pivot_distance, resolve(scene)["r_b"]
+        I_f, q, q1, q2 = kind.J_arm + 0.4 * kind.arm_length ** 2, k * s, k * s1, k * s2
+        l = np.hypot(x - r_b, y - math.sqrt(d * d - r_b * r_b))
+        slide = np.abs(y * np.sin(q) + x * np.cos(q))  # (-y, x) . (-sin psi, cos psi)
+    else:
+        I_f, q1, q2, l, slide = 0.4, s1, s2, 1.0, np.abs(x)
+    P = I_f * q2 * OMEGA ** 2
+    friction = 0.05 * np.abs(P) / l * slide
+    assert np.max(friction) > 1e-3  # N m
+    assert np.max(np.abs(out["M"] - P * q1 - friction)) < 1e-12 * np.max(friction)
