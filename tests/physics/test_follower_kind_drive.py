@@ -162,6 +162,8 @@ def test_bad_follower_kind_is_refused_by_name(fields, word):
     (dict(SCENE, gravity=True, gamma=math.pi / 2, beta=1.0), "oscillating_roller", "beta"),
     (dict(SCENE, r_b=0.2), "oscillating_flat", "pivot"),  # d = 0.18 m inside the base circle
     (dict(SCENE, lift=0.1, r_b=0.01), "translating_flat", "r_b"),  # rho = r_b + s + s'' < 0: a cusp
+    # J_0 + m s' (s' - mu (r_b + s)) < 0 on the rise: the face's friction would wedge it
+    (dict(SCENE, drive="voltage", mu=0.5, J_cam=0.0), "translating_flat", "'mu'.*wedge"),
 ])
 def test_kind_where_the_reference_cannot_run_it_is_refused(scene, kind, word):
     with pytest.raises(ParameterError, match=word):
