@@ -245,3 +245,21 @@ def test_flat_face_friction_torque_from_the_envelopes_contact(name):
     friction = 0.05 * np.abs(P) / l * slide
     assert np.max(friction) > 1e-3  # N m
     assert np.max(np.abs(out["M"] - P * q1 - friction)) < 1e-12 * np.max(friction)
+
+
+def test_roller_arm_contact_force_carries_the_torque():
+    """Speed drive at 10 rad/s with friction and gravity: the contact's torque about the pivot, N_contact L cos(alpha),
+    times psi' is the cam's load torque less the shaft's friction (virtual work, as 4.3's identity for the
+    translating roller); alpha the pressure angle of the triangle (15.1) written here."""
+    kind = KINDS["oscillating_roller"]
+    scene = dict(SCENE, gravity=True, gamma=math.pi / 2, beta=0.0, mu=0.05)
+    out = simulate_reference(scene, TURN, TURN / 97, omega_ref=constant(OMEGA), follower=kind)
+    s, s1, _ = cycloidal(out["theta"])
+    k, L, d, r_b = kind.lift_angle / H, kind.arm_length, kind.pivot_distance, resolve(scene)["r_b"]
+    delta = math.acos((d * d + L * L - r_b * r_b) / (2 * d * L)) + k * s
+    alpha = np.arctan2(d * np.cos(delta) - L * (1.0 - k * s1), d * np.sin(delta))
+    assert np.max(np.abs(out["alpha"] - alpha)) < 1e-12
+    torque = out["N_contact"] * L * np.cos(alpha) * k * s1
+    load = out["M"] - resolve(scene)["M_f"]
+    assert np.max(np.abs(load)) > 0.1  # N m
+    assert np.max(np.abs(torque - load)) < 1e-12 * np.max(np.abs(load))
