@@ -98,7 +98,8 @@ class KindDriveModel(DriveModel):
                                          ("'closure' (a follower of its own)", p["closure"] == "spring")) if on]
         if refused:
             raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam (closure 'kinematic' or "
-                                 f"'form' without clearance) and a rigid shaft so far: parameters {', '.join(refused)} must be off")
+                                 f"'form' without clearance) and a rigid shaft so far: parameters "
+                                 f"{', '.join(refused)} must be off")
         if self.kind.oscillating and p["gravity"] and p["beta"] != 0.0:
             raise ParameterError(f"parameter 'beta' = {p['beta']!r} rad is not used by follower_type {kind!r} "
                                  f"(the arm's angle to gravity is its psi_0): leave it at 0")

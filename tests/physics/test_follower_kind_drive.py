@@ -100,12 +100,13 @@ def _stored(out: dict[str, np.ndarray], kind: FollowerKind, scene: dict) -> np.n
     return 0.5 * out["J"] * out["omega"] ** 2 + 0.5 * p["L"] * out["i"] ** 2 + V
 
 
+REVERSING = Signal((0.0, 0.3, 0.3, 0.6, 0.6), (12.0, 12.0, -6.0, -6.0, 1.0), hold=True)  # V: forward, back, stall
 VOLTAGE = dict(SCENE, drive="voltage", gravity=True, gamma=math.pi / 2, mu=0.05, M_f=0.012, inductance=True, L=1e-3,
                J_cam=2e-4)
 
 
 @pytest.mark.parametrize("name", list(KINDS))
-@pytest.mark.parametrize("u, turns", [(constant(40.0), True), (Signal((0.0, 0.3, 0.3, 0.6, 0.6), (12.0, 12.0, -6.0, -6.0, 1.0), hold=True), False)])
+@pytest.mark.parametrize("u, turns", [(constant(40.0), True), (REVERSING, False)])
 def test_voltage_drive_energy_balance_with_friction_and_gravity(name, u, turns):
     """docs/model.md 9 with c_e = c_m: stored energy (from the outputs) - its start = E_in - E_copper - E_shaft -
     E_guide (the kind's friction loss), to 1e-11 of the electrical work: the cam turning at 40 V (0.25 s, over a
