@@ -264,3 +264,35 @@ def test_roller_arm_contact_force_carries_the_torque():
     load = out["M"] - resolve(scene)["M_f"]
     assert np.max(np.abs(load)) > 0.1  # N m
     assert np.max(np.abs(torque - load)) < 1e-12 * np.max(np.abs(load))
+
+
+@pytest.mark.parametrize("name", list(KINDS))
+def test_voltage_drive_is_lagranges_equation_integrated_here(name):
+    """Voltage drive at 40 V, L = 0, gravity on, friction off: the reference's theta(t) and omega(t) are those of
+    Lagrange's equation written here and integrated by scipy's Radau (not the reference's DOP853 and events):
+    (J_0 + I_f q'^2) omega' = c_m (u - c_e omega) / R - I_f q' q'' omega^2 - dV/dq q', q and its derivatives from
+    the cycloidal law's closed form (its acceleration is continuous at the breakpoints)."""
+    from scipy.integrate import solve_ivp
+
+    kind = KINDS[name]
+    scene = dict(VOLTAGE, inductance=False, shaft_friction=False, guide_friction=False,
+                 beta=0.0 if kind.oscillating else math.pi)
+    p = resolve(scene)
+    J_0, u = p["J_m"] + p["J_cam"], 40.0
+    k = kind.lift_angle / H if kind.oscillating else 1.0
+    I_f = (kind.J_arm + 0.4 * kind.arm_length ** 2) if kind.oscillating else 0.4
+    W = p["G"] * kind.arm_length + kind.m_arm * KGF * kind.r_cm_arm if kind.oscillating else 0.0
+
+    def rhs(t, y):
+        s, s1, s2 = (float(x[0]) for x in cycloidal(np.array([y[0]])))
+        q, q1, q2 = k * s, k * s1, k * s2
+        dV = W * math.cos(q + kind.psi_0) if kind.oscillating else p["G"]
+        torque = p["c_m"] * (u - p["c_e"] * y[1]) / p["R"]
+        return [y[1], (torque - I_f * q1 * q2 * y[1] ** 2 - dV * q1) / (J_0 + I_f * q1 * q1)]
+
+    grid = np.linspace(0.0, 0.3, 31)
+    own = solve_ivp(rhs, (0.0, 0.3), [0.0, 0.0], method="Radau", t_eval=grid, rtol=1e-11, atol=1e-12)
+    out = simulate_reference(scene, 0.3, 0.01, u=constant(u), follower=kind)
+    assert out["theta"][-1] > 1.0  # rad: the cam turns through the rise
+    assert np.max(np.abs(out["theta"] - own.y[0])) < 1e-8
+    assert np.max(np.abs(out["omega"] - own.y[1])) < 1e-7 * np.max(np.abs(own.y[1]))
