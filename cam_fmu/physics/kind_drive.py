@@ -95,7 +95,9 @@ class KindDriveModel(DriveModel):
         kind = self.kind.follower_type
         refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0),
                                          ("'k_shaft' (compliant shaft)", self.compliant),
-                                         ("'closure' (a follower of its own)", p["closure"] == "spring")) if on]
+                                         ("'closure' (a follower of its own)", p["closure"] == "spring"),
+                                         # the follower train as parameters (where the table has them)
+                                         ("'k_train' (follower train)", p.get("k_train", 0.0) > 0.0)) if on]
         if refused:
             raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam (closure 'kinematic' or "
                                  f"'form' without clearance) and a rigid shaft so far: parameters "
