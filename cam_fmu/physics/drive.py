@@ -266,6 +266,11 @@ class DriveModel:
         N = (push + sigma * f) * math.sqrt(1.0 + tan_a * tan_a)  # X: N cos(alpha) = m a - F_gx + sigma f (the C bits)
         return LoadState(omega_dot, M, J, f, v, a, alpha, s, N)
 
+    def friction_power(self, load: LoadState, side: float = 0.0) -> float:
+        """The follower's friction loss [W] at ``load``: the guide's f |v| (docs/model.md 9); ``side``, the branch
+        the integrator holds, is for another follower kind's (physics/kind_drive.py)."""
+        return load.f * abs(load.v)
+
     def breakaway_direction(self, theta: float, torque: float, engaged: bool = True,
                             engaged_backward: bool | None = None) -> float:
         """Direction the shaft starts to move from rest: +1, -1, or 0 (stays stuck).

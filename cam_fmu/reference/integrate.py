@@ -27,11 +27,14 @@ from ..physics.formulations import formulation_name
 from ..physics.formulations.consistent import EVENT_NAME, EVENTS, HybridDrive
 from ..physics.formulations.paper import PaperScheme, calculation_steps
 from ..physics.formulations.speed import speed_drive_outputs
+from ..physics.follower_kind import FollowerKind
+from ..physics.kind_drive import KindDriveModel
 from ..physics.modes import Event
 from ..physics.parameters import ParameterError
 from ..physics.train import Train
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
+from .follower_kind import kind_reference
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .train_speed import speed_train_reference
 from .train_voltage import voltage_train_reference
@@ -50,12 +53,25 @@ def simulate_reference(
     energy: bool = False,
     method: str | None = None,
     train: Train | None = None,
+    follower: FollowerKind | None = None,
 ) -> dict[str, np.ndarray]:
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
 
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
     m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS
-    (the speed drive; the voltage drive, with its friction, reference/train_voltage.py)."""
+    (the speed drive; the voltage drive, with its friction, reference/train_voltage.py).
+
+    ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
+    'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the
+    speed drive (reference/follower_kind.py), its outputs add reference.follower_kind.KIND_OUTPUTS."""
+    if follower is not None and not follower.default:
+        if train is not None and train.active:
+            raise ParameterError(f"the follower train does not run with follower_type {follower.follower_type!r} "
+                                 f"(only with the translating roller so far)")
+        model = KindDriveModel(params, follower)
+        return kind_reference(model, _grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"]),
+                              omega_ref or constant(INPUT_STARTS["omega_ref"]),
+                              {"rtol": rtol, "atol": atol, "energy": energy, "method": method})
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
@@ -166,6 +182,7 @@ class _Consistent(VoltageRun):
     def _rhs(self, mode, base: float):
         hybrid, model, n = self.hybrid, self.model, self.hybrid.size
         energy, u_at = self.energy, piece_input(self.u, self.piece_end)
+        side = mode.side if hybrid.guide_side and not mode.stuck else 0.0  # the friction's branch held
 
         def rhs(t, y):
             u_t = u_at(t)[0]
@@ -176,7 +193,7 @@ class _Consistent(VoltageRun):
                 omega = 0.0 if mode.stuck else y[1]
                 load = model.load(state[0], omega, dy[1], mode.direction, mode.contact != 0)
                 slip = hybrid.motor_speed(state) - omega
-                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), load.f * abs(load.v),
+                dy += [u_t * i, model.R * i * i, model.M_f * abs(omega), model.friction_power(load, side),
                        model.d_shaft * slip * slip]
             return dy
 
