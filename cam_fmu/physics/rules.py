@@ -190,9 +190,6 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(TRAIN, Not(Cmp(Num("m_end"), ">"))),
          "parameter 'm_end' = {m_end} kg: a follower train (k_train = {k_train} N/m) needs its end mass; allowed with "
          "k_train > 0: m_end in (0, 1e4] kg"),
-    Rule(AllOf(TRAIN, Is("drive", ("speed",))),
-         "parameter 'k_train' = {k_train} N/m: the engine runs the follower train in the voltage drive so far; allowed "
-         "with drive 'speed': k_train = 0 (the scipy reference runs it: reference/train_speed.py)"),
     Rule(AllOf(TRAIN, Is("solver", ("etdrk4",))),
          "parameter 'k_train' = {k_train} N/m: solver 'etdrk4' integrates the rigid drive's electrical pole, not the "
          "train's end mass; allowed with it: k_train = 0 (use solver 'rk4', 'rk23' or 'rk45')"),

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from ..physics.drive import DriveModel
 from ..physics.parameters import ParameterError
@@ -68,12 +68,15 @@ def residual_scene(params: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def drive_residual(params: Mapping[str, Any], r: float, zeta: float = 0.0, train_hz: float = 50.0,
-                   m_end: float = 1.0, rtol: float = 1e-12, atol: float = 1e-13) -> DriveResidual:
+                   m_end: float = 1.0, rtol: float = 1e-12, atol: float = 1e-13,
+                   simulate: Callable[..., Mapping[str, Any]] | None = None) -> DriveResidual:
     """The residual / lift after the rise of the scene ``params`` for r = rise time / natural period (> 0) and the
     damping ratio ``zeta`` in [0, 1), by running the speed drive's reference with the train (``train_hz`` [Hz],
-    ``m_end`` [kg]: the result does not depend on them but through rounding)."""
+    ``m_end`` [kg]: the result does not depend on them but through rounding). ``simulate``: another run of the drive
+    with ``simulate_reference``'s arguments (the C engine's, in its tests), by default the reference."""
     from .integrate import simulate_reference
 
+    simulate = simulate or simulate_reference
     for name, value, ok in (("r", r, r > 0.0), ("zeta", zeta, 0.0 <= zeta < 1.0),
                             ("train_hz", train_hz, train_hz > 0.0), ("m_end", m_end, m_end > 0.0)):
         if not (math.isfinite(value) and ok):
@@ -86,7 +89,7 @@ def drive_residual(params: Mapping[str, Any], r: float, zeta: float = 0.0, train
     t_rise = r / train_hz
     omega = p["rise_angle"] / t_rise
     t_measured = t_rise + min(1.0 / train_hz, 0.5 * p["upper_dwell"] / omega)
-    out = simulate_reference(p, t_measured, t_rise, omega_ref=constant(omega), rtol=rtol, atol=atol, train=train)
+    out = simulate(p, t_measured, t_rise, omega_ref=constant(omega), rtol=rtol, atol=atol, train=train)
     lift, deflection = p["lift"], end_weight(train, p) / k
     w_d = w_n * math.sqrt(1.0 - zeta * zeta)
 

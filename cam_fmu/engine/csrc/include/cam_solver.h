@@ -128,6 +128,11 @@ void cam_exponential_pair(const CamModel *m, const CamMode *mode, const double x
  * growth factor, at most 5x and 1e3 s; where the step reached `bound` [s] and may grow, no shorter than *h_next
  * was). Rejected: 0, and *dt shrunk (to no less than a tenth). Every adaptive step of the engine takes it. */
 int cam_step_control(double norm, double exponent, double bound, double *dt, double *h_next);
+/* The follower train's end mass x[CAM_X_END], x[CAM_V_END] over a step of h [s] of the speed drive's imposed motion
+ * theta0 + omega0 t + alpha t^2 / 2 (train.c): Dormand-Prince 5(4) on the model's rtol, atol, its step carried in
+ * *h_next, the steps taken into *steps; CAM_ERR_REJECTED (x as before) where the step falls below 1e-12 h. */
+int cam_train_follow(const CamModel *m, double x[CAM_NX], double theta0, double omega0, double alpha, double h,
+                     double *h_next, long *steps, CamError *err);
 
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is

@@ -7,7 +7,7 @@
 #include <float.h>
 #include <math.h>
 
-#include "cam_drive.h"
+#include "cam_solver.h"
 
 #define TWO_PI (2.0 * 3.141592653589793)
 
@@ -80,9 +80,9 @@ static double rest_position(const CamModel *m, double theta, double s)
 
 static int speed_init(CamDrive *d, CamError *err)
 {
-    double unused[CAM_NX];
+    double x0[CAM_NX];   /* the model's start: the speed drive keeps only a train's end mass of it */
     (void)err;
-    cam_initial(&d->model, d->model.params.v[CAM_P_THETA0], 0.0, 0.0, unused, &d->mode);   /* a valid mode in every saved state */
+    cam_initial(&d->model, d->model.params.v[CAM_P_THETA0], 0.0, 0.0, x0, &d->mode);   /* a valid mode in every saved state */
     d->speed.theta = d->model.params.v[CAM_P_THETA0];
     d->speed.speed = d->omega_ref;
     d->speed.s = s_at(&d->model.profile, d->speed.theta);
@@ -90,13 +90,32 @@ static int speed_init(CamDrive *d, CamError *err)
     d->speed.fresh = 1.0;
     if (d->model.free_follower)
         cam_follower_start(&d->model, &d->speed, d->omega_ref, d->omega_dot_ref);
+    if (d->model.train) {   /* the end mass at rest relative to the follower (its speed set with the inputs) */
+        d->x[CAM_X_END] = x0[CAM_X_END];
+        d->x[CAM_V_END] = 0.0;
+    }
     return CAM_OK;
+}
+
+/* F_train [N] with the follower on the cam at theta [rad] turning at omega [rad/s] and the end mass at x_e, v_e. */
+static double train_force(const CamModel *m, double theta, double omega, double x_e, double v_e)
+{
+    double x[CAM_NX] = {0.0};
+    x[CAM_THETA] = theta;
+    x[CAM_X_END] = x_e;
+    x[CAM_V_END] = v_e;
+    return cam_train_force_at(m, x, omega);
 }
 
 static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
 {
     (void)u;
     d->speed.speed = omega_ref;
+    if (d->model.train && d->speed.fresh != 0.0) {   /* before the first step: v_e = v, the cam at omega_ref */
+        double p[4];
+        cam_profile_eval(&d->model.profile, d->speed.theta, p);
+        d->x[CAM_V_END] = p[1] * omega_ref;
+    }
     if (d->model.free_follower) {   /* its own motion: the start's contact follows the inputs set before the first step */
         if (d->speed.fresh != 0.0)
             cam_follower_start(&d->model, &d->speed, omega_ref, omega_dot_ref);
@@ -126,14 +145,23 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
         *steps = 1;
         return CAM_OK;
     }
-    (void)err;
+    if (d->model.train) {   /* the end mass under the step's motion (train.c), before the cam moves on */
+        double h_next = d->solver.h_next > 0.0 ? d->solver.h_next : h;
+        int status = cam_train_follow(&d->model, d->x, st->theta, d->omega_ref, d->omega_dot_ref, h, &h_next, steps,
+                                      err);
+        if (status != CAM_OK)
+            return status;
+        d->solver.h_next = h_next;
+        st->fresh = 0.0;
+    } else {
+        *steps = 1;
+    }
     st->speed = d->omega_ref + d->omega_dot_ref * h;
     st->s = follower_along(&d->model.profile, st->s, st->theta, end, d->model.c);
     st->theta = end;
     if (st->speed == 0.0 && d->omega_ref == 0.0)   /* a step at rest; one that stops the cam at its end still moves
                                                         there (the left limit), at rest from the next input on */
         st->s = rest_position(&d->model, st->theta, st->s);
-    *steps = 1;
     return CAM_OK;
 }
 
@@ -162,18 +190,30 @@ static void speed_outputs(CamDrive *d, double out[])
         cam_follower_outputs(m, st, omega_dot, direction, out);
         return;
     }
+    double x_e = d->x[CAM_X_END], v_e = d->x[CAM_V_END], F = train_force(m, theta, omega, x_e, v_e), a_e = 0.0;
     on = engaged(m, theta, st->s, direction, omega_dot);
-    cam_load(m, theta, omega, omega_dot, direction, on, 0.0, &load);
+    cam_load(m, theta, omega, omega_dot, direction, on, F, &load);
     i = (m->J_0 * omega_dot + load.M) / m->c_m;
     voltage = m->R * i + m->c_e * omega;
-    if (m->L > 0.0 && omega != 0.0) {
-        double step = 1e-6, dM;
-        cam_load(m, theta + step, omega, omega_dot, direction, on, 0.0, &ahead);
-        cam_load(m, theta - step, omega, omega_dot, direction, on, 0.0, &behind);
+    if (m->train)
+        a_e = (F + m->F_ex) / m->m_end;
+    if (m->L > 0.0 && omega != 0.0) {   /* along the motion: the cam 1e-6 rad on at constant speed, the train's force
+                                         * with the end mass and the speed over that time */
+        double step = 1e-6, dt = step / omega, dM;
+        cam_load(m, theta + step, omega, omega_dot, direction, on,
+                 train_force(m, theta + step, omega + omega_dot * dt, x_e + v_e * dt, v_e + a_e * dt), &ahead);
+        cam_load(m, theta - step, omega, omega_dot, direction, on,
+                 train_force(m, theta - step, omega - omega_dot * dt, x_e - v_e * dt, v_e - a_e * dt), &behind);
         dM = (ahead.M - behind.M) / (2.0 * step);
         voltage += m->L * omega * dM / m->c_m;
     }
     cam_record_outputs(&load, omega, theta, st->s, i, voltage, out);   /* load.s_cam: s_cam at theta */
+    if (m->train) {
+        out[CAM_O_S_END] = x_e;
+        out[CAM_O_V_END] = v_e;
+        out[CAM_O_A_END] = a_e;
+        out[CAM_O_F_TRAIN] = F;
+    }
 }
 
 static void speed_advice(const CamDrive *d, char *buf, size_t len)
