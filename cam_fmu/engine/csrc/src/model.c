@@ -139,15 +139,16 @@ static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x
 {
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], omega_motor = x[CAM_OMEGA_M];
     double shaft = cam_drive_torque(m, x, omega, u);   /* x[CAM_OMEGA] is 0 while stuck */
+    double F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;
         dx[CAM_OMEGA] = 0.0;
     } else {
         dx[CAM_THETA] = omega;
         dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, shaft, mode->direction, mode->contact != 0,
-                                      m->guide_side ? mode->side : 0.0, 0.0);
+                                      m->guide_side ? mode->side : 0.0, F);
     }
-    train_rhs(m, x, 0.0, dx);   /* a compliant shaft carries no train (physics/rules.py) */
+    train_rhs(m, x, F, dx);
     dx[CAM_TWIST] = omega_motor - omega;
     dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - shaft) / m->J_m;
     dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;

@@ -63,6 +63,16 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
     out[CAM_O_F_TRAIN] = 0.0;
 }
 
+/* J: the train's end mass's kinetic energy, its spring's and its weight's potential (docs/model.md 14.6; 0 without). */
+static double train_energy(const CamEnergy *e, const double out[])
+{
+    double stretch = out[CAM_O_S] - out[CAM_O_S_END];
+    if (e->k_train == 0.0)
+        return 0.0;
+    return 0.5 * e->m_end * out[CAM_O_V_END] * out[CAM_O_V_END] + 0.5 * e->k_train * stretch * stretch
+           - e->F_ex * out[CAM_O_S_END];
+}
+
 /* E_mech [J] of published outputs: kinetic + gravity potential; compliant: the cam side's and the rotor's
  * kinetic energy and the shaft's elastic energy k (theta_m - theta)^2 / 2 (docs/model.md section 12). */
 static double mechanical(const CamEnergy *e, const double out[])
@@ -76,17 +86,12 @@ static double mechanical(const CamEnergy *e, const double out[])
         twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];   /* and a compliant shaft's rotor and elastic energy */
         return own + 0.5 * e->J_m * out[CAM_O_OMEGA_M] * out[CAM_O_OMEGA_M] + 0.5 * e->k_shaft * twist * twist;
     }
-    if (e->k_train > 0.0) {   /* a rigid shaft (physics/rules.py): and the train's end mass and spring */
-        double stretch = out[CAM_O_S] - out[CAM_O_S_END];
-        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S] + 0.5 * e->m_end * out[CAM_O_V_END]
-               * out[CAM_O_V_END] + 0.5 * e->k_train * stretch * stretch - e->F_ex * out[CAM_O_S_END];
-    }
     if (e->k_shaft == 0.0)
-        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S];
+        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S] + train_energy(e, out);
     twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];
     omega_m = out[CAM_O_OMEGA_M];
     return 0.5 * (out[CAM_O_J] - e->J_m) * omega * omega + 0.5 * e->J_m * omega_m * omega_m
-           + 0.5 * e->k_shaft * twist * twist - e->F_gx * out[CAM_O_S];
+           + 0.5 * e->k_shaft * twist * twist - e->F_gx * out[CAM_O_S] + train_energy(e, out);
 }
 
 void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
