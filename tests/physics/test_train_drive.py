@@ -173,6 +173,18 @@ VOLTAGE = dict(VERTICAL, drive="voltage", shaft_friction=False, guide_friction=F
 
 
 @pytest.mark.parametrize("inductance", [False, True])
+def stiff_train_errors(params: dict, m_e: float, rigid: dict) -> list[float]:
+    """theta's largest difference to ``rigid`` over 0.15 s at 6 V with a train of k_train = 1e6, 1e7, 1e8 N/m and
+    end mass m_e [kg]; each decade divides it by 10 (to 5 %): the angle converges as 1/k_train."""
+    errors = []
+    for k in (1e6, 1e7, 1e8):
+        out = simulate_reference(params, 0.15, 1e-3, u=constant(6.0), train=Train(k_train=k, m_end=m_e))
+        errors.append(np.max(np.abs(out["theta"] - rigid["theta"])))
+    for a, b in zip(errors[:-1], errors[1:]):
+        assert b / a == pytest.approx(0.1, rel=0.05)
+    return errors
+
+
 def test_voltage_drive_with_a_train_balances_the_motors_work(inductance):
     """Damped train, under gravity, the voltage jumping from 12 V to -6 V (the cam reverses) over 1 s: the drive's
     stored energy (1/2 J omega^2 + 1/2 L i^2 - F_gx s, DriveModel.energy) plus the train's (end mass kinetic + spring
@@ -201,12 +213,7 @@ def test_voltage_drive_stiff_train_converges_to_the_rigid_drive():
     p, m_e = model.params, 0.5
     rigid = simulate_reference(dict(VOLTAGE, m=p["m"] + m_e, G=p["G"] + m_e * G_N), 0.15, 1e-3, u=constant(6.0))
     assert rigid["theta"][-1] > 0.5 * RISE  # rad: through the rise
-    errors = []
-    for k in (1e6, 1e7, 1e8):
-        out = simulate_reference(VOLTAGE, 0.15, 1e-3, u=constant(6.0), train=Train(k_train=k, m_end=m_e))
-        errors.append(np.max(np.abs(out["theta"] - rigid["theta"])))
-    for a, b in zip(errors[:-1], errors[1:]):
-        assert b / a == pytest.approx(0.1, rel=0.05)  # measured 0.097, 0.0998
+    stiff_train_errors(VOLTAGE, m_e, rigid)  # measured 0.097, 0.0998
 
 
 # The voltage drive with the model's friction: the shaft's Coulomb friction M_f (its default) and the guide's
@@ -280,10 +287,5 @@ def test_voltage_drive_with_friction_stiff_train_converges_to_the_rigid_drive():
     rigid = simulate_reference(heavy, 0.15, 1e-3, u=constant(6.0))
     smooth = simulate_reference(dict(heavy, mu=0.0), 0.15, 1e-3, u=constant(6.0))
     assert rigid["theta"][-1] > 0.5 * RISE  # rad: through the rise
-    errors = []
-    for k in (1e6, 1e7, 1e8):
-        out = simulate_reference(FRICTION, 0.15, 1e-3, u=constant(6.0), train=Train(k_train=k, m_end=m_e))
-        errors.append(np.max(np.abs(out["theta"] - rigid["theta"])))
-    for a, b in zip(errors[:-1], errors[1:]):
-        assert b / a == pytest.approx(0.1, rel=0.05)
+    errors = stiff_train_errors(FRICTION, m_e, rigid)
     assert errors[-1] < 1e-2 * np.max(np.abs(smooth["theta"] - rigid["theta"]))  # 1.7e-6 against 1.3e-3 rad
