@@ -176,3 +176,14 @@ def test_the_residual_after_a_cycloidal_rise_through_the_engine_is_the_closed_fo
         got = drive_residual(params, r, simulate=engine_simulate).residual
         closed = 0.5 if r == 1.0 else abs(np.sin(np.pi * r)) / (np.pi * r * abs(r * r - 1.0))
         assert got == pytest.approx(closed, abs=1e-4), (r, got, closed)
+
+
+@pytest.mark.parametrize("solver", ["euler", "rk4", "rk23", "rk45"])
+def test_a_train_too_stiff_for_the_work_bound_is_refused_naming_it(solver):
+    """A 5 MHz train (k_train = 1e12 N/m on 1 g): no solver aliases it; each refuses the step within max_steps (or
+    euler its first-order step), the message naming the train's rate and k_train, and the state stays as before."""
+    sim = DriveSimulator(dict(defaults(), **dict(TRAIN, k_train=1e12, m_end=1e-3), solver=solver))
+    before = sim.state_array()
+    with pytest.raises(Exception, match="k_train") as info:
+        sim.do_step(0.0, 0.01, u=U)
+    assert "train" in str(info.value) and list(sim.state_array()) == list(before)

@@ -35,12 +35,19 @@ static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
     it->method->step(it->method, &d->model, &d->mode, d->x, u, h, &it->work);
 }
 
-/* A compliant drive's likely cause of many small steps, into buf ("" when the shaft is rigid): the shaft's rate
- * against the lightest cam side, or the electrical pole, which rk45 then takes explicitly (docs/model.md 12.1). */
-static void compliant_cause(const CamModel *m, char *buf, size_t len)
+/* A likely cause of many small steps, into buf ("" for none): a follower train ringing faster than h_max resolves, or
+ * a compliant shaft's rate against the lightest cam side, or the electrical pole, which rk45 then takes explicitly
+ * (docs/model.md 12.1, 14.6). */
+static void stiff_cause(const CamModel *m, char *buf, size_t len)
 {
     double shaft, pole;
     buf[0] = '\0';
+    if (m->train && m->train_rate * m->h_max > 1.0) {
+        snprintf(buf, len, "; the follower train's rate sqrt(k_train / m_end) + d_train / m_end = %.3g 1/s asks for "
+                 "steps of about %.3g s (a tenth of that with a fixed step: soften k_train or raise m_end, or raise "
+                 "max_steps)", m->train_rate, 1.0 / m->train_rate);
+        return;
+    }
     if (!m->compliant)
         return;
     shaft = cam_shaft_rate(m, m->J_0);
@@ -97,7 +104,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
         }
         if (dt < floor_) {
             char a[32], b[32], c[32], e[32], cause[300];
-            compliant_cause(m, cause, sizeof cause);
+            stiff_cause(m, cause, sizeof cause);
             snprintf(a, sizeof a, "%g", m->rtol);
             snprintf(b, sizeof b, "%g", m->atol);
             snprintf(c, sizeof c, "%g", floor_);
@@ -264,7 +271,7 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
 {
     const CamModel *m = &d->model;
     char advice[256], cause[300];
-    compliant_cause(m, cause, sizeof cause);
+    stiff_cause(m, cause, sizeof cause);
     if (h > m->h_max * (double)m->max_steps)  /* h_max alone makes the count impossible: say so */
         snprintf(advice, sizeof advice, "h_max = %g s caps every internal step, so this communication step "
                  "needs at least %.4g of them: raise h_max or max_steps, or shorten the communication step",
