@@ -404,3 +404,27 @@ def test_stiff_train_converges_to_the_compliant_drive_with_the_end_mass_on_the_f
     assert heavy["theta"][-1] > 0.5 * RISE  # rad: through the rise
     assert np.max(np.abs(heavy["omega_m"] - heavy["omega"])) > 0.2  # rad/s: the shaft does twist (0.73, 0.48)
     stiff_train_errors(scene, m_e, heavy)
+
+
+def test_held_cam_under_a_swinging_rotor():
+    """At 0 V the compliant drive's cam stops and static friction holds it while the rotor swings on the shaft: the
+    twist phi follows the damped oscillator J_m phi'' + (d_shaft + c_m c_e / R) phi' + k_shaft phi = 0 (the motor
+    at 0 V, L = 0, a damper of c_m c_e / R) from the first held sample, whatever the train does on the held
+    follower."""
+    scene = dict(FRICTION, **SHAFT)
+    model = DriveModel(scene)
+    _, out = friction_run(scene)
+    held = np.flatnonzero(out["omega"] == 0.0)
+    held = held[np.flatnonzero(np.diff(held) != 1)[-1] + 1:]  # the last stretch held
+    assert held[-1] == len(out["time"]) - 1 and len(held) > 300 and not out["voltage"][held].any()
+    assert np.all(out["theta"][held] == out["theta"][held[0]])
+    k, J_m = model.k_shaft, model.J_m
+    c = model.d_shaft + model.c_m * model.c_e / model.R
+    w_n, zeta = math.sqrt(k / J_m), c / (2.0 * math.sqrt(k * J_m))
+    w_d = w_n * math.sqrt(1.0 - zeta * zeta)
+    phi = out["theta_m"][held] - out["theta"][held]
+    rate0 = out["omega_m"][held[0]]
+    t = out["time"][held] - out["time"][held[0]]
+    want = np.exp(-zeta * w_n * t) * (phi[0] * np.cos(w_d * t) + (rate0 + zeta * w_n * phi[0]) / w_d * np.sin(w_d * t))
+    assert math.hypot(phi[0], (rate0 + zeta * w_n * phi[0]) / w_d) > 1e-6  # rad: it does swing (9.4e-6 rad)
+    assert np.max(np.abs(phi - want)) < 1e-13  # rad (measured 1.2e-15)
