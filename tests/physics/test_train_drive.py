@@ -119,7 +119,8 @@ def test_stiff_train_converges_to_the_rigid_drive_with_the_end_mass_on_the_follo
 
 
 @pytest.mark.parametrize("drive, shaft", [("speed", {}), ("voltage", {}),
-                                         ("voltage", dict(k_shaft=50.0, d_shaft=0.002, J_cam=2e-5))])
+                                         ("voltage", dict(k_shaft=50.0, d_shaft=0.002, J_cam=2e-5))],
+                         ids=["speed", "voltage", "voltage-compliant"])
 def test_no_train_is_the_rigid_reference_bit_for_bit(drive, shaft):
     """Train() (k_train = 0) and no train give today's reference, every output bit for bit (with the shaft's and the
     guide's friction, which the voltage drive's train now runs with; and with a compliant shaft, which it runs with
