@@ -199,9 +199,6 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(TRAIN, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="))),
          "parameter 'k_train' = {k_train} N/m: the train runs with the follower on the cam (closure 'kinematic', or "
          "'form' without clearance) so far; allowed with closure {closure} and c = {c} m: k_train = 0"),
-    Rule(AllOf(TRAIN, COMPLIANT),
-         "parameter 'k_train' = {k_train} N/m: the train runs with a rigid shaft so far; allowed with k_shaft = "
-         "{k_shaft} N.m/rad: k_train = 0 (or k_shaft = 0)"),
     *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),

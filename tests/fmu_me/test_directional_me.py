@@ -52,6 +52,8 @@ CASES = {
                 "gamma": 0.8},
     "train_friction": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "mu": 0.05, "gamma": 1.2,
                        "beta": 0.7},
+    "train_compliant": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "k_shaft": 50.0, "d_shaft": 1e-3,
+                        "J_m": 3e-5, "J_cam": 1.41e-5, "L": 1e-3},
     **FOLLOWER,
 }
 
