@@ -45,7 +45,7 @@ THETA, OMEGA, CURRENT, X_E, V_E, TWIST, OMEGA_M = range(7)  # TWIST, OMEGA_M: a 
 # there at once and the run stalled between the two events (L > 0, at a voltage step to 0). The kinetic energy the
 # stop then drops, J (1e-12)^2 / 2, is nothing.
 STOP_SLACK = 1e-12
-# J: the energy integrals after the five states, in this order.
+# J: the energy integrals after the five states (seven with a compliant shaft), in this order.
 TRAIN_ENERGY = ("W_train", "E_train_damp", "E_in", "E_copper", "E_shaft", "E_guide")
 # J: a compliant shaft's damper loss int d_shaft (omega_m - omega)^2 dt, after TRAIN_ENERGY (the name
 # reference/integrate.py's compliant drive gives it).
