@@ -26,6 +26,8 @@ BENCHMARKS = {
     "jacobian": ("jacobian", False, "stiff runs (L = 1 mH, rigid and compliant) and a run through events (backlash, "
                                     "closure form) under scipy's BDF and Radau with cam.fmu's directional derivatives "
                                     "against differencing: right-hand sides, wall"),
+    "train": ("train", False, "the follower train's cost against the rigid drive, per run and per internal step "
+                              "(in-process, voltage drive under rk45, rk4, rk23; speed drive)"),
 }
 DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
 
