@@ -14,7 +14,10 @@ paper's formulation) and refuses closure 'spring' and 'form' with a clearance, w
 advising only commands that run on that scene (``advice``): for 'spring', `cam-fmu jump` (where and at what speed
 it leaves the cam); for 'form', whose groove holds the follower on both flanks (`jump` refuses it), the map with
 `--set closure=kinematic` (the clearance ignored) and `cam-fmu simulate` (its flights, N_contact = 0). With a
-compliant shaft the CSV adds the columns f_r and f_a [Hz] and the figure a third panel.
+compliant shaft the CSV adds the columns f_r and f_a [Hz] and the figure a third panel. With a follower train
+(k_train > 0, rigid shaft) the map is the train's low-frequency limit (the end mass carried with the follower in J
+and M) and the CSV and JSON add f_r_train, f_a_train [Hz], the resonance and anti-resonance the train makes
+(control.reflect).
 """
 from __future__ import annotations
 
@@ -93,12 +96,15 @@ def run(args) -> int:
         unit = "kg m^2" if key == "J" else "N m"
         print(f"{key}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} {unit} (min at "
               f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
-    if extremes["f_r_min"] is None:
-        print("resonance: none (the drive-train is rigid, k_shaft = 0)")
-    else:
-        for key, what in (("f_r", "resonance"), ("f_a", "anti-resonance")):
-            print(f"{what}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} Hz (min at "
-                  f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
+    pairs = [(key, what) for key, what in (("f_r", "resonance"), ("f_a", "anti-resonance"),
+                                           ("f_r_train", "the train's resonance"),
+                                           ("f_a_train", "the train's anti-resonance"))
+             if extremes.get(key + "_min") is not None]
+    if not pairs:
+        print("resonance: none (the drive-train is rigid, k_shaft = 0, and carries no train, k_train = 0)")
+    for key, what in pairs:
+        print(f"{what}: {extremes[key + '_min']:.6g} .. {extremes[key + '_max']:.6g} Hz (min at "
+              f"{extremes['theta_' + key + '_min']:.4f} rad, max at {extremes['theta_' + key + '_max']:.4f} rad)")
     for path in written:
         print(path)
     sys.stdout.flush()

@@ -49,25 +49,49 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
         p["gravity"] = False
         model = DriveModel(p)
     _, s1, s2, _ = model.program.derivatives(theta0)
-    k_g = -model.F_gx * s2
+    F_x = model.F_gx + _end_weight(model)  # N: gravity along X on the follower, and on a train's end mass
+    k_g = -F_x * s2
     if k_g < -1e-12:  # N m/rad: a rounding remainder of a horizontal mounting (F_gx ~ 1e-16 G) is no stiffness
-        raise ValueError(f"theta0 = {theta0!r} rad: gravity's stiffness there is k_g = -F_gx s'' = {k_g:.4g} N m/rad "
+        raise ValueError(f"theta0 = {theta0!r} rad: gravity's stiffness there is k_g = -F_x s'' = {k_g:.4g} N m/rad "
                          "< 0, the cam would fall away from a standstill (choose an angle where k_g >= 0, or "
                          "another mounting)")
-    u0 = model.R * (-model.F_gx * s1) / model.c_m + 0.0  # + 0.0: no -0 V in a report
+    u0 = model.R * (-F_x * s1) / model.c_m + 0.0  # + 0.0: no -0 V in a report
     if model.L > 0.0:
         p["i0"] = u0 / model.R
     return p, u0
 
 
+def _end_weight(model: DriveModel) -> float:
+    """F_ex [N]: a train's end mass's weight along X (0 without a train; physics/train.py)."""
+    from ..physics.train import end_weight
+
+    return end_weight(model.train, model.params) if model.train.active else 0.0
+
+
+def _with_train(model: DriveModel, s1: float, J_c: float, A: list, C: list) -> tuple[list, list]:
+    """A and C with a train's end mass (docs/model.md 14.6) appended as two states, its deviation from the static
+    deflection and its velocity: dF = k_train (s' dtheta - x_e) + d_train (s' omega - v_e) pulls the cam (row 1, its
+    speed) by -s' dF / J_c and drives the end mass, m_end v_e' = dF."""
+    k, d, m_e = model.train.k_train, model.train.d_train, model.train.m_end
+    n = len(A)
+    A = [row + [0.0, 0.0] for row in A] + [[0.0] * (n + 2) for _ in range(2)]
+    A[1][0] -= s1 * k * s1 / J_c
+    A[1][1] -= s1 * d * s1 / J_c
+    A[1][n], A[1][n + 1] = s1 * k / J_c, s1 * d / J_c
+    A[n][n + 1] = 1.0
+    A[n + 1][0], A[n + 1][1], A[n + 1][n], A[n + 1][n + 1] = k * s1 / m_e, d * s1 / m_e, -k / m_e, -d / m_e
+    return A, [row + [0.0, 0.0] for row in C]
+
+
 def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(A, B, C) of the drive linearised at rest at theta0 [rad] without friction (docs/model.md 12.3): states
-    (theta - theta0, omega, phi, omega_m[, i]); input u [V]; outputs (omega_m, omega) [rad/s]. A rigid shaft
-    is the one-mass limit: states (theta - theta0, omega[, i]), both outputs omega."""
+    (theta - theta0, omega, phi, omega_m[, i][, x_e, v_e]); input u [V]; outputs (omega_m, omega) [rad/s]. A rigid
+    shaft is the one-mass limit: states (theta - theta0, omega[, i][, x_e, v_e]), both outputs omega. A follower
+    train (k_train > 0) adds its end mass's deviation and velocity, and its weight to gravity's stiffness."""
     model = DriveModel(dict(params or {}, **FROZEN_OFF))
     _, s1, s2, _ = model.program.derivatives(theta0)
     J_c = model.J_0 + model.m * s1 * s1
-    k_g = -model.F_gx * s2
+    k_g = -(model.F_gx + _end_weight(model)) * s2
     R, L, c_e, c_m = model.R, model.L, model.c_e, model.c_m
     damping = 0.0 if L > 0.0 else c_m * c_e / R  # L = 0: the back-EMF's torque -c_m c_e omega_m / R
     gain = 0.0 if L > 0.0 else c_m / R  # L = 0: the motor's torque per volt
@@ -93,6 +117,9 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
         A[n][n] = -R / L
         B = B + [1.0 / L]
         C = [row + [0.0] for row in C]
+    if model.train.active:
+        A, C = _with_train(model, s1, J_c, A, C)
+        B = B + [0.0, 0.0]
     return np.array(A), np.array(B), np.array(C)
 
 

@@ -12,8 +12,15 @@ At a constant cam speed omega [rad/s] (omega_dot = 0), for every cam angle theta
 With a compliant shaft (k_shaft > 0, docs/model.md section 12.3) also the undamped
 resonance f_r(theta) and anti-resonance f_a(theta) [Hz] of the two-mass system that the
 rotor J_m and the cam side J_c(theta) = J_cam + m s'^2 make on the shaft; a rigid drive-train
-has none, and the map reports them as None. Plain floats through physics.drive.DriveModel;
-numpy only for the arrays.
+has none, and the map reports them as None.
+
+With a follower train (k_train > 0, docs/model.md 14.6) the map is the train's low-frequency limit, the end mass
+carried with the follower: J adds m_end s'^2, the inertial part m_end s'' omega^2 s', gravity -F_ex s' (its weight).
+Above that the train rings: with a rigid shaft the map adds the undamped anti-resonance f_a_train =
+sqrt(k_train / m_end) / (2 pi) (the end mass on its spring, which the cam cannot move there) and the resonance
+f_r_train(theta) = sqrt(k_train (1 / m_end + s'^2 / J_c)) / (2 pi) of the cam (J_c = J_0 + m s'^2, a mass J_c / s'^2
+along X) and the end mass on the spring between them. Plain floats through physics.drive.DriveModel; numpy only for
+the arrays.
 """
 from __future__ import annotations
 
@@ -23,11 +30,14 @@ from typing import Any, Mapping
 import numpy as np
 
 from ..physics.drive import DriveModel, sign, solve_guide_friction
+from ..physics.train import end_weight
 
 PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
 COLUMNS = ("theta", "J", "M", *PARTS)
 FREQUENCIES = ("f_r", "f_a")  # Hz: the columns a compliant shaft adds
-UNITS = {"theta": "rad", "J": "kg.m2", "M": "N.m", **{part: "N.m" for part in PARTS}, "f_r": "Hz", "f_a": "Hz"}
+TRAIN_FREQUENCIES = ("f_r_train", "f_a_train")  # Hz: the columns a follower train adds (with a rigid shaft)
+UNITS = {"theta": "rad", "J": "kg.m2", "M": "N.m", **{part: "N.m" for part in PARTS}, "f_r": "Hz", "f_a": "Hz",
+         "f_r_train": "Hz", "f_a_train": "Hz"}
 # What the map assumes of the follower (refused where it is a body of its own: closure 'spring', or 'form' with a
 # clearance): printed and in the JSON.
 ASSUMES = ("the follower on the cam at every angle: a groove's two flanks push and pull it, a clearance c is "
@@ -62,25 +72,34 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
     omega = rpm * 2.0 * math.pi / 60.0
     direction = 1.0 if omega > 0.0 else -1.0
     thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
-    columns = COLUMNS + (FREQUENCIES if model.compliant else ())
+    train = model.train if model.train.active else None
+    m_end = train.m_end if train else 0.0
+    F_ex = end_weight(train, model.params) if train else 0.0
+    columns = COLUMNS + (FREQUENCIES if model.compliant else ()) + (TRAIN_FREQUENCIES if train and not
+                                                                     model.compliant else ())
     out = {name: np.empty(points) for name in columns}
     rotor = model.J_m if model.compliant else 0.0  # J_0 holds J_m already when the shaft is rigid
     for k, theta in enumerate(thetas):
         s, s1, s2, _ = model.program.derivatives(float(theta))
         tan_a = s1 / (model.r_b + s)
         sigma = sign(s1 * direction)
-        push = model.m * s2 * omega * omega - model.F_gx
+        # the end mass carried along (a train's low-frequency limit): its inertia and weight on the follower
+        carried = m_end * s2 * omega * omega - F_ex
+        push = model.m * s2 * omega * omega - model.F_gx + carried
         f = solve_guide_friction(push * tan_a + model.G_y, tan_a, sigma, model.mu, model.N_g, 0.0)
         out["theta"][k] = theta
         J_c = model.J_0 + model.m * s1 * s1
-        out["J"][k] = rotor + J_c
+        out["J"][k] = rotor + J_c + m_end * s1 * s1
         if model.compliant:
             out["f_r"][k], out["f_a"][k] = two_mass_frequencies(model.k_shaft, model.J_m, J_c)
-        out["M_inertial"][k] = model.m * s2 * omega * omega * s1
-        out["M_gravity"][k] = -model.F_gx * s1
+        elif train:
+            out["f_r_train"][k] = math.sqrt(train.k_train * (1.0 / m_end + s1 * s1 / J_c)) / (2.0 * math.pi)
+            out["f_a_train"][k] = math.sqrt(train.k_train / m_end) / (2.0 * math.pi)
+        out["M_inertial"][k] = (model.m + m_end) * s2 * omega * omega * s1
+        out["M_gravity"][k] = -(model.F_gx + F_ex) * s1
         out["M_guide"][k] = sigma * f * s1
         out["M_shaft"][k] = model.M_f * direction
-        out["M"][k] = model.load(float(theta), omega, 0.0, direction).M
+        out["M"][k] = model.load(float(theta), omega, 0.0, direction, True, carried).M
     return out
 
 
@@ -89,7 +108,8 @@ def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
     resonance keys f_r_min .. f_a_max [Hz] (None: the drive-train is rigid)."""
     theta = result["theta"]
     out: dict[str, Any] = {"rpm": rpm, "omega": rpm * 2.0 * math.pi / 60.0, "assumes": ASSUMES}
-    names = [("J", "J"), ("M", "M")] + ([("f_r", "f_r"), ("f_a", "f_a")] if "f_r" in result else [])
+    names = [("J", "J"), ("M", "M")] + ([("f_r", "f_r"), ("f_a", "f_a")] if "f_r" in result else []) \
+        + ([(name, name) for name in TRAIN_FREQUENCIES] if "f_r_train" in result else [])
     for name, key in names:
         low, high = int(np.argmin(result[name])), int(np.argmax(result[name]))
         out[f"{key}_min"], out[f"theta_{key}_min"] = float(result[name][low]), float(theta[low])
@@ -100,5 +120,5 @@ def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
     return out
 
 
-__all__ = ["COLUMNS", "FREQUENCIES", "PARTS", "FreeFollowerError", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary",
+__all__ = ["COLUMNS", "FREQUENCIES", "TRAIN_FREQUENCIES", "PARTS", "FreeFollowerError", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary",
            "two_mass_frequencies"]

@@ -343,3 +343,39 @@ def test_the_shaft_band_of_a_turning_drive_is_the_two_mass_closed_form():
     assert bands["resonance"] == pytest.approx([f_r_heavy, f_r_light], rel=1e-5)
     assert bands["anti-resonance"] == pytest.approx([f_a_heavy, f_a_light], rel=1e-5)
     assert shaft_bands(dict(SHAFT, k_shaft=0.0), 1.37) is None
+
+
+TRAIN = {"k_train": 2e4, "m_end": 0.2}   # 50.3 Hz on its own (docs/model.md 14.6)
+
+
+def test_the_engine_responds_as_the_linearised_drive_with_a_train():
+    """The follower train in the frozen-angle response: the engine's measurement against the linear model with the
+    end mass's two states, under vertical gravity (the end mass's weight in the holding voltage and gravity's
+    stiffness); measured 2.9e-6 of the peak (an undamped train rings through the measuring window: 2.9e-4)."""
+    params = dict(TRAIN, d_train=0.5, gamma=math.pi / 2)
+    theta0 = math.radians(60.0)
+    f = np.array([20.0, 45.0, 50.0, 55.0, 61.4, 90.0])
+    exact = analytic_response(params, theta0, f)
+    seen = measured_response(params, f, theta0=theta0)
+    assert _difference(seen.cam, exact.cam) < 1e-4 and _difference(seen.motor, exact.motor) < 1e-4
+    plain = analytic_response(dict(gamma=math.pi / 2), theta0, f)
+    assert exact.u0 < plain.u0 < 0.0   # the end mass's weight held too
+
+
+def test_a_train_is_an_anti_resonance_at_its_own_frequency_and_a_resonance_with_the_cam():
+    """Undamped, gravity off, no back-EMF: the train's reaction on the cam is s'^2 m_end s^2 k / (m_end s^2 + k) in
+    the cam's angle, infinite at s = j sqrt(k / m_end): |H| dips to nothing at f_a = sqrt(k / m_end) / (2 pi), and the
+    cam (a mass J_c / s'^2 along X) on the train's spring with the end mass resonates at
+    f_r = sqrt(k (1 / m_end + s'^2 / J_c)) / (2 pi), J_c = J_0 + m s'^2 (closed forms written here)."""
+    quiet = dict(TRAIN, c_e=1e-6, gravity=False)
+    for theta_deg in (30.0, 60.0, 100.0):
+        theta0 = math.radians(theta_deg)
+        model = DriveModel(quiet)
+        s1 = model.program.derivatives(theta0)[1]
+        J_c = model.J_0 + model.m * s1 * s1
+        f_a = math.sqrt(2e4 / 0.2) / (2.0 * math.pi)
+        f_r = math.sqrt(2e4 * (1.0 / 0.2 + s1 * s1 / J_c)) / (2.0 * math.pi)
+        A, _, _ = linear_model(quiet, theta0)
+        assert max(np.linalg.eigvals(A).imag) / (2.0 * math.pi) == pytest.approx(f_r, rel=1e-6)
+        dip = analytic_response(quiet, theta0, [0.99 * f_a, f_a, 1.01 * f_a]).cam
+        assert abs(dip[1]) < 1e-6 * min(abs(dip[0]), abs(dip[2]))

@@ -119,3 +119,28 @@ def test_the_cli_reports_the_resonance_of_the_shipped_compliant_scene(tmp_path):
     assert 200.0 < found["f_r_min"] < found["f_r_max"] < 370.0 and 25.0 < found["f_a_min"] < 26.0
     header = (tmp_path / "compliant_shaft_reflect.csv").read_text().splitlines()[0]
     assert header.endswith("f_r [Hz],f_a [Hz]")
+
+
+def test_a_train_is_its_low_frequency_limit_and_its_two_frequencies():
+    """With a follower train the map is the end mass carried by the follower: J, M and its parts those of the drive
+    with m + m_end and the end mass's weight (G + m_end g_n, mounted vertically) without a train, to rounding; f_a_train is
+    sqrt(k_train / m_end) / (2 pi) and f_r_train(theta) the undamped pole of the linearised drive with the train
+    (control.frequency.linear_model's eigenvalues, back-EMF and gravity off)."""
+    from cam_fmu.control.frequency import linear_model
+    from cam_fmu.physics.train import G_N
+
+    # vertical: the end mass's weight acts along X only (its own guide carries nothing across; physics/train.py)
+    train = {"k_train": 2e4, "m_end": 0.2, "gamma": math.pi / 2, "mu": 0.05}
+    model = DriveModel(train)
+    carried = {"m": model.m + 0.2, "G": model.params["G"] + 0.2 * G_N, "gamma": math.pi / 2, "mu": 0.05}
+    got, rigid = reflected_map(train, 300.0, points=72), reflected_map(carried, 300.0, points=72)
+    for name in ("J", "M", *PARTS):
+        assert np.allclose(got[name], rigid[name], rtol=1e-12, atol=1e-15), name
+    assert np.all(got["f_a_train"] == math.sqrt(2e4 / 0.2) / (2.0 * math.pi))
+    quiet = {"k_train": 2e4, "m_end": 0.2, "c_e": 1e-6, "gravity": False}
+    ring = reflected_map(quiet, 300.0, points=8)
+    for theta, f_r in zip(ring["theta"][1:4], ring["f_r_train"][1:4]):
+        A, _, _ = linear_model(quiet, float(theta))
+        assert max(np.linalg.eigvals(A).imag) / (2.0 * math.pi) == pytest.approx(f_r, rel=1e-6)
+    keys = summary(got, 300.0)
+    assert keys["f_r_train_max"] == pytest.approx(got["f_r_train"].max()) and keys["f_r_min"] is None
