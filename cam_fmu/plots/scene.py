@@ -8,7 +8,9 @@ Kinds (the scene's ``plot`` key; ``PLOTS`` is their one table):
   voltage [V] (the armature voltage the speed drive needs), i, omega, s, M, J for
   ``drive = "speed"`` (``TIME_PANELS``, keyed by the scene's drive);
 - ``follower``: over t, one curve per run: the follower's gap to the cam s - s_cam [mm], its velocity v,
-  acceleration a and the load torque M (the follower as a body of its own, docs/model.md section 13).
+  acceleration a and the load torque M (the follower as a body of its own, docs/model.md section 13);
+- ``train``: over t, one curve per run: the follower train's stretch s_end - s [mm] (its ringing about the static
+  deflection), its force F_train, the end mass's acceleration and the load torque M (docs/model.md 14.6).
 
 With 2+ runs, ``fig6`` and ``time`` draw below each quantity a smaller axes
 "difference [unit]": every further run minus the primary (first) run on the
@@ -144,8 +146,18 @@ def _follower(plt: Any, results: Results, drive: str = "speed") -> tuple[Any, li
 
 
 # kind -> draw(plt, results, drive) -> (figure, axes); 'time' picks its panels by the drive (TIME_PANELS)
+TRAIN_PANELS = (("stretch", "train's stretch s_end - s", "mm", 1e3), ("F_train", "train's force F_train", "N", 1.0),
+                ("a_end", "end mass acceleration a_end", "m/s$^2$", 1.0), ("M", "load torque M", "N m", 1.0))
+
+
+def _train(plt: Any, results: Results, drive: str = "voltage") -> tuple[Any, list]:
+    with_stretch = {label: {**r, "stretch": np.asarray(r["s_end"]) - np.asarray(r["s"])}
+                    for label, r in results.items()}
+    return _panels(plt, with_stretch, "time", TRAIN_PANELS, ncols=2, figsize=(11, 7.8))
+
+
 PLOTS: dict[str, Callable[[Any, Results, str], tuple[Any, list]]] = {
-    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time, "follower": _follower,
+    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time, "follower": _follower, "train": _train,
 }
 
 
