@@ -6,7 +6,9 @@ turn), as a
 motion table (DIR/<scene>_polydyne.csv, 'angle_deg,lift_mm', and DIR/<scene>_polydyne.toml: the scene's
 [parameters] with motion_table set to it). The table's rise, through the drive's interpolation, drives the
 integrated train at the design speed and across +-10 % (``--band``): its residual after the rise against the
-plain law's. Needs the train's natural frequency (--train-hz, or a scene with k_train and m_end) and a law whose
+plain law's; and the table runs through the drive (the C engine's speed drive with the train, the end mass's
+ringing read in the dwell after the rise: reference/train_residual.py's measurement, experiments.engine_runs):
+``polydyne_drive`` per speed, ``residual_polydyne_drive`` at the design speed. Needs the train's natural frequency (--train-hz, or a scene with k_train and m_end) and a law whose
 acceleration is continuous; names where the jerk jumps (the corrected cam's velocity jumps there).
 """
 from __future__ import annotations
@@ -46,6 +48,8 @@ def run(args) -> int:
     from ..physics.parameters import law_spec
     from ..vibration.polydyne import StrokeProgram, jerk_jumps, polydyne_table, table_residual, table_rise
     from ..vibration.spectral import check_zeta, residual
+    from ..experiments.engine_runs import simulate_engine
+    from ..reference.train_residual import drive_residual
     from ._train_scene import out_dir, scene_and_law, train_of
 
     scene, label, rise_law = scene_and_law(args.scene, args.set)
@@ -75,10 +79,13 @@ def run(args) -> int:
     rise = table_rise(text, beta_rise, lift)
     factors = np.linspace(1.0 - args.band, 1.0 + args.band, args.speeds) if args.speeds > 1 else np.ones(1)
     rows = []
+    table_params = dict(params, motion_table=text)
     for f in sorted(set(factors.tolist()) | {1.0}):
         r = r_rise / f
         rows.append({"rpm": args.rpm * f, "r": r, "plain": float(residual(rise_law, r, zeta)[0]),
-                     "polydyne": table_residual(rise, beta_rise, lift, r, zeta)})
+                     "polydyne": table_residual(rise, beta_rise, lift, r, zeta),
+                     "polydyne_drive": drive_residual(table_params, r, zeta, train_hz=f_n, rtol=1e-10, atol=1e-12,
+                                                      simulate=simulate_engine, table_ok=True).residual})
     design = next(row for row in rows if row["rpm"] == args.rpm)
     destination = out_dir(args.out)
     csv_path = destination / f"{scene.name}_polydyne.csv"
@@ -91,6 +98,7 @@ def run(args) -> int:
              for name, jumps in (("rise", jerk_jumps(rise_law)), ("return", jerk_jumps(return_law))) if jumps]
     out = {"scene": scene.name, "law": label, "rpm": args.rpm, "train_hz": f_n, "zeta": zeta, "r_rise": r_rise,
            "r_return": r_ret, "residual_plain": design["plain"], "residual_polydyne": design["polydyne"],
+           "residual_polydyne_drive": design["polydyne_drive"],
            "band": rows, "notes": notes, "files": [str(csv_path), str(toml_path)]}
     if args.json:
         print(json.dumps(out))
@@ -98,10 +106,10 @@ def run(args) -> int:
     print(f"scene {scene.name}: rise law {label} at {args.rpm:g} 1/min with a {f_n:g} Hz train (zeta {zeta:g}): "
           f"r = {r_rise:.6g}")
     print(f"  residual after the rise / lift: plain law {design['plain']:.4g}, polydyne table "
-          f"{design['polydyne']:.4g}")
+          f"{design['polydyne']:.4g} (through the drive: {design['polydyne_drive']:.4g})")
     for row in rows:
         print(f"  {row['rpm']:10.6g} 1/min  r = {row['r']:.5g}  plain {row['plain']:.4g}  polydyne "
-              f"{row['polydyne']:.4g}")
+              f"{row['polydyne']:.4g}  through the drive {row['polydyne_drive']:.4g}")
     for note in notes:
         print("  note: " + note)
     print(csv_path)

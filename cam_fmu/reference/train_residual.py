@@ -47,17 +47,19 @@ class DriveResidual:
     omega: float        # rad/s, the cam speed
 
 
-def residual_scene(params: Mapping[str, Any]) -> dict[str, Any]:
+def residual_scene(params: Mapping[str, Any], table_ok: bool = False) -> dict[str, Any]:
     """The scene's parameters for the measurement: speed drive (rigid shaft), follower on the cam (no clearance,
     return spring or restitution), from the rise's start, and an upper dwell after the rise (the rest of the turn
-    split with the return when the scene has none)."""
+    split with the return when the scene has none). ``table_ok``: a motion table whose rise, lift and upper dwell
+    are the parameters' rise_angle, lift and upper_dwell (a polydyne table: vibration/polydyne.py) is measured as
+    it is, else refused."""
     p = dict(DriveModel(params).params)
-    if p.get("motion_table"):
+    if p.get("motion_table") and not table_ok:
         raise ParameterError("the residual through the drive needs a rise law: parameter 'motion_table' must be empty")
     # The cam's motion imposed (a rigid shaft), the follower on it: no clearance, no return spring, no restitution.
     p.update(drive="speed", closure="kinematic", c=0.0, k_shaft=0.0, k_spring=0.0, F_spring0=0.0, restitution=0.0,
              theta0=0.0, omega0=0.0)
-    if p["upper_dwell"] <= 0.0:
+    if p["upper_dwell"] <= 0.0 and not p.get("motion_table"):
         rest = 2.0 * math.pi - p["rise_angle"]
         back = max(0.5 * rest, 1e-3)
         if rest - back <= 0.0:
@@ -69,11 +71,12 @@ def residual_scene(params: Mapping[str, Any]) -> dict[str, Any]:
 
 def drive_residual(params: Mapping[str, Any], r: float, zeta: float = 0.0, train_hz: float = 50.0,
                    m_end: float = 1.0, rtol: float = 1e-12, atol: float = 1e-13,
-                   simulate: Callable[..., Mapping[str, Any]] | None = None) -> DriveResidual:
+                   simulate: Callable[..., Mapping[str, Any]] | None = None, table_ok: bool = False) -> DriveResidual:
     """The residual / lift after the rise of the scene ``params`` for r = rise time / natural period (> 0) and the
     damping ratio ``zeta`` in [0, 1), by running the speed drive's reference with the train (``train_hz`` [Hz],
     ``m_end`` [kg]: the result does not depend on them but through rounding). ``simulate``: another run of the drive
-    with ``simulate_reference``'s arguments (the C engine's, in its tests), by default the reference."""
+    with ``simulate_reference``'s arguments (experiments.engine_runs.simulate_engine: the C engine's), by default the
+    reference; ``table_ok``: see residual_scene."""
     from .integrate import simulate_reference
 
     simulate = simulate or simulate_reference
@@ -82,7 +85,7 @@ def drive_residual(params: Mapping[str, Any], r: float, zeta: float = 0.0, train
         if not (math.isfinite(value) and ok):
             allowed = {"zeta": "[0, 1) (underdamped)"}.get(name, "> 0")
             raise ValueError(f"{name} = {value!r}: allowed {allowed}")
-    p = residual_scene(params)
+    p = residual_scene(params, table_ok)
     w_n = 2.0 * math.pi * train_hz
     k = m_end * w_n * w_n
     train = Train(k_train=k, d_train=2.0 * zeta * math.sqrt(k * m_end), m_end=m_end)

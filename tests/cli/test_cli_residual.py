@@ -120,6 +120,11 @@ def test_polydyne_writes_a_table_the_drive_runs(tmp_path):
     assert out["r_rise"] == pytest.approx(2.5, rel=1e-14)     # pi rad at 20 pi rad/s: 0.05 s of a 20 ms period
     assert out["residual_plain"] > 1e-2 and out["residual_polydyne"] <= 1e-4
     assert [row["rpm"] for row in out["band"]] == pytest.approx([540.0, 600.0, 660.0])
+    # issue 41's target through the drive (the engine's speed drive turning the table with the train): <= 1e-4 of
+    # the lift where the plain law's is above 1e-2, and the integrated train's answer at every speed of the band
+    assert out["residual_polydyne_drive"] <= 1e-4
+    for row in out["band"]:
+        assert row["polydyne_drive"] == pytest.approx(row["polydyne"], abs=1e-6)
     params = tomllib.loads((tmp_path / "paper_fig6_polydyne.toml").read_text(encoding="utf-8"))["parameters"]
     text = (tmp_path / "paper_fig6_polydyne.csv").read_text(encoding="utf-8")
     assert params["motion_table"] == text

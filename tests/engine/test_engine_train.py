@@ -12,7 +12,8 @@ from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.physics.parameters import defaults
 from cam_fmu.physics.signals import Signal
-from cam_fmu.reference.integrate import _grid, simulate_reference
+from cam_fmu.experiments.engine_runs import simulate_engine
+from cam_fmu.reference.integrate import simulate_reference
 from cam_fmu.reference.train_residual import drive_residual
 
 STOP, STEP, U = 1.0, 0.01, 3.5
@@ -159,26 +160,13 @@ def test_the_speed_drive_carries_the_train_as_the_reference_does(extra):
         assert worst(engine, reference, name) < 5e-8, (name, worst(engine, reference, name))
 
 
-def engine_simulate(params, stop, interval, omega_ref, rtol, atol, train):
-    """simulate_reference's run of the speed drive with a train, on the C engine (train_residual.drive_residual)."""
-    p = dict(params, k_train=train.k_train, d_train=train.d_train, m_end=train.m_end, rtol=rtol, atol=atol)
-    sim = DriveSimulator(p)
-    sim.set_inputs(U, omega_ref.value(0.0), 0.0)
-    grid = _grid(stop, interval)
-    rows = [sim.outputs()]
-    for a, b in zip(grid[:-1], grid[1:]):
-        sim.do_step(a, b - a, omega_ref=omega_ref.value(a), omega_dot_ref=0.0)
-        rows.append(sim.outputs())
-    return {"time": grid, **{name: np.array([r[name] for r in rows]) for name in rows[0]}}
-
-
 def test_the_residual_after_a_cycloidal_rise_through_the_engine_is_the_closed_form():
     """Issue 41's check through the C engine: the end mass's residual amplitude / lift after a cycloidal rise at
     constant speed is |sin(pi r)| / (pi r |r^2 - 1|) within 1e-4 absolute over r = 1..6 (measured over r = 1, 1.25,
     .., 6: 1.0e-12)."""
     params = dict(defaults(), rise_law="cycloidal")
     for r in (1.0, 1.5, 2.0, 2.5, 3.3, 4.0, 5.5, 6.0):
-        got = drive_residual(params, r, simulate=engine_simulate).residual
+        got = drive_residual(params, r, simulate=simulate_engine).residual
         closed = 0.5 if r == 1.0 else abs(np.sin(np.pi * r)) / (np.pi * r * abs(r * r - 1.0))
         assert got == pytest.approx(closed, abs=1e-4), (r, got, closed)
 
