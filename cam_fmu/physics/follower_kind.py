@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any, Mapping
 
 from ..kinematics.follower_types import FOLLOWER_TYPES
 from .parameters import ParameterError
@@ -73,6 +74,14 @@ class FollowerKind:
                                      f"{left}{low:g}, {high:g}] {unit}")
         if self.oscillating and self.lift_angle >= math.pi:
             raise ParameterError(f"follower parameter 'lift_angle' = {self.lift_angle!r} rad: allowed (0, pi) rad")
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, Any]) -> "FollowerKind":
+        """The kind the resolved drive parameters ``p`` name (physics/parameters.py FOLLOWER_KIND_PARAMETERS; an
+        arm's three needed fields are 0 there when not set)."""
+        if not str(p["follower_type"]).startswith("oscillating"):
+            return cls(p["follower_type"])
+        return cls(p["follower_type"], **{name: p[name] for name in ARM_FIELDS})
 
     @property
     def oscillating(self) -> bool:
