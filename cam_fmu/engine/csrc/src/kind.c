@@ -130,3 +130,77 @@ void cam_kind_init(CamModel *m)
         m->delta0 = asin(fmin(1.0, r_b / d));
     }
 }
+
+/* d(alpha) and d(N) [rad, N per the seed] of cam_kind_load's contact at q (q[4]) for P, dP, dtheta. */
+static void contact_tangent(const CamModel *m, const double q[4], double P, double dP, double dtheta, double *dalpha,
+                            double *dN)
+{
+    double delta = m->delta0 + q[0], d = m->pivot_distance, L = m->arm_length, c = cos(delta), sn = sin(delta);
+    *dalpha = 0.0;
+    *dN = dP;
+    if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {
+        double Y = d * c - L * (1.0 - q[1]), X = d * sn, alpha = atan2(Y, X);
+        double dY = (-d * sn * q[1] + L * q[2]) * dtheta, dX = d * c * q[1] * dtheta, ca = cos(alpha);
+        *dalpha = (X * dY - Y * dX) / (X * X + Y * Y);
+        *dN = dP / (L * ca) + P * sin(alpha) * *dalpha / (L * ca * ca);
+    } else if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT) {
+        *dN = (dP * (1.0 - q[1]) - P * q[2] * dtheta) / (d * c) + P * (1.0 - q[1]) * sn * q[1] * dtheta / (d * c * c);
+    }
+}
+
+int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], const double seed[CAM_NX],
+                     double dT, double du, double omega_dot, double ddx[CAM_NX], double dout[])
+{
+    double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
+    double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, B, dB, J, dJ, V2, domega_dot = 0.0, P, dP;
+    double k = m->q_scale, dalpha, dN;
+    int n, moving = !mode->stuck, engaged = mode->contact != 0;
+    cam_kind_eval(m, theta, q);
+    V2 = m->arm && m->W != 0.0 ? -m->W * sin(q[0] + m->psi_0) : 0.0;   /* d2V/dq2 */
+    for (n = 0; n < CAM_NX; n++)
+        ddx[n] = 0.0;
+    if (!moving)
+        omega_dot = 0.0;
+    w = moving ? x[CAM_OMEGA] : 0.0;
+    dw = moving ? domega : 0.0;
+    J = m->J_0 + m->I_f * q[1] * q[1];
+    dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;
+    if (moving) {   /* J omega_dot = T - M_f d - (I_f q'' w^2 + V'(q)) q' */
+        B = m->I_f * q[2] * w * w + cam_kind_slope(m, q[0]);
+        dB = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
+        domega_dot = (dT - dB * q[1] - B * q[2] * dtheta - omega_dot * dJ) / J;
+        ddx[CAM_THETA] = domega;
+        ddx[CAM_OMEGA] = domega_dot;
+    }
+    ddx[CAM_CURRENT] = m->has_current ? (du - m->R * di - m->c_e * domega) / m->L : 0.0;
+    for (n = 0; n < CAM_N_OUTPUTS; n++)
+        dout[n] = 0.0;
+    dout[CAM_O_OMEGA] = domega;
+    dout[CAM_O_THETA] = dout[CAM_O_THETA_M] = dtheta;
+    dout[CAM_O_OMEGA_M] = domega;
+    dout[CAM_O_I] = m->has_current ? di : (du - m->c_e * domega) / m->R;
+    dout[CAM_O_VOLTAGE] = du;
+    dout[CAM_O_S] = dout[CAM_O_S_CAM] = q[1] / k * dtheta;
+    if (engaged) {
+        P = m->I_f * (q[2] * w * w + q[1] * omega_dot) + cam_kind_slope(m, q[0]);
+        dP = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot + q[1] * domega_dot)
+             + V2 * q[1] * dtheta;
+        contact_tangent(m, q, P, dP, dtheta, &dalpha, &dN);
+        dout[CAM_O_J] = dJ;
+        dout[CAM_O_V] = (q[2] * dtheta * w + q[1] * dw) / k;
+        dout[CAM_O_A] = (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot + q[1] * domega_dot) / k;
+        dout[CAM_O_M] = dP * q[1] + P * q[2] * dtheta;
+        dout[CAM_O_ALPHA] = dalpha;
+        dout[CAM_O_N_CONTACT] = dN;
+    }
+    if (mode->stuck)   /* static friction takes the whole torque */
+        dout[CAM_O_M] = dT;
+    dout[CAM_O_S_END] = dout[CAM_O_S];   /* no train with a kind (the rules) */
+    dout[CAM_O_V_END] = dout[CAM_O_V];
+    dout[CAM_O_A_END] = dout[CAM_O_A];
+    if (m->arm) {
+        dout[CAM_O_PSI] = q[1] * dtheta;
+        dout[CAM_O_PSI_DOT] = q[2] * dtheta * w + q[1] * dw;
+    }
+    return CAM_OK;
+}
