@@ -1,7 +1,8 @@
 """The follower's kind in the drive: translating or oscillating, roller or flat face (docs/model.md 16).
 
-The kind is its own description, not an FMU parameter (the C engine does not run it yet): the reference takes it as
-an optional input, ``simulate_reference(..., follower=FollowerKind(...))``. ``translating_roller`` (the default) is
+The kind is the drive's parameters follower_type and an arm's fields (physics/parameters.py FOLLOWER_KIND_PARAMETERS,
+``FollowerKind.from_parameters``; the C engine runs it without friction, docs/model.md 16.1), or for the reference
+this description, ``simulate_reference(..., follower=FollowerKind(...))``. ``translating_roller`` (the default) is
 today's follower, bit for bit. An oscillating follower turns about its pivot by psi(theta) = lift_angle * S(theta)
 (S = s / h the law's normalised lift); its own fields:
 
