@@ -105,7 +105,8 @@ def test_every_shipped_scene_is_recorded_with_every_solver_and_formulation():
         for case in cases:
             assert (case["comm_step"], case["stop_time"]) == (scene.output_interval, scene.stop_time)
             steps = case["result"]["steps"]
-            names = set(OUTPUT_NAMES) - TRAIN_OUTPUTS - KIND_OUTPUTS - (set() if case["name"] in LATER else ADDED_OUTPUTS)
+            names = (set(OUTPUT_NAMES) - TRAIN_OUTPUTS - KIND_OUTPUTS
+                     - (set() if case["name"] in LATER else ADDED_OUTPUTS))
             if case["result"]["error"] is None:
                 assert len(steps) > baseline.SAMPLES and steps[-1] == n, case["name"]
                 assert set(case["result"]["final"]) == names

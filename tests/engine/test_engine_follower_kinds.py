@@ -31,8 +31,10 @@ SPEED = Signal((0.0, 0.5), (5.0, 30.0))  # rad/s: a ramp
 NAMES = ("theta", "omega", "i", "M", "J", "s", "v", "a", "alpha", "N_contact", "psi", "psi_dot", "voltage")
 # (drive parameters, bound on every NAMES' difference relative to its largest value): measured at most 2.2e-8 .. 1.9e-7
 # (rk45 at the engine's default tolerances; the largest the oscillating roller's alpha), 2.6e-9 .. 9.1e-9 (rk4 at h_max
-# 25 us; at 0.1 ms 1e-6 .. 8.5e-6), 1.3e-13 (the speed drive: the same formulas at the same imposed angles)
-DRIVES = {"rk45": (dict(), 1e-6), "rk4": (dict(solver="rk4", h_max=2.5e-5), 1e-6), "speed": (dict(drive="speed"), 1e-6)}
+# 25 us; at 0.1 ms 1e-6 .. 8.5e-6), 2.3e-7 .. 5.0e-7 (rk23 at the engine's tolerances), 1.3e-13 (the speed drive: the
+# same formulas at the same imposed angles)
+DRIVES = {"rk45": (dict(), 1e-6), "rk4": (dict(solver="rk4", h_max=2.5e-5), 1e-6), "rk23": (dict(solver="rk23"), 2e-6),
+          "speed": (dict(drive="speed"), 1e-6)}
 
 
 def engine_run(params: dict) -> dict[str, np.ndarray]:

@@ -109,7 +109,8 @@ void cam_kind_init(CamModel *m)
     const double *v = m->params.v;
     double L = v[CAM_P_ARM_LENGTH], d = v[CAM_P_PIVOT_DISTANCE], gamma = v[CAM_P_GAMMA], r_b = m->r_b, in_plane;
     m->kind = (int)v[CAM_P_FOLLOWER_TYPE];
-    m->arm = m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER || m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT;
+    m->arm = m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER
+             || m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT;
     m->I_f = m->m;
     m->q_scale = 1.0;
     if (!m->arm)
@@ -188,7 +189,8 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         contact_tangent(m, q, P, dP, dtheta, &dalpha, &dN);
         dout[CAM_O_J] = dJ;
         dout[CAM_O_V] = (q[2] * dtheta * w + q[1] * dw) / k;
-        dout[CAM_O_A] = (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot + q[1] * domega_dot) / k;
+        dout[CAM_O_A] = (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot
+                         + q[1] * domega_dot) / k;
         dout[CAM_O_M] = dP * q[1] + P * q[2] * dtheta;
         dout[CAM_O_ALPHA] = dalpha;
         dout[CAM_O_N_CONTACT] = dN;
