@@ -1,7 +1,8 @@
 """The follower's kind in the drive: translating or oscillating, roller or flat face (docs/model.md 16).
 
-The kind is its own description, not an FMU parameter (the C engine does not run it yet): the reference takes it as
-an optional input, ``simulate_reference(..., follower=FollowerKind(...))``. ``translating_roller`` (the default) is
+The kind is the drive's parameters follower_type and an arm's fields (physics/parameters.py FOLLOWER_KIND_PARAMETERS,
+``FollowerKind.from_parameters``; the C engine runs it without friction, docs/model.md 16.1), or for the reference
+this description, ``simulate_reference(..., follower=FollowerKind(...))``. ``translating_roller`` (the default) is
 today's follower, bit for bit. An oscillating follower turns about its pivot by psi(theta) = lift_angle * S(theta)
 (S = s / h the law's normalised lift); its own fields:
 
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any, Mapping
 
 from ..kinematics.follower_types import FOLLOWER_TYPES
 from .parameters import ParameterError
@@ -73,6 +75,14 @@ class FollowerKind:
                                      f"{left}{low:g}, {high:g}] {unit}")
         if self.oscillating and self.lift_angle >= math.pi:
             raise ParameterError(f"follower parameter 'lift_angle' = {self.lift_angle!r} rad: allowed (0, pi) rad")
+
+    @classmethod
+    def from_parameters(cls, p: Mapping[str, Any]) -> "FollowerKind":
+        """The kind the resolved drive parameters ``p`` name (physics/parameters.py FOLLOWER_KIND_PARAMETERS; an
+        arm's three needed fields are 0 there when not set)."""
+        if not str(p["follower_type"]).startswith("oscillating"):
+            return cls(p["follower_type"])
+        return cls(p["follower_type"], **{name: p[name] for name in ARM_FIELDS})
 
     @property
     def oscillating(self) -> bool:

@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping
 
+from ..kinematics.follower_types import FOLLOWER_TYPES
 from ..kinematics.presets import PRESETS
 from .units import UnitError, to_si
 
@@ -201,7 +202,29 @@ TRAIN_PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("m_end", "kg", 0.0, "the train's end mass, moved by the train along X (used only with k_train > 0: a rigid "
        "train's mass belongs in m)", low=0.0, high=1e4),
 )
-PARAMETERS: tuple[ParameterSpec, ...] = _MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS + TRAIN_PARAMETERS
+# The follower's kind (docs/model.md 16): translating or oscillating, roller or flat face; an arm's data. The same
+# names, defaults and ranges as physics/follower_kind.py's FollowerKind (0 for the three an arm needs: not set; the
+# rules refuse an arm without them, and any of them set on a translating follower, naming the type).
+FOLLOWER_KIND_PARAMETERS: tuple[ParameterSpec, ...] = (
+    _P("follower_type", "", "translating_roller", "the follower: 'translating_roller' (the paper's), "
+       "'translating_flat', 'oscillating_roller' (an arm about a pivot with a roller; its pitch curve, r_roller = 0), "
+       "'oscillating_flat' (an arm with a flat face); docs/model.md 16", kind="string", choices=FOLLOWER_TYPES),
+    _P("arm_length", "m", 0.0, "an oscillating follower's arm L, pivot to the roller centre or the face's reference "
+       "point (0: not set; needed by the oscillating types)", low=0.0, high=10.0, low_open=True, zero_ok=True),
+    _P("pivot_distance", "m", 0.0, "an oscillating follower's pivot distance d from the cam axis (0: not set; needed "
+       "by the oscillating types)", low=0.0, high=20.0, low_open=True, zero_ok=True),
+    _P("lift_angle", "rad", 0.0, "an oscillating follower's swing: psi = lift_angle s / lift, in (0, pi) (0: not "
+       "set; needed by the oscillating types)", low=0.0, high=math.nextafter(math.pi, 0.0), low_open=True,
+       zero_ok=True),   # below pi: an arm cannot swing half a turn
+    _P("J_arm", "kg.m2", 0.0, "an oscillating follower's arm about its pivot, without m (which sits at arm_length)",
+       low=0.0, high=1e3),
+    _P("m_arm", "kg", 0.0, "an oscillating follower's own arm mass (its weight acts at r_cm_arm)", low=0.0, high=1e4),
+    _P("r_cm_arm", "m", 0.0, "pivot to the arm's own centre of mass, along the arm", low=-10.0, high=10.0),
+    _P("psi_0", "rad", 0.0, "the arm's angle above the horizontal (of the cam's plane) at psi = 0", low=-math.pi,
+       high=math.pi),
+)
+PARAMETERS: tuple[ParameterSpec, ...] = (_MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS + TRAIN_PARAMETERS
+                                         + FOLLOWER_KIND_PARAMETERS)
 BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
 
 

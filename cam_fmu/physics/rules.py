@@ -143,6 +143,12 @@ FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_F
 OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
 TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
+GUIDE_FRICTION_ON = Where(Cmp(Num("guide_friction"), "!="), Num("mu"))    # 1: mu where the effect is on
+# The follower's kind (docs/model.md 16): an arm's fields with their units, the arm's three it needs first.
+OSCILLATING = Is("follower_type", ("oscillating_roller", "oscillating_flat"))
+OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
+ARM_UNITS = (("arm_length", "m"), ("pivot_distance", "m"), ("lift_angle", "rad"), ("J_arm", "kg.m2"),
+             ("m_arm", "kg"), ("r_cm_arm", "m"), ("psi_0", "rad"))
 
 PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
            "consistent formulation)")
@@ -199,6 +205,29 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(TRAIN, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="))),
          "parameter 'k_train' = {k_train} N/m: the train runs with the follower on the cam (closure 'kinematic', or "
          "'form' without clearance) so far; allowed with closure {closure} and c = {c} m: k_train = 0"),
+    *(Rule(AllOf(Not(OSCILLATING), Cmp(Num(name), "!=")),
+           f"parameter {name!r} = {{{name}}} {unit} is not used by follower_type {{follower_type}} (only by the "
+           f"oscillating types): leave it at its default 0") for name, unit in ARM_UNITS),
+    *(Rule(AllOf(OSCILLATING, Not(Cmp(Num(name), ">"))),
+           f"parameter {name!r} = {{{name}}} {unit}: follower_type {{follower_type}} needs it; allowed "
+           f"{BY_NAME[name].allowed()[5:]}")
+      for name, unit in ARM_UNITS[:3]),
+    Rule(AllOf(OSCILLATING, Cmp(Num("gravity"), "!="), Cmp(Num("beta"), "!=")),
+         "parameter 'beta' = {beta} rad is not used by follower_type {follower_type} (the arm's angle to gravity is "
+         "its psi_0): leave it at 0"),
+    Rule(AllOf(OTHER_KIND, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="), COMPLIANT, TRAIN,
+                                 AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
+         "parameter 'follower_type' = {follower_type}: runs with the follower on the cam (closure 'kinematic', or "
+         "'form' without clearance), a rigid shaft, no follower train and a solver other than 'etdrk4' (which "
+         "integrates the roller's electrical pole) so far; allowed with closure {closure}, c = {c} m, k_shaft = "
+         "{k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: 'translating_roller'"),
+    Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),
+         "parameter 'follower_type' = {follower_type}: the paper's formulation (steps 1-9) has the translating "
+         "roller only; allowed with it: 'translating_roller' (or formulation 'consistent', docs/model.md 16)"),
+    Rule(AllOf(OTHER_KIND, Cmp(GUIDE_FRICTION_ON, "!=")),
+         "parameter 'follower_type' = {follower_type}: the engine runs its friction (mu) not yet; allowed with "
+         "mu = {mu}: 'translating_roller' (or mu = 0 or guide_friction false; the scipy reference runs it: "
+         "simulate_reference(..., follower=FollowerKind(...)))"),
     *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),

@@ -36,6 +36,9 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("a_end", "m/s2", "the end mass acceleration (without a train: a)"),
     ("F_train", "N", "the train's force k_train (s - s_end) + d_train (v - v_end), on the end mass along X (without a "
      "train: 0)"),
+    ("psi", "rad", "an oscillating follower's arm angle about its pivot, lift_angle s / lift (docs/model.md 16; 0 for "
+     "a translating follower)"),
+    ("psi_dot", "rad/s", "the arm's rate psi' omega (0 for a translating follower)"),
 )
 # The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
 # section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
@@ -59,8 +62,9 @@ FOLLOWER_UNITS: dict[str, str] = {row[0]: row[1] for row in FOLLOWER_COLUMNS}
 
 def output_record(**values: Any) -> dict[str, float]:
     """Every output, in table order, from keyword values (a missing one is a KeyError; without a train the end mass's
-    columns are the follower's s, v, a and F_train = 0 unless given)."""
-    rigid = {"s_end": values["s"], "v_end": values["v"], "a_end": values["a"], "F_train": 0.0}
+    columns are the follower's s, v, a and F_train = 0, a translating follower's psi and psi_dot 0, unless given)."""
+    rigid = {"s_end": values["s"], "v_end": values["v"], "a_end": values["a"], "F_train": 0.0, "psi": 0.0,
+             "psi_dot": 0.0}
     return {name: values[name] if name in values else rigid[name] for name in OUTPUT_NAMES}
 
 # Model Exchange's states: the engine's x[CAM_NX] (cam_model.h's slots, in order), then a free follower's gap and
@@ -127,6 +131,8 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "v_end": ("x_theta", "x_omega", "x_v_end", "x_gap_rate"),
     "a_end": _FLIGHT + _TRAIN,
     "F_train": ("x_theta", "x_omega") + _TRAIN,
+    "psi": ("x_theta",),   # an arm's angle (docs/model.md 16; 0 for a translating follower)
+    "psi_dot": ("x_theta", "x_omega"),
 }
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).

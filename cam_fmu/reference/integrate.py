@@ -30,7 +30,7 @@ from ..physics.formulations.speed import speed_drive_outputs
 from ..physics.follower_kind import FollowerKind
 from ..physics.kind_drive import KindDriveModel
 from ..physics.modes import Event
-from ..physics.parameters import ParameterError
+from ..physics.parameters import ParameterError, resolve
 from ..physics.train import Train
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
@@ -63,8 +63,15 @@ def simulate_reference(
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
     'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the
-    speed drive (reference/follower_kind.py), its outputs add reference.follower_kind.KIND_OUTPUTS."""
-    if follower is not None and not follower.default:
+    speed drive (reference/follower_kind.py), its outputs add reference.follower_kind.KIND_OUTPUTS. None: the
+    parameters' kind (follower_type and an arm's fields), as the engine takes it; given with a parameter kind other
+    than the default, the two must be equal."""
+    named = FollowerKind.from_parameters(resolve(params))
+    if follower is None:
+        follower = named
+    elif not named.default and named != follower:
+        raise ParameterError(f"follower={follower!r} and the parameters' kind {named!r} differ: give one of them")
+    if not follower.default:
         if train is not None and train.active:
             raise ParameterError(f"the follower train does not run with follower_type {follower.follower_type!r} "
                                  f"(only with the translating roller so far)")

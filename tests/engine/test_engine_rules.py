@@ -13,11 +13,11 @@ import pytest
 from cam_fmu.engine.simulator import CamError, DriveSimulator, _set_parameter, engine
 from cam_fmu.physics import rules
 from cam_fmu.physics.drive import DriveModel, own_follower
-from cam_fmu.physics.parameters import BY_NAME, ParameterError, resolve
+from cam_fmu.physics.parameters import BY_NAME, FOLLOWER_KIND_PARAMETERS, ParameterError, resolve
 
 PER_RULE = 3       # cases kept for each rule
 ACCEPTED = 12      # and parameter sets no rule refuses
-DRAWS = 4000
+DRAWS = 40000     # the follower kind's eight fields make the later rules' cases rare (the last one met at 40000)
 
 
 def candidates(name: str) -> list:
@@ -31,6 +31,26 @@ def candidates(name: str) -> list:
     return [0.0, inside] if spec.zero_ok or spec.low == 0.0 else [inside]
 
 
+def kind_fields(rng: random.Random, params: dict) -> dict:
+    """The follower kind's fields of a case: drawn alone they would nearly always break a kind rule and hide the
+    later rules, so a third of the cases take the default kind, a third a type with the fields it needs (an arm's
+    three inside their ranges but for one in six, a translating type's all at 0), a third the drawn type with one field
+    drawn."""
+    draw = rng.random()
+    if draw < 1 / 3:
+        return {p.name: p.default for p in FOLLOWER_KIND_PARAMETERS}
+    if draw < 2 / 3:
+        kind = params["follower_type"]
+        arm = kind.startswith("oscillating")
+        needed = ("arm_length", "pivot_distance", "lift_angle")   # each set, or now and then missing
+        return {p.name: (rng.choice(candidates(p.name)[-1:] * 5 + [0.0]) if arm and p.name in needed
+                         else params[p.name] if arm else p.default) for p in FOLLOWER_KIND_PARAMETERS
+                if p.name != "follower_type"}
+    one = rng.choice([p.name for p in FOLLOWER_KIND_PARAMETERS if p.name != "follower_type"])
+    return {p.name: params[p.name] if p.name == one else p.default for p in FOLLOWER_KIND_PARAMETERS
+            if p.name != "follower_type"}
+
+
 def cases() -> list[tuple[int | None, dict]]:
     """(index of the first rule that refuses, or None; parameters) for every kept case."""
     names = sorted(rules.rule_names())
@@ -38,6 +58,7 @@ def cases() -> list[tuple[int | None, dict]]:
     kept: dict[int | None, list[dict]] = {}
     for _ in range(DRAWS):
         params = {name: rng.choice(candidates(name)) for name in names}
+        params.update(kind_fields(rng, params))
         p = resolve(params)
         first = next((k for k, rule in enumerate(rules.RULES) if rule.when.value(p)), None)
         bucket = kept.setdefault(first, [])

@@ -36,6 +36,17 @@ FOLLOWER = {
     "groove_compliant_L": {"omega0": 20.0, "c": 5e-4, **SHAFT},
     "groove_stuck": {"omega0": 0.0, "u": 0.0, "c": 5e-4},
 }
+# The follower's kind (kind.c, docs/model.md 16) on the scene's cam: an arm with a roller or a flat face, gravity
+# tilted; no guide friction (the engine refuses it with a kind so far).
+ARM = {"arm_length": 0.15, "pivot_distance": 0.18, "J_arm": 2e-3, "m_arm": 0.2, "r_cm_arm": 0.07, "psi_0": 0.3,
+       "mu": 0.0, "gamma": 1.2}
+KIND = {
+    "oscillating_roller": {"omega0": 20.0, "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM},
+    "oscillating_roller_stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3, "theta0": 1.0,
+                                   "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM},
+    "oscillating_flat_L": {"omega0": 20.0, "L": 1e-3, "follower_type": "oscillating_flat", "lift_angle": 0.15, **ARM},
+    "translating_flat": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.0, "gamma": 1.2, "beta": 0.7},
+}
 FLIGHT = {"spring_in_flight", "spring_in_flight_tilted", "spring_in_flight_L", "spring_in_flight_compliant_L"}
 CASES = {
     "rigid": {"omega0": 20.0},
@@ -55,6 +66,7 @@ CASES = {
     "train_compliant": {"omega0": 20.0, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "k_shaft": 50.0, "d_shaft": 1e-3,
                         "J_m": 3e-5, "J_cam": 1.41e-5, "L": 1e-3},
     **FOLLOWER,
+    **KIND,
 }
 
 

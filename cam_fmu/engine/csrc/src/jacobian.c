@@ -93,6 +93,8 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     double w, dw, s1, ds1, t, dt, a, da, push, root, i_dot, sigma, f, df, along, dalong, F, dF = 0.0;
     int k, engaged = mode->contact != 0, moving = !mode->stuck;
     cam_rhs(m, mode, x, u, dx);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: rigid shaft, no train, no guide friction */
+        return cam_kind_tangent(m, mode, x, seed, dT_motor, du, dx[CAM_OMEGA], ddx, dout);
     cam_profile_eval(&m->profile, theta, d);
     for (k = 0; k < CAM_NX; k++)
         ddx[k] = 0.0;

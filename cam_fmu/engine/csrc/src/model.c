@@ -46,6 +46,12 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
                        double axial, Terms *t)
 {
     double s, s1, mass, J, inertial, tan_a;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq (no guide friction) */
+        cam_kind_eval(m, theta, t->d);
+        t->J = m->J_0 + m->I_f * t->d[1] * t->d[1];
+        t->x0 = (drive - (m->I_f * t->d[2] * omega * omega + cam_kind_slope(m, t->d[0]) + axial) * t->d[1]) / t->J;
+        return;
+    }
     cam_profile_eval(&m->profile, theta, t->d);
     s = t->d[0];
     s1 = t->d[1];
@@ -181,6 +187,10 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
               double axial, CamLoad *out)
 {
     double d[4], s, s1, tan_a, shaft, v, a, sigma, push, f;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c (no train: the rules refuse it) */
+        cam_kind_load(m, theta, omega, omega_dot, direction, engaged, out);
+        return;
+    }
     cam_profile_eval(&m->profile, theta, d);
     s = d[0];
     s1 = d[1];
@@ -377,7 +387,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->F_ex = v[CAM_P_GRAVITY] != 0.0 ? model->m_end * CAM_G_N * mounting(sin(v[CAM_P_GAMMA]), v[CAM_P_GAMMA])
                                              * mounting(cos(v[CAM_P_BETA]), v[CAM_P_BETA]) : 0.0;   /* N: its weight */
     model->train_rate = model->train ? sqrt(model->k_train / model->m_end) + model->d_train / model->m_end : 0.0;
-    model->follower = model->m != 0.0 || model->F_gx != 0.0 || model->mu != 0.0 || model->train;
+    cam_kind_init(model);   /* the follower's type (kind.c, docs/model.md 16) */
+    model->follower = model->I_f != 0.0 || model->F_gx != 0.0 || model->W != 0.0 || model->mu != 0.0 || model->train;
     model->has_current = model->L > 0.0;
     model->backlash = model->c > 0.0;
     model->guide_side = model->mu > 0.0 && model->follower;
@@ -396,7 +407,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
     model->restitution = v[CAM_P_RESTITUTION];
     model->free_follower = cam_own_follower(v);   /* physics/rules.py OWN_FOLLOWER (docs/model.md 13) */
-    if ((status = cam_check_rules(v, err)) != CAM_OK) {   /* physics/rules.py RULES, generated */
+    if ((status = cam_check_rules(v, err)) != CAM_OK                  /* physics/rules.py RULES, generated */
+        || (status = cam_kind_check(model, err)) != CAM_OK) {      /* then geometry an arm or a face cannot have */
         cam_model_free(model);
         return status;
     }

@@ -25,6 +25,7 @@ void cam_outputs(const CamModel *m, const CamMode *mode, const double x[CAM_NX],
         cam_load(m, theta, omega, omega_dot, mode->direction, engaged, F, &load);
     }
     cam_record_outputs(&load, omega, theta, engaged ? load.s_cam - m->c * mode->contact : mode->s_free, i, u, out);
+    cam_kind_outputs(m, theta, mode->stuck ? 0.0 : omega, out);
     if (m->train) {   /* the end mass (docs/model.md 14.6) */
         out[CAM_O_S_END] = x[CAM_X_END];
         out[CAM_O_V_END] = x[CAM_V_END];
@@ -61,6 +62,7 @@ void cam_record_outputs(const CamLoad *load, double omega, double theta, double 
     out[CAM_O_V_END] = load->v;
     out[CAM_O_A_END] = load->a;
     out[CAM_O_F_TRAIN] = 0.0;
+    out[CAM_O_PSI] = out[CAM_O_PSI_DOT] = 0.0;   /* an arm's: cam_kind_outputs */
 }
 
 /* J: the train's end mass's kinetic energy, its spring's and its weight's potential (docs/model.md 14.6; 0 without). */
@@ -71,6 +73,13 @@ static double train_energy(const CamEnergy *e, const double out[])
         return 0.0;
     return 0.5 * e->m_end * out[CAM_O_V_END] * out[CAM_O_V_END] + 0.5 * e->k_train * stretch * stretch
            - e->F_ex * out[CAM_O_S_END];
+}
+
+/* J: an arm's weight's potential W sin(psi + psi_0) (docs/model.md 16; 0 without: a translating follower's weight is
+ * F_gx's). */
+static double arm_energy(const CamEnergy *e, const double out[])
+{
+    return e->W != 0.0 ? e->W * sin(out[CAM_O_PSI] + e->psi_0) : 0.0;
 }
 
 /* E_mech [J] of published outputs: kinetic + gravity potential; compliant: the cam side's and the rotor's
@@ -87,7 +96,7 @@ static double mechanical(const CamEnergy *e, const double out[])
         return own + 0.5 * e->J_m * out[CAM_O_OMEGA_M] * out[CAM_O_OMEGA_M] + 0.5 * e->k_shaft * twist * twist;
     }
     if (e->k_shaft == 0.0)
-        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S] + train_energy(e, out);
+        return 0.5 * out[CAM_O_J] * omega * omega - e->F_gx * out[CAM_O_S] + train_energy(e, out) + arm_energy(e, out);
     twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];
     omega_m = out[CAM_O_OMEGA_M];
     return 0.5 * (out[CAM_O_J] - e->J_m) * omega * omega + 0.5 * e->J_m * omega_m * omega_m
@@ -114,6 +123,8 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
     e->k_train = m->k_train;
     e->m_end = m->m_end;
     e->F_ex = m->F_ex;
+    e->W = m->W;
+    e->psi_0 = m->psi_0;
     e->theta = out[CAM_O_THETA_M];
     e->i = i;
     e->e_mech0 = mechanical(e, out);

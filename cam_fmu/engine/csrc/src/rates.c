@@ -17,11 +17,11 @@ double cam_stiffness_rate(const CamModel *m, const CamMode *mode, const double x
 {
     double d[4], J, omega = x[CAM_OMEGA], rate = 0.0;
     int engaged = mode->contact != 0;
-    cam_profile_eval(&m->profile, x[CAM_THETA], d);
-    J = m->J_0 + (engaged ? m->m * d[1] * d[1] : 0.0);
+    cam_kind_eval(m, x[CAM_THETA], d);   /* the follower's coordinate q and inertia I_f (s and m: the roller's) */
+    J = m->J_0 + (engaged ? m->I_f * d[1] * d[1] : 0.0);
     if (engaged)
-        rate = (2.0 * m->m * fabs(d[1] * d[2] * omega) + fabs(omega) * sqrt(m->m * J * (d[2] * d[2] + fabs(d[1] * d[3]))))
-               / J;
+        rate = (2.0 * m->I_f * fabs(d[1] * d[2] * omega)
+                + fabs(omega) * sqrt(m->I_f * J * (d[2] * d[2] + fabs(d[1] * d[3])))) / J;
     if (m->compliant) {   /* the two-mass oscillation and its damping; the motor acts on the rotor alone */
         rate += cam_shaft_rate(m, J);
         J = m->J_m;
@@ -49,6 +49,6 @@ double cam_profile_rate(const CamModel *m, const double x[CAM_NX])
 double cam_torque_gain(const CamModel *m, const CamMode *mode, const double x[CAM_NX])
 {
     double d[4];
-    cam_profile_eval(&m->profile, x[CAM_THETA], d);
-    return m->c_m / (m->J_0 + (mode->contact != 0 ? m->m * d[1] * d[1] : 0.0));
+    cam_kind_eval(m, x[CAM_THETA], d);
+    return m->c_m / (m->J_0 + (mode->contact != 0 ? m->I_f * d[1] * d[1] : 0.0));
 }

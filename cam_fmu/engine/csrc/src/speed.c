@@ -208,6 +208,7 @@ static void speed_outputs(CamDrive *d, double out[])
         voltage += m->L * omega * dM / m->c_m;
     }
     cam_record_outputs(&load, omega, theta, st->s, i, voltage, out);   /* load.s_cam: s_cam at theta */
+    cam_kind_outputs(m, theta, omega, out);
     if (m->train) {
         out[CAM_O_S_END] = x_e;
         out[CAM_O_V_END] = v_e;

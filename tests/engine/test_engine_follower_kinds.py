@@ -1,0 +1,125 @@
+"""The follower's kind in the C engine (docs/model.md 16): a translating flat face, an oscillating roller and an
+oscillating flat face in the consistent voltage drive (rk45 and rk4) and the speed drive, against the scipy reference
+(physics/kind_drive.py KindDriveModel, written apart), with gravity tilted and shaft friction; the reference takes the
+kind from the parameters as the engine does; what the engine does not run yet, and geometry that cannot be built,
+refused by name."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cam_fmu.engine.simulator import DriveSimulator
+from cam_fmu.physics.follower_kind import FollowerKind
+from cam_fmu.physics.parameters import ParameterError, defaults
+from cam_fmu.physics.signals import Signal, constant
+from cam_fmu.reference.integrate import simulate_reference
+
+RISE = math.pi / 2  # rad: cycloidal rise, dwell, return, dwell of 90 deg each
+SCENE = dict(rise_law="cycloidal", return_law="cycloidal", rise_angle=RISE, upper_dwell=RISE, return_angle=RISE,
+             lower_dwell=RISE, lift=0.02, r_b=0.08, closure="kinematic", m=0.4, G=4.0, M_f=0.012, mu=0.0,
+             gamma=1.2, J_cam=2e-4)   # gravity tilted out of the vertical; shaft friction on, guide friction off
+ARM = dict(arm_length=0.15, pivot_distance=0.18, J_arm=2e-3, m_arm=0.2, r_cm_arm=0.07, psi_0=0.3)
+KINDS = {"translating_flat": dict(follower_type="translating_flat", beta=0.3),
+         "oscillating_roller": dict(follower_type="oscillating_roller", lift_angle=0.3, **ARM),
+         "oscillating_flat": dict(follower_type="oscillating_flat", lift_angle=0.15, **ARM)}
+STOP, STEP = 0.9, 0.01  # s
+# V: forward, back, then too little to turn the cam against its load (stops and break-aways)
+VOLTS = Signal((0.0, 0.3, 0.3, 0.6, 0.6), (40.0, 40.0, -12.0, -12.0, 1.0), hold=True)
+SPEED = Signal((0.0, 0.5), (5.0, 30.0))  # rad/s: a ramp
+NAMES = ("theta", "omega", "i", "M", "J", "s", "v", "a", "alpha", "N_contact", "psi", "psi_dot", "voltage")
+# (drive parameters, bound on every NAMES' difference relative to its largest value): measured at most 2.2e-8 .. 1.9e-7
+# (rk45 at the engine's default tolerances; the largest the oscillating roller's alpha), 2.6e-9 .. 9.1e-9 (rk4 at h_max
+# 25 us; at 0.1 ms 1e-6 .. 8.5e-6), 2.3e-7 .. 5.0e-7 (rk23 at the engine's tolerances), 1.3e-13 (the speed drive: the
+# same formulas at the same imposed angles)
+DRIVES = {"rk45": (dict(), 1e-6), "rk4": (dict(solver="rk4", h_max=2.5e-5), 1e-6), "rk23": (dict(solver="rk23"), 2e-6),
+          "speed": (dict(drive="speed"), 1e-6)}
+
+
+def engine_run(params: dict) -> dict[str, np.ndarray]:
+    """The engine's outputs on the grid, the inputs held over each step at their value at its start."""
+    sim = DriveSimulator(params)
+    grid = np.arange(int(round(STOP / STEP)) + 1) * STEP
+    sim.set_inputs(VOLTS.value(0.0), SPEED.value(0.0), SPEED.slope(0.0))
+    rows = [sim.outputs()]
+    for t in grid[:-1]:
+        sim.do_step(t, STEP, u=VOLTS.value(t), omega_ref=SPEED.value(t), omega_dot_ref=SPEED.slope(t))
+        rows.append(sim.outputs())
+    return {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+
+def worst(engine: dict, reference: dict, name: str) -> float:
+    """max |engine - reference| over the grid, relative to the reference's largest |value| (absolute where it is 0)."""
+    scale = float(np.max(np.abs(reference[name])))
+    return float(np.max(np.abs(engine[name] - reference[name]))) / (scale if scale > 0.0 else 1.0)
+
+
+@pytest.mark.parametrize("drive", list(DRIVES))
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_the_engine_runs_every_kind_as_the_reference_does(kind, drive):
+    extra, bound = DRIVES[drive]
+    params = dict(defaults(), **SCENE, **KINDS[kind], **extra)
+    engine = engine_run(params)
+    reference = simulate_reference(params, STOP, STEP, u=VOLTS, omega_ref=SPEED)
+    for name in NAMES:
+        assert worst(engine, reference, name) < bound, (name, worst(engine, reference, name))
+    assert np.ptp(engine["theta"]) > 1.0   # rad: the cam turns (and the follower moves through the law)
+    if KINDS[kind]["follower_type"].startswith("oscillating"):
+        assert np.max(engine["psi"]) > 0.5 * params["lift_angle"]
+        assert np.allclose(engine["psi"], params["lift_angle"] / params["lift"] * engine["s"], rtol=0, atol=1e-15)
+    else:
+        assert not np.any(engine["psi"]) and not np.any(engine["psi_dot"])
+    if drive != "speed":   # it stops and breaks away: the held cam under shaft friction
+        assert np.min(engine["omega"]) < 0.0 < np.max(engine["omega"])
+
+
+def test_the_reference_takes_the_kind_from_the_parameters():
+    """simulate_reference with the kind as parameters is the run with follower=FollowerKind(...), bit for bit."""
+    arm = KINDS["oscillating_roller"]
+    params = dict(defaults(), **SCENE, drive="speed")
+    named = simulate_reference(dict(params, **arm), 0.2, 0.01, omega_ref=constant(10.0))
+    given = simulate_reference(params, 0.2, 0.01, omega_ref=constant(10.0), follower=FollowerKind(**arm))
+    assert set(named) == set(given) and all(np.array_equal(named[k], given[k]) for k in named)
+
+
+def test_the_translating_roller_has_no_arm_outputs():
+    """The default type: psi and psi_dot are 0 in the engine and the reference (the rest is the baseline's)."""
+    params = dict(defaults(), **SCENE)
+    engine = engine_run(params)
+    assert np.ptp(engine["s"]) > 0.0 and not np.any(engine["psi"]) and not np.any(engine["psi_dot"])
+
+
+def refusal(params: dict) -> str:
+    with pytest.raises(ParameterError) as exc:
+        DriveSimulator({**defaults(), **SCENE, **params})
+    return str(exc.value)
+
+
+@pytest.mark.parametrize("params,names", [
+    (dict(arm_length=0.15), ("'arm_length'", "'translating_roller'")),
+    (dict(follower_type="translating_flat", psi_0=0.1), ("'psi_0'", "'translating_flat'")),
+    (dict(follower_type="oscillating_flat", lift_angle=0.1, pivot_distance=0.18), ("'arm_length'", "needs it")),
+    (dict(KINDS["oscillating_roller"], beta=0.2), ("'beta'", "psi_0")),
+    (dict(KINDS["oscillating_roller"], mu=0.05), ("'follower_type'", "mu = 0.05")),
+    (dict(KINDS["translating_flat"], closure="spring", k_spring=1e3), ("'follower_type'", "closure 'spring'")),
+    (dict(KINDS["translating_flat"], k_shaft=100.0), ("'follower_type'", "k_shaft = 100.0")),
+    (dict(KINDS["oscillating_flat"], k_train=1e4, m_end=0.1), ("'follower_type'", "k_train = 10000.0")),
+    (dict(KINDS["oscillating_flat"], formulation="paper"), ("'follower_type'", "paper")),
+    (dict(KINDS["oscillating_flat"], solver="etdrk4"), ("'follower_type'", "etdrk4")),
+    (dict(KINDS["oscillating_roller"], arm_length=0.05), ("'arm_length' = 0.05", "cannot reach")),
+    (dict(KINDS["oscillating_roller"], lift_angle=3.0), ("'lift_angle' = 3.0", "90 deg")),
+    (dict(KINDS["oscillating_flat"], pivot_distance=0.07), ("'pivot_distance' = 0.07", "inside the base circle")),
+    (dict(KINDS["oscillating_flat"], lift_angle=1.3), ("'lift_angle' = 1.3", "perpendicular")),
+])
+def test_what_the_engine_does_not_run_is_refused_by_name(params, names):
+    message = refusal(params)
+    assert all(name in message for name in names), message
+
+
+@pytest.mark.parametrize("params", [dict(KINDS["oscillating_roller"], arm_length=0.05),
+                                    dict(KINDS["oscillating_flat"], pivot_distance=0.07)])
+def test_the_reference_refuses_the_same_geometry(params):
+    """The geometry the engine refuses, the reference refuses too (kinematics/follower_checks.py, written apart)."""
+    with pytest.raises(ParameterError):
+        simulate_reference(dict(defaults(), **SCENE, **params, drive="speed"), 0.1, 0.01, omega_ref=constant(10.0))
