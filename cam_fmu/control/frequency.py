@@ -43,6 +43,7 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
     holds it there against gravity; ValueError when gravity's stiffness makes that equilibrium unstable."""
     p = dict(params or {}, **FROZEN_OFF, theta0=theta0, omega0=0.0)
     model = DriveModel(p)
+    model.require_translating_roller("the frequency response at a frozen angle")
     if abs(model.F_gx) <= 1e-12 * p.get("G", 1.0) and model.F_gx != 0.0:
         # a horizontal mounting's gravity along X is sin(pi) G = 1.2e-16 G of rounding: held by a voltage of
         # 1e-15 V, the frictionless cam would crawl at rest and its stops chatter; it is no load at all
@@ -89,6 +90,7 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
     shaft is the one-mass limit: states (theta - theta0, omega[, i][, x_e, v_e]), both outputs omega. A follower
     train (k_train > 0) adds its end mass's deviation and velocity, and its weight to gravity's stiffness."""
     model = DriveModel(dict(params or {}, **FROZEN_OFF))
+    model.require_translating_roller("the linearised drive of the frequency response")
     _, s1, s2, _ = model.program.derivatives(theta0)
     J_c = model.J_0 + model.m * s1 * s1
     k_g = -(model.F_gx + _end_weight(model)) * s2

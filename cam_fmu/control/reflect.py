@@ -67,6 +67,7 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
     if points < 8:
         raise ValueError(f"points = {points}: at least 8 angles over a turn")
     model = DriveModel(params)
+    model.require_translating_roller("the reflected-load map")
     if model.free_follower:
         raise FreeFollowerError(model.closure)
     omega = rpm * 2.0 * math.pi / 60.0

@@ -154,6 +154,7 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
         raise ValueError("give the operating point: theta0 (a frozen angle) or a finite u0 [V] (a mean speed)")
     p = dict(params or {})
     model = DriveModel(p)
+    model.require_translating_roller("the frequency response")
     J_heavy = max(model.J_0 + model.m * model.program.derivatives(t)[1] ** 2
                   for t in np.linspace(0.0, 2.0 * math.pi, 361)) + (model.J_m if model.compliant else 0.0)
     settle = SETTLE_TIME_CONSTANTS * model.R * J_heavy / (model.c_e * model.c_m)  # the slowest mechanical pole

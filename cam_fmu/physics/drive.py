@@ -175,9 +175,17 @@ class DriveModel:
         self.k_spring, self.F_spring0, self.restitution = p["k_spring"], p["F_spring0"], p["restitution"]
         check_rules(p)  # the cross-parameter rules (rules.RULES; C's are generated from the same table)
         self.train = Train(p["k_train"], p["d_train"], p["m_end"])  # the follower train (14.6; k_train = 0: none)
+        self.follower_type = p["follower_type"]  # this class computes the translating roller (others: kind_drive.py)
         self.free_follower = own_follower(p)
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
+
+    def require_translating_roller(self, what: str) -> None:
+        """Refuse, naming ``what`` (a command or map), a follower type other than the translating roller, which
+        this model's formulas are (the other types: physics/kind_drive.py, docs/model.md 16)."""
+        if self.follower_type != "translating_roller":
+            raise ParameterError(f"parameter 'follower_type' = {self.follower_type!r}: {what} computes the "
+                                 f"translating roller only so far (docs/model.md 16); allowed: 'translating_roller'")
 
     # ----------------------------------------------------------- mechanics
     def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float,

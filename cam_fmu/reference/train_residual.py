@@ -53,7 +53,9 @@ def residual_scene(params: Mapping[str, Any], table_ok: bool = False) -> dict[st
     split with the return when the scene has none). ``table_ok``: a motion table whose rise, lift and upper dwell
     are the parameters' rise_angle, lift and upper_dwell (a polydyne table: vibration/polydyne.py) is measured as
     it is, else refused."""
-    p = dict(DriveModel(params).params)
+    model = DriveModel(params)
+    model.require_translating_roller("the residual through the drive")
+    p = dict(model.params)
     if p.get("motion_table") and not table_ok:
         raise ParameterError("the residual through the drive needs a rise law: parameter 'motion_table' must be empty")
     # The cam's motion imposed (a rigid shaft), the follower on it: no clearance, no return spring, no restitution.

@@ -123,3 +123,21 @@ def test_the_reference_refuses_the_same_geometry(params):
     """The geometry the engine refuses, the reference refuses too (kinematics/follower_checks.py, written apart)."""
     with pytest.raises(ParameterError):
         simulate_reference(dict(defaults(), **SCENE, **params, drive="speed"), 0.1, 0.01, omega_ref=constant(10.0))
+
+
+@pytest.mark.parametrize("kind", ["translating_flat", "oscillating_roller"])
+def test_the_maps_that_model_the_roller_only_refuse_another_type_by_name(kind):
+    """reflect, bode's linear model and frozen angle, its turning measurement and the residual through the drive compute
+    the translating roller's formulas (physics/drive.py): with another follower type they refuse, naming it, rather
+    than map a roller in its place."""
+    from cam_fmu.control.frequency import frozen_parameters, linear_model
+    from cam_fmu.control.reflect import reflected_map
+    from cam_fmu.experiments.frequency import operating_point
+    from cam_fmu.reference.train_residual import residual_scene
+
+    params = dict(KINDS[kind], mu=0.0)
+    for call in (lambda: reflected_map(params, 60.0), lambda: linear_model(params, 1.0),
+                 lambda: frozen_parameters(params, 1.0), lambda: operating_point(params, u0=3.5),
+                 lambda: residual_scene(params)):
+        with pytest.raises(ParameterError, match=f"'follower_type' = '{kind}'.*translating roller only"):
+            call()
