@@ -1,6 +1,7 @@
-"""`cam-fmu bench train` (tools/bench/train.py): the train's cost is measured on runs that differ by the train alone,
-and what it reports is consistent: the train's run takes more internal steps than the rigid one (it resolves the
-50 Hz ringing), its ratios are the quotients of the figures reported beside them. No time is asserted."""
+"""`cam-fmu bench train` and `cam-fmu bench kinds` (tools/bench/train.py, kinds.py over variants.py): each feature
+is measured on runs that differ by it alone, and what is reported is consistent: the train's run takes more
+internal steps than the rigid one (it resolves the 50 Hz ringing), every ratio is the quotient of the figures
+reported beside it. No time is asserted."""
 from __future__ import annotations
 
 import csv
@@ -8,20 +9,24 @@ from types import SimpleNamespace
 
 import pytest
 
-from cam_fmu.tools.bench import BENCHMARKS, train
+from cam_fmu.tools.bench import BENCHMARKS, kinds, train
 
 
-def test_the_train_benchmark_reports_consistent_ratios(tmp_path):
+@pytest.mark.parametrize("module, name", [(train, "train"), (kinds, "kinds")])
+def test_the_feature_benchmarks_report_consistent_ratios(tmp_path, module, name):
     said: list[str] = []
     ctx = SimpleNamespace(quick=True, out=tmp_path, say=said.append)
-    assert BENCHMARKS["train"][0] == "train" and train.run(ctx) == 0
-    rows = list(csv.DictReader(open(tmp_path / "train.csv", encoding="utf-8")))
-    assert [r["setting"] for r in rows] == list(train.SETTINGS) and len(said) == len(rows)
+    assert BENCHMARKS[name][0] == name and module.run(ctx) == 0
+    rows = list(csv.DictReader(open(tmp_path / f"{name}.csv", encoding="utf-8")))
+    labels = list(train.SETTINGS if module is train else kinds.KINDS)
+    assert [r["setting"] for r in rows] == labels and len(said) == len(rows)
     for r in rows:
-        n_rigid, n_train = int(r["rigid_steps"]), int(r["train_steps"])
-        assert n_train > n_rigid > 0
-        t_rigid, t_train = float(r["rigid_ms"]), float(r["train_ms"])
-        assert float(r["run_ratio"]) == pytest.approx(t_train / t_rigid, rel=1e-12)
-        assert float(r["step_ratio"]) == pytest.approx((t_train / n_train) / (t_rigid / n_rigid), rel=1e-12)
-    speed = rows[-1]
-    assert int(speed["rigid_steps"]) == round(train.STOP / train.STEP)   # the rigid speed drive: one per step
+        n_base, n_variant = int(r["base_steps"]), int(r["variant_steps"])
+        assert n_base > 0 and n_variant > 0
+        if module is train:
+            assert n_variant > n_base
+        t_base, t_variant = float(r["base_ms"]), float(r["variant_ms"])
+        assert float(r["run_ratio"]) == pytest.approx(t_variant / t_base, rel=1e-12)
+        assert float(r["step_ratio"]) == pytest.approx((t_variant / n_variant) / (t_base / n_base), rel=1e-12)
+    if module is train:
+        assert int(rows[-1]["base_steps"]) == round(train.STOP / train.STEP)   # the rigid speed drive: one a step

@@ -28,6 +28,8 @@ BENCHMARKS = {
                                     "against differencing: right-hand sides, wall"),
     "train": ("train", False, "the follower train's cost against the rigid drive, per run and per internal step "
                               "(in-process, voltage drive under rk45, rk4, rk23; speed drive)"),
+    "kinds": ("kinds", False, "each follower type's cost against the translating roller's, per run and per internal "
+                              "step (in-process, voltage drive, rk45)"),
 }
 DEFAULT = tuple(name for name, (_m, default, _w) in BENCHMARKS.items() if default)
 
