@@ -112,7 +112,7 @@ def test_voltage_drive_time_figure_has_no_voltage_panel():
 def test_every_kind_is_written(tmp_path):
     for kind in PLOTS:
         scene = find_scene({"fig4": "paper_fig4", "fig5": "paper_fig5a", "fig6": "paper_fig6",
-                            "time": "speed_drive", "follower": "spring_bounce"}[kind])
+                            "time": "speed_drive", "follower": "spring_bounce", "train": "train_voltage"}[kind])
         assert scene.plot == kind
         path = plot_scene(scene, _fake_results([run.label for run in scene.runs]), tmp_path / f"{kind}.png")
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
