@@ -5,13 +5,13 @@ engine unchanged. The engine steps from output point to output point with the in
 ramp of omega_ref as its slope, exactly)."""
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping
 
 import numpy as np
 
 from ..physics.signals import Signal, constant
 from ..physics.variables import INPUT_STARTS
+from ..reference.integrate import output_grid
 
 __all__ = ["simulate_engine"]
 
@@ -30,14 +30,11 @@ def simulate_engine(params: Mapping[str, Any] | None, stop_time: float, output_i
     p.update({k: v for k, v in (("rtol", rtol), ("atol", atol)) if v is not None})
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
-    n = int(math.floor(stop_time / output_interval * (1.0 + 1e-12)))
-    grid = list(np.arange(n + 1) * output_interval)
-    if stop_time - grid[-1] > 1e-9 * stop_time:
-        grid.append(stop_time)
+    grid = output_grid(stop_time, output_interval)   # the reference's times
     sim = DriveSimulator(p)
     sim.set_inputs(u.value(0.0), omega_ref.value(0.0), omega_ref.slope(0.0))
     rows = [sim.outputs()]
     for a, b in zip(grid[:-1], grid[1:]):
         sim.do_step(a, b - a, u=u.value(a), omega_ref=omega_ref.value(a), omega_dot_ref=omega_ref.slope(a))
         rows.append(sim.outputs())
-    return {"time": np.array(grid), **{name: np.array([r[name] for r in rows]) for name in rows[0]}}
+    return {"time": grid, **{name: np.array([r[name] for r in rows]) for name in rows[0]}}

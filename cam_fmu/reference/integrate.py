@@ -58,7 +58,7 @@ def simulate_reference(
     """Run the drive from 0 to ``stop_time`` [s]; outputs every ``output_interval`` [s].
 
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
-    m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_OUTPUTS
+    m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_INTEGRALS
     (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py).
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
@@ -76,13 +76,13 @@ def simulate_reference(
             raise ParameterError(f"the follower train does not run with follower_type {follower.follower_type!r} "
                                  f"(only with the translating roller so far)")
         model = KindDriveModel(params, follower)
-        return kind_reference(model, _grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"]),
+        return kind_reference(model, output_grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"]),
                               omega_ref or constant(INPUT_STARTS["omega_ref"]),
                               {"rtol": rtol, "atol": atol, "energy": energy, "method": method})
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
-    grid = _grid(stop_time, output_interval)
+    grid = output_grid(stop_time, output_interval)
     options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
     train = model.train if train is None else train   # the parameters' (k_train, d_train, m_end) unless given
     if train.active:
@@ -94,7 +94,8 @@ def simulate_reference(
     return REFERENCES[formulation_name(model)](model, grid, u, omega_ref, options)
 
 
-def _grid(stop_time: float, output_interval: float) -> np.ndarray:
+def output_grid(stop_time: float, output_interval: float) -> np.ndarray:
+    """The output times [s]: 0, output_interval, .., and stop_time (a last, shorter interval ends there, as fmpy's)."""
     if not (stop_time > 0.0 and output_interval > 0.0):
         raise ValueError(f"stop_time = {stop_time} s and output_interval = {output_interval} s must be > 0")
     n = int(math.floor(stop_time / output_interval * (1.0 + 1e-12)))

@@ -23,14 +23,11 @@ from ..physics.train import Train, end_weight
 from .flight import speed_motion
 from .hybrid import collect, next_breakpoint
 
-__all__ = ["TRAIN_OUTPUTS", "speed_train_reference"]
+__all__ = ["TRAIN_INTEGRALS", "speed_train_reference"]
 
-# The columns a run with a train adds [unit, meaning].
-TRAIN_OUTPUTS: tuple[tuple[str, str, str], ...] = (
-    ("s_end", "m", "the train's end mass position along X"),
-    ("v_end", "m/s", "the end mass velocity"),
-    ("a_end", "m/s2", "the end mass acceleration"),
-    ("F_train", "N", "the train's force k_train (s - x_e) + d_train (v - v_e): on the end mass along X"),
+# The columns a run with a train adds beside the outputs (s_end, v_end, a_end, F_train: physics.variables.OUTPUTS)
+# [unit, meaning].
+TRAIN_INTEGRALS: tuple[tuple[str, str, str], ...] = (
     ("W_train", "J", "work the follower has done on the train, int F_train v dt"),
     ("E_train_damp", "J", "energy the train's damper has dissipated, int d_train (v - v_e)^2 dt"),
 )
@@ -51,8 +48,8 @@ def _pieces(omega_ref: Signal, stop: float) -> list[tuple[float, float]]:
 
 def speed_train_reference(model: DriveModel, grid: np.ndarray, omega_ref: Signal, train: Train, rtol: float,
                           atol: float) -> dict[str, np.ndarray]:
-    """The speed drive with ``train`` on ``grid`` [s]: the rigid drive's outputs with F_train in the load, and
-    TRAIN_OUTPUTS."""
+    """The speed drive with ``train`` on ``grid`` [s]: the drive's outputs (the train's among them) with F_train in
+    the load, and TRAIN_INTEGRALS."""
     from scipy.integrate import solve_ivp
 
     if model.free_follower or model.c != 0.0:

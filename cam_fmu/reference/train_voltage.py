@@ -286,7 +286,7 @@ class _VoltageTrain(VoltageRun):
 def voltage_train_reference(model: DriveModel, grid: np.ndarray, u: Signal, train: Train, rtol: float,
                             atol: float, method: str | None) -> dict[str, np.ndarray]:
     """The voltage drive with ``train`` on ``grid`` [s]: the drive's outputs with F_train in the load (and in the
-    guide's friction), the train's outputs (reference.train_speed.TRAIN_OUTPUTS) and E_in, E_copper, E_shaft,
+    guide's friction), the train's outputs and integrals (reference.train_speed.TRAIN_INTEGRALS) and E_in, E_copper, E_shaft,
     E_guide [J]."""
     _check(model)
     return _VoltageTrain(model, u, train, rtol, atol, method).run(grid)

@@ -147,12 +147,12 @@ SPRING = dict(drive="speed", closure="spring", k_spring=2000.0, F_spring0=20.0, 
 
 def _run(params, omega, turns=1.0, points=400):
     from cam_fmu.reference.flight import FollowerRun
-    from cam_fmu.reference.integrate import _grid
+    from cam_fmu.reference.integrate import output_grid
 
     model = DriveModel(params)
     run = FollowerRun(model, constant(omega), 1e-12, 1e-13)
     stop = turns * 2 * math.pi / omega
-    return model, run, run.run(_grid(stop, stop / points), 0.0)
+    return model, run, run.run(output_grid(stop, stop / points), 0.0)
 
 
 def test_no_lift_off_below_the_jump_speed_and_lift_off_above():

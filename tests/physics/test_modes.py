@@ -16,7 +16,7 @@ from cam_fmu.physics.formulations.consistent import EVENT_NAMES, EVENTS, Mode as
 from cam_fmu.physics.modes import Event, Follower, Shaft
 from cam_fmu.physics.signals import constant
 from cam_fmu.reference.flight import FollowerRun
-from cam_fmu.reference.integrate import _Consistent, _grid
+from cam_fmu.reference.integrate import _Consistent, output_grid
 from cam_fmu.reference.voltage_flight import VoltageFollowerRun
 
 MODEL_MD = Path(__file__).resolve().parents[2] / "docs" / "model.md"
@@ -43,7 +43,7 @@ def test_a_follower_halted_by_the_guide_friction_stays_where_the_deceleration_st
     assert f0 > 0.0 and model.F_gx == 0.0
     run = _Modes(model, constant(10.0), 1e-12, 1e-13)
     stop = 2 * math.pi / 10.0
-    r = run.run(_grid(stop, stop / 2000), 0.0)
+    r = run.run(output_grid(stop, stop / 2000), 0.0)
     modes = np.array([m.name for m in run.modes])
     halted = np.flatnonzero(modes == "HALTED")
     assert len(halted) >= 10 and set(modes) == {"LOWER", "UPPER", "FLIGHT", "HALTED"}

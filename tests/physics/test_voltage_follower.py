@@ -18,7 +18,7 @@ from cam_fmu.physics.follower import Flight
 from cam_fmu.physics.parameters import ParameterError
 from cam_fmu.physics.signals import constant
 from cam_fmu.reference.voltage_flight import VoltageFollowerRun
-from cam_fmu.reference.integrate import _grid, simulate_reference
+from cam_fmu.reference.integrate import output_grid, simulate_reference
 
 C_M = 0.015 * 9.80665
 # The paper's cam held by a return spring, horizontal, without guide friction, on a flywheel J_cam = 0.05 kg m2
@@ -31,7 +31,7 @@ U = 11.0  # V
 def run(params: dict, stop: float, interval: float, u: float = U, energy: bool = False):
     model = DriveModel(params)
     body = VoltageFollowerRun(model, constant(u), 1e-12, 1e-13, energy, None)
-    return model, body, body.run(_grid(stop, interval))
+    return model, body, body.run(output_grid(stop, interval))
 
 
 def stored(model: DriveModel, r: dict) -> np.ndarray:

@@ -111,18 +111,18 @@ double cam_drive_torque(const CamModel *m, const double x[CAM_NX], double omega,
     return cam_torque(m, omega, x[CAM_CURRENT], u);
 }
 
-double cam_train_force(const CamModel *m, const double x[CAM_NX], double s, double v)
-{
-    return m->train ? m->k_train * (s - x[CAM_X_END]) + m->d_train * (v - x[CAM_V_END]) : 0.0;
-}
-
-double cam_train_force_at(const CamModel *m, const double x[CAM_NX], double omega)
+double cam_train_force(const CamModel *m, double theta, double omega, double x_e, double v_e)
 {
     double d[4];
     if (!m->train)
         return 0.0;
-    cam_profile_eval(&m->profile, x[CAM_THETA], d);
-    return cam_train_force(m, x, d[0], d[1] * omega);
+    cam_profile_eval(&m->profile, theta, d);
+    return m->k_train * (d[0] - x_e) + m->d_train * (d[1] * omega - v_e);
+}
+
+double cam_train_force_at(const CamModel *m, const double x[CAM_NX], double omega)
+{
+    return cam_train_force(m, x[CAM_THETA], omega, x[CAM_X_END], x[CAM_V_END]);
 }
 
 /* The end mass's rates (docs/model.md 14.6) into dx: x_e' = v_e, m_end v_e' = F_train + F_ex; held at 0 without a

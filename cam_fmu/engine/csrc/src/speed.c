@@ -97,16 +97,6 @@ static int speed_init(CamDrive *d, CamError *err)
     return CAM_OK;
 }
 
-/* F_train [N] with the follower on the cam at theta [rad] turning at omega [rad/s] and the end mass at x_e, v_e. */
-static double train_force(const CamModel *m, double theta, double omega, double x_e, double v_e)
-{
-    double x[CAM_NX] = {0.0};
-    x[CAM_THETA] = theta;
-    x[CAM_X_END] = x_e;
-    x[CAM_V_END] = v_e;
-    return cam_train_force_at(m, x, omega);
-}
-
 static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
 {
     (void)u;
@@ -190,7 +180,7 @@ static void speed_outputs(CamDrive *d, double out[])
         cam_follower_outputs(m, st, omega_dot, direction, out);
         return;
     }
-    double x_e = d->x[CAM_X_END], v_e = d->x[CAM_V_END], F = train_force(m, theta, omega, x_e, v_e), a_e = 0.0;
+    double x_e = d->x[CAM_X_END], v_e = d->x[CAM_V_END], F = cam_train_force(m, theta, omega, x_e, v_e), a_e = 0.0;
     on = engaged(m, theta, st->s, direction, omega_dot);
     cam_load(m, theta, omega, omega_dot, direction, on, F, &load);
     i = (m->J_0 * omega_dot + load.M) / m->c_m;
@@ -201,9 +191,9 @@ static void speed_outputs(CamDrive *d, double out[])
                                          * with the end mass and the speed over that time */
         double step = 1e-6, dt = step / omega, dM;
         cam_load(m, theta + step, omega, omega_dot, direction, on,
-                 train_force(m, theta + step, omega + omega_dot * dt, x_e + v_e * dt, v_e + a_e * dt), &ahead);
+                 cam_train_force(m, theta + step, omega + omega_dot * dt, x_e + v_e * dt, v_e + a_e * dt), &ahead);
         cam_load(m, theta - step, omega, omega_dot, direction, on,
-                 train_force(m, theta - step, omega - omega_dot * dt, x_e - v_e * dt, v_e - a_e * dt), &behind);
+                 cam_train_force(m, theta - step, omega - omega_dot * dt, x_e - v_e * dt, v_e - a_e * dt), &behind);
         dM = (ahead.M - behind.M) / (2.0 * step);
         voltage += m->L * omega * dM / m->c_m;
     }

@@ -17,13 +17,8 @@ typedef struct {                /* the cam's motion over the step */
 static void rates(void *ctx, const double *y, double *dy)
 {
     const Motion *mo = ctx;
-    double tau = y[0], theta = mo->theta0 + (mo->omega0 + 0.5 * mo->alpha * tau) * tau, omega = mo->omega0
-                                                                                             + mo->alpha * tau;
-    double x[CAM_NX] = {0.0}, F;
-    x[CAM_THETA] = theta;
-    x[CAM_X_END] = y[1];
-    x[CAM_V_END] = y[2];
-    F = cam_train_force_at(mo->m, x, omega);
+    double tau = y[0], theta = mo->theta0 + (mo->omega0 + 0.5 * mo->alpha * tau) * tau;
+    double F = cam_train_force(mo->m, theta, mo->omega0 + mo->alpha * tau, y[1], y[2]);
     dy[0] = 1.0;
     dy[1] = y[2];
     dy[2] = (F + mo->m->F_ex) / mo->m->m_end;
@@ -41,8 +36,8 @@ int cam_train_follow(const CamModel *m, double x[CAM_NX], double theta0, double 
     while (h - y[0] > 1e-12 * h) {
         bound = h - y[0];
         dt = *h_next < bound ? *h_next : bound;
+        rates(&mo, y, k);   /* k[0]: the rates at y, for every trial from it */
         for (;;) {
-            rates(&mo, y, k);
             cam_tableau_step(t, TRAIN_SLOTS, TRAIN_SLOTS, rates, &mo, y, dt, k, out, e);
             for (norm = 0.0, slot = 1; slot < TRAIN_SLOTS; slot++) {
                 scale = fabs(y[slot]) > fabs(out[slot]) ? fabs(y[slot]) : fabs(out[slot]);
