@@ -221,11 +221,8 @@ def contract_header() -> str:
              f'#include "{HEADER}"', "",
              "/* Slots of the continuous state x; a rigid drive carries the first CAM_NX_RIGID. */", "enum {"]
     lines += [f"    CAM_{name} = {k},   /* Model Exchange's {state} */" for k, (name, state) in enumerate(contract.X_SLOTS)]
-    lines += [f"    CAM_NX = {contract.NX}, CAM_NX_RIGID = {contract.NX_RIGID}", "};", "",
-              "/* Model Exchange's states after x[CAM_NX] (the voltage drive's free follower), then their count. */",
-              "enum {"]
-    lines += [f"    CAM_ME_{name} = {contract.NX + k},   /* {state} */" for k, (name, state) in enumerate(contract.ME_SLOTS)]
-    lines += [f"    CAM_ME_NX = {contract.NX + len(contract.ME_SLOTS)}", "};", "",
+    lines += [f"    CAM_NX = {contract.NX}, CAM_NX_RIGID = {contract.NX_RIGID}, CAM_NX_SHAFT = {contract.NX_SHAFT},",
+              f"    CAM_ME_NX = {contract.NX}   /* Model Exchange's states: x itself */", "};", "",
               "/* Event codes (physics/formulations/consistent.py EVENT_NAMES, in order; names: cam_event_name). */",
               "enum {"]
     lines += [f"    {contract.event_c_name(name)} = {k}," for k, name in enumerate(contract.event_names())]

@@ -20,13 +20,14 @@ from ..physics.variables import STATES
 # train (docs/model.md 14.6) its end mass's position and velocity (a drive with either carries all NX).
 X_SLOTS: tuple[tuple[str, str], ...] = (("THETA", "x_theta"), ("OMEGA", "x_omega"), ("CURRENT", "x_i"),
                                         ("TWIST", "x_twist"), ("OMEGA_M", "x_omega_m"), ("X_END", "x_end"),
-                                        ("V_END", "x_v_end"))
+                                        ("V_END", "x_v_end"), ("GAP", "x_gap"), ("RATE", "x_gap_rate"))
 NX = len(X_SLOTS)
-# Model Exchange's states after x (physics.variables.STATES, in order): the voltage drive's free follower's gap to
-# the flank it left last and the gap's rate (docs/model.md 13.6), held at 0 in contact and without one.
-ME_SLOTS: tuple[tuple[str, str], ...] = (("GAP", "x_gap"), ("RATE", "x_gap_rate"))
+# The last two slots are the voltage drive's follower of its own (docs/model.md 13.6): its gap to the flank it left last
+# and the gap's rate, held at 0 on a flank and without a follower of its own. Co-simulation and Model Exchange carry
+# this one vector (a compliant shaft or a train carries the first NX_SHAFT slots, a follower of its own all NX).
 NX_RIGID = 3
-MAX_EVENTS = 3          # event functions a mode has active at once at most (cam_event_codes)
+NX_SHAFT = 7
+MAX_EVENTS = 4          # event functions a mode has active at once at most (cam_event_codes)
 MESSAGE_LEN = 1024      # bytes of an error's message
 
 # The error statuses (cam_error.h): C name, value, what Python raises (engine/simulator.py raise_for), meaning.
@@ -41,16 +42,17 @@ STATUSES: tuple[tuple[str, int, str, str], ...] = (
 # The saved state (cam_drive.h cam_drive_get_state): a flat array of doubles, its entries in this order, each a
 # name and how many doubles; STATE_LEN leaves room for entries a later version adds. Bump STATE_VERSION whenever
 # the layout changes: a state of another layout is refused by its version.
-STATE_VERSION = 3.0     # 2: the compliant shaft's two slots in x; 3: the train's end mass's two
+STATE_VERSION = 4.0     # 2: the compliant shaft's two slots in x; 3: the train's end mass's two; 4: the follower's
+# gap and rate in x, its flank left and flight direction in the mode
 STATE_LEN = 64
 STATE_LAYOUT: tuple[tuple[str, int], ...] = (
     ("VERSION", 1), ("FORMULATION", 1), ("TIME", 1), ("U", 1), ("OMEGA_REF", 1), ("OMEGA_DOT_REF", 1),
     ("H_NEXT", 1), ("STEPS_TAKEN", 1), ("X", NX),
-    ("STUCK", 1), ("DIRECTION", 1), ("CONTACT", 1), ("S_FREE", 1), ("SIDE", 1),       # the mode
+    ("STUCK", 1), ("DIRECTION", 1), ("CONTACT", 1), ("S_FREE", 1), ("SIDE", 1), ("LEFT", 1), ("SIGMA", 1),   # mode
     ("FORM_U", 1), ("HAVE_BUDGET", 1),
     ("WORK_IN", 1), ("WORK_ABS", 1), ("BUDGET_THETA", 1), ("BUDGET_I", 1), ("E_MECH0", 1), ("E_MAG0", 1),
     ("PAPER", 11),      # CamPaperState in order: theta, omega, i, J, M, s, v, a, alpha, voltage, M_l
-    ("SPEED", 10),      # CamSpeedState in order: theta, s, speed, v, contact, impacts, rebound, fresh, left, sigma
+    ("SPEED", 8),       # CamSpeedState in order: theta, s, speed, v, contact, impacts, rebound, fresh
 )
 
 # The structures a binding reads (C type, field, comment): written as C typedefs, built as ctypes.Structure.
@@ -61,6 +63,8 @@ STRUCTS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("int", "contact", "backlash: +1 the cam drives the follower up, -1 down, 0 free in the gap; 1 without"),
         ("double", "s_free", "m: the follower's position while contact == 0"),
         ("double", "side", "+1/-1: sign of the guide's side force N_r (the friction branch)"),
+        ("int", "left", "a follower of its own: the flank it left last (+1, -1), its gap's origin"),
+        ("double", "sigma", "a follower of its own in flight: sgn(v) held between events (0: halted by friction)"),
     ),
     "CamEventRecord": (   # one transition, as the event log keeps it (not part of the saved state)
         ("int", "code", "CAM_EV_*"),
@@ -155,6 +159,5 @@ def structure(name: str) -> type:
 
 
 def check_states() -> None:
-    """X_SLOTS then ME_SLOTS name Model Exchange's states, in order (physics.variables.STATES)."""
-    assert [s[1] for s in X_SLOTS + ME_SLOTS] == [row[0] for row in STATES], \
-        "X_SLOTS, ME_SLOTS and physics.variables.STATES"
+    """X_SLOTS name Model Exchange's states, in order (physics.variables.STATES)."""
+    assert [s[1] for s in X_SLOTS] == [row[0] for row in STATES], "X_SLOTS and physics.variables.STATES"

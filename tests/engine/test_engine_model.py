@@ -16,10 +16,13 @@ from cam_fmu.physics.variables import OUTPUT_NAMES
 
 D3 = ctypes.c_double * NX  # CAM_NX: the rigid slots and a compliant shaft's two
 NO = len(OUTPUT_NAMES)
-DRIVES = [{}, {"c": 5e-4}, {"L": 1e-3}, {"gamma": 1.5707963267948966, "beta": 3.141592653589793, "mu": 0.05},
-          {"c": 1e-3, "L": 1e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0, "M_f": 0.0},
+# The rigid drive's contract functions: a clearance under closure 'kinematic' (the backlash of docs/model.md 6; with
+# 'form' the follower is a body of its own, whose functions voltage_follower.c provides and tests/fmu_me checks)
+DRIVES = [{}, {"c": 5e-4, "closure": "kinematic"}, {"L": 1e-3}, {"gamma": 1.5707963267948966, "beta": 3.141592653589793, "mu": 0.05},
+          {"c": 1e-3, "closure": "kinematic", "L": 1e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0, "M_f": 0.0},
           {"k_shaft": 40.0, "d_shaft": 0.01, "J_cam": 2e-5},
-          {"k_shaft": 5e3, "J_cam": 1e-4, "L": 1e-3, "c": 5e-4, "mu": 0.1, "gamma": 2.0, "beta": 1.0}]
+          {"k_shaft": 5e3, "J_cam": 1e-4, "L": 1e-3, "c": 5e-4, "closure": "kinematic", "mu": 0.1, "gamma": 2.0,
+           "beta": 1.0}]
 EVENTS = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
 
 

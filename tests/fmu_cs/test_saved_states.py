@@ -140,7 +140,8 @@ INCONSISTENT = [  # (parameters, slot, value, words of the message)
     ({}, S.S_TIME, -1e-3, "before the drive's start time"),
     ({}, S.S_X + 2, 0.5, "no inductance"),
     ({}, S.S_X + 3, 0.1, "shaft is rigid"),
-    ({"c": 5e-4}, S.S_S_FREE, 1.0, "beyond the clearance"),
+    ({"c": 5e-4, "closure": "kinematic"}, S.S_S_FREE, 1.0, "beyond the clearance"),
+    ({"c": 5e-4}, S.S_X + 7, 0.01, "follower gap 0.01 m"),   # its own follower's gap x[CAM_GAP]: off the groove
     ({"drive": "speed"}, S.S_HAVE_BUDGET, 1.0, "keeps none"),
     ({}, S.S_BUDGET, -1.0, "more energy than its account"),  # work_in: the source delivered -1 J
     ({}, S.S_X + 1, 1e150, "more energy than its account"),  # finite outputs, 1/2 J omega^2 far past the books

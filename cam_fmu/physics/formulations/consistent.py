@@ -26,12 +26,12 @@ from ..variables import output_record
 
 THETA, OMEGA, CURRENT, TWIST, OMEGA_M = 0, 1, 2, 3, 4  # slots of the continuous state y
 # The events of the hybrid system (docs/model.md section 10); an engine's event codes index this tuple.
-EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force")
-STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE = EVENT_NAMES
+EVENT_NAMES = ("stop", "contact", "engage_up", "engage_down", "break_away", "side_force", "halt")
+STOP, CONTACT, ENGAGE_UP, ENGAGE_DOWN, BREAK_AWAY, SIDE, HALT = EVENT_NAMES
 # Each of them in the one enumeration of the reference's events (physics/modes.py): the contact loss is the groove's
 # lift-off, an engagement a touch-down (plastic here).
 EVENTS = dict(zip(EVENT_NAMES, (Event.STOP, Event.LIFT_OFF, Event.TOUCH_LOWER, Event.TOUCH_UPPER, Event.BREAK_AWAY,
-                                Event.SIDE)))
+                                Event.SIDE, Event.HALT)))
 EVENT_NAME = {kind: name for name, kind in EVENTS.items()}
 # N [N]: the side-force event fires at N_r = -side * SIDE_HYSTERESIS, so a side force that stays
 # exactly 0 (tan(alpha) = 0 and no sideways gravity, e.g. at theta = 0) cannot flip the branch

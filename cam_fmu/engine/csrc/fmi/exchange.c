@@ -153,8 +153,8 @@ int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx)
         return CAM_ERR_SIMULATION;
     for (k = 0; k < nx; k++)
         nominal[k] = 1.0;
-    nominal[CAM_ME_GAP] = 1e-3;    /* m, m/s: a follower's flight (a groove's clearance, a bounce's height) is of */
-    nominal[CAM_ME_RATE] = 1e-2;   /* millimetres; a host's absolute tolerance is its relative one times these */
+    nominal[CAM_GAP] = 1e-3;    /* m, m/s: a follower's flight (a groove's clearance, a bounce's height) is of */
+    nominal[CAM_RATE] = 1e-2;   /* millimetres; a host's absolute tolerance is its relative one times these */
     return CAM_OK;
 }
 
@@ -166,7 +166,7 @@ static int active_codes(const CamDrive *d, int codes[CAM_MAX_EVENTS])
     if (follower(d))
         return follower(d)->codes(d, codes);
     n = cam_event_codes(&d->model, &d->mode, codes);
-    if (d->mode.stuck && !d->model.has_current && !d->model.compliant && n < CAM_MAX_EVENTS)
+    if (d->mode.stuck && !d->model.has_current && !d->model.compliant && n < CAM_ME_EVENTS)
         codes[n++] = CAM_EV_BREAK_AWAY;
     return n;
 }
@@ -183,7 +183,7 @@ static int indicators(const CamDrive *d, double target, double z[CAM_EXCHANGE_NZ
     int n = active_codes(d, codes), k;
     double x[CAM_ME_NX];
     cam_drive_me_states(d, x);
-    for (k = 0; k < CAM_MAX_EVENTS; k++)
+    for (k = 0; k < CAM_ME_EVENTS; k++)
         z[k] = k < n ? event_value(d, codes[k], x) : CAM_EXCHANGE_IDLE;
     z[CAM_EXCHANGE_BREAKPOINT] = d->mode.stuck || target != target ? CAM_EXCHANGE_IDLE
                                                                     : d->mode.direction * (target - d->x[CAM_THETA]);
@@ -271,7 +271,7 @@ int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *valu
     n = indicators(d, e->target, z, codes);
     k = due(e, z, codes, n);
     if (follower(d)) {   /* a lift-off, touch-down or halt, else the contact settled; its log line is the note */
-        int status = follower(d)->event_update(d, k >= 0 ? codes[k] : 0, cam_instance_error(e->instance));
+        int status = follower(d)->event_update(d, k >= 0 ? codes[k] : EV_NONE, cam_instance_error(e->instance));
         if (status != CAM_OK)
             return status;
         fired->code = k >= 0 ? codes[k] : -1;

@@ -7,9 +7,9 @@
  *
  * - States: x[CAM_ME_NX], cam_model.h's slots (with L = 0 the current slot is held at 0, derivative 0;
  *   a rigid shaft, k_shaft = 0, holds the twist and the motor's speed at 0 the same way), then a free
- *   follower's gap and its rate (cam_drive.h CAM_ME_GAP; held at 0 in contact and without one).
+ *   follower's gap and its rate (cam_drive.h CAM_GAP; held at 0 in contact and without one).
  * - Inputs are continuous: every evaluation uses the inputs the host set last.
- * - Event indicators, CAM_EXCHANGE_NZ of them: slots 0..CAM_MAX_EVENTS-1 hold the event functions of
+ * - Event indicators, CAM_EXCHANGE_NZ of them: slots 0..CAM_ME_EVENTS-1 hold the event functions of
  *   the mode (cam_event_codes' order; the break-away function also at rest with L = 0, where the input
  *   can start the shaft), an unused slot CAM_EXCHANGE_IDLE; the last slot is the angle to the profile's
  *   next breakpoint ahead [rad], so that the host's solver restarts where the profile's higher
@@ -29,8 +29,9 @@
 
 #include "cam_instance.h"
 
-enum { CAM_EXCHANGE_BREAKPOINT = CAM_MAX_EVENTS, CAM_EXCHANGE_NZ = CAM_MAX_EVENTS + 1 };
-/* physics/variables.py's EVENT_INDICATORS is CAM_MAX_EVENTS + 1 (a compile error if not) */
+enum { CAM_ME_EVENTS = 3,   /* a mode's event functions a host sees at most (a rigid drive's, a follower's) */
+       CAM_EXCHANGE_BREAKPOINT = CAM_ME_EVENTS, CAM_EXCHANGE_NZ = CAM_ME_EVENTS + 1 };
+/* physics/variables.py's EVENT_INDICATORS is CAM_ME_EVENTS + 1 (a compile error if not) */
 typedef char cam_exchange_indicator_count[CAM_N_EVENT_INDICATORS == CAM_EXCHANGE_NZ ? 1 : -1];
 #define CAM_EXCHANGE_IDLE 1.0            /* an unused indicator slot */
 #define CAM_EXCHANGE_MAX_ITERATIONS 32   /* transitions at one event instant at most */

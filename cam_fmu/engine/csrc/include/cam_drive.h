@@ -36,6 +36,11 @@ typedef struct {
     void (*advice)(const struct CamDrive *d, char *buf, size_t len);
     /* optional: Model Exchange of states of its own (NULL: x under cam_rhs, the rigid drive's event table) */
     const struct CamExchangeHooks *exchange;
+    /* optional, for cam_integrate: the transition of event `code` at the drive's state at time [s] in place of
+     * cam_apply_event (EV_NONE: the step's start, settled in place of cam_settle; EV_BREAK: a profile breakpoint
+     * reached), with what it logs; and the longest internal step [s] the state allows beyond the solver's limits */
+    void (*transition)(struct CamDrive *d, int code, double time);
+    double (*step_limit)(const struct CamDrive *d, double time);
 } CamFormulation;
 
 /* A formulation's Model Exchange (cam_drive_me_* and fmi/exchange.c call them): its states x[CAM_ME_NX] and back,
@@ -73,10 +78,9 @@ typedef struct {
     double v;                   /* m/s, its velocity */
     double contact;             /* +1 on the flank pushing along +X, -1 on a groove's other flank, 0 in flight */
     double impacts;             /* touch-downs so far */
-    double rebound;             /* s: shorter than the flight the last rebound starts (the scan's first step), or 0 */
+    double rebound;             /* s: shorter than the flight the last rebound starts (the scan's first step), or 0; the
+                                 * voltage drive's follower: the time until which that guard holds [s] (0: none) */
     double fresh;               /* 1 until the first step: the start's contact follows the inputs set */
-    double left;                /* the voltage drive's follower: the flank it last left (+1, -1), its gap's origin */
-    double sigma;               /* and its direction in flight, sgn(v) held between events (0: held by friction) */
 } CamSpeedState;
 
 /* The follower as a body of its own in the speed drive (follower.c; docs/model.md section 13): its contact at the
@@ -96,11 +100,13 @@ typedef double (*CamEventValue)(void *ctx, int code, double x);
 int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
                            int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
                            double *at);
-/* The follower's event codes (docs/model.md 13.7), one space for the speed drive's (follower.c) and the voltage
- * drive's (voltage_follower.c, and Model Exchange's indicators): touch-down on flank +1 (TOUCH_UP), -1 (TOUCH_DOWN);
- * the voltage drive's shaft stops (EV_STOP) and breaks away; EV_BREAK and EV_SIDE only end a step. */
-typedef enum { EV_NONE = 0, EV_STOP, EV_LIFT_OFF, EV_TOUCH_UP, EV_TOUCH_DOWN, EV_HALT, EV_BREAK_AWAY, EV_BREAK,
-               EV_SIDE } CamFollowerEvent;
+/* The follower's names for the one table of event codes (CAM_EV_*, generated; docs/model.md 10 and 13.7), for the
+ * speed drive's follower (follower.c) and the voltage drive's (voltage_follower.c, Model Exchange's indicators):
+ * lift-off is the contact's loss, touch-down on flank +1 (TOUCH_UP) and -1 (TOUCH_DOWN) its engagements; EV_BREAK (a
+ * profile breakpoint, integrate.c's code -1) and EV_SIDE only end a step; EV_NONE: no event. */
+typedef enum { EV_NONE = -2, EV_BREAK = -1, EV_STOP = CAM_EV_STOP, EV_LIFT_OFF = CAM_EV_CONTACT,
+               EV_TOUCH_UP = CAM_EV_ENGAGE_UP, EV_TOUCH_DOWN = CAM_EV_ENGAGE_DOWN, EV_BREAK_AWAY = CAM_EV_BREAK_AWAY,
+               EV_SIDE = CAM_EV_SIDE_FORCE, EV_HALT = CAM_EV_HALT } CamFollowerEvent;
 /* N: the force closing the follower onto its +1 flank at s [m], F_spring0 + k_spring s - F_gx, and the guide's
  * friction at no contact force, mu (|G_y| + |N_g|): both drives' followers' (follower.c). */
 double cam_follower_closing(const CamModel *m, double s);
@@ -116,9 +122,8 @@ void cam_follower_note(char *events, size_t len, long *dropped, const char *form
 /* The solver's carried state (rk45: step size and first-same-as-last derivative). */
 typedef struct {
     double h_next;              /* s: the next trial step of an adaptive method */
-    int k1_valid;               /* k1 (k_own: of a formulation's own state vector) holds f(x) under fsal_u and the mode */
+    int k1_valid;               /* k1 holds f(x) under fsal_u and the mode */
     double k1[CAM_NX];
-    double k_own[CAM_MAX_SLOTS];
     double fsal_u;
 } CamSolverState;
 
@@ -150,12 +155,12 @@ typedef struct CamDrive {
     CamEventRecord event_log[CAM_EVENT_LOG];
 } CamDrive;
 
-/* Model Exchange's continuous state (physics/variables.py STATES): x[CAM_NX], then the voltage drive's free follower
- * (closures 'form', 'spring'; docs/model.md 13.6) as its gap g = left (s - s_flank(theta)) [m] to the flank it left
- * last and the gap's rate w [m/s], held at 0 (derivative 0) in contact and without a follower of its own. The
- * follower's states, events and transitions are its formulation's hooks (CamExchangeHooks, voltage_follower_events.c);
- * exchange.c drives them. */
-enum { CAM_VF_ME_EVENTS = 3,   /* (CAM_ME_GAP, CAM_ME_RATE, CAM_ME_NX: generated, engine/contract.py ME_SLOTS) */
+/* Model Exchange's continuous state (physics/variables.py STATES) is x[CAM_NX] itself: its last slots, the voltage
+ * drive's free follower (closures 'form', 'spring'; docs/model.md 13.6) as its gap g = left (s - s_flank(theta)) [m]
+ * to the flank it left last and the gap's rate w [m/s], are held at 0 (derivative 0) in contact and without a follower
+ * of its own. The follower's Model Exchange indicators and event update are its formulation's hooks
+ * (CamExchangeHooks, voltage_follower_events.c); exchange.c drives them. */
+enum { CAM_VF_ME_EVENTS = 3,   /* (CAM_ME_NX = CAM_NX: generated, engine/contract.py X_SLOTS) */
        CAM_VF_BREAK_AWAY = EV_BREAK_AWAY /* the stuck shaft's break-away, driven by the input (at 0 it is due) */ };
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX]);
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);

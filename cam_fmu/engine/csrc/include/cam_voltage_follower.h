@@ -34,9 +34,13 @@ void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contac
 void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact);
 /* rad/s2: > 0 where the stuck shaft starts, *dir the way it starts. */
 double cam_vf_breakaway(const CamModel *m, const double y[NY], double u, int contact, double *dir);
-/* y from the drive's state, and back (the follower's s, v in d->speed, the shaft's mode in d->mode). */
-void cam_vf_load_y(const CamDrive *d, double y[NY]);
-void cam_vf_store_y(CamDrive *d, const double y[NY]);
+/* y from the model's state x and mode (the follower's gap and rate in x, its contact, flank left and flying direction
+ * in the mode), and back: x and the mode from y with the contact `contact` and the flank left `left` after, under the
+ * input u [V] (the side force's sign). */
+void cam_vf_y(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double y[NY]);
+void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int left, double x[CAM_NX],
+              CamMode *mode);
+/* (cam_vf_rhs, cam_vf_codes, cam_vf_value: the model contract's, declared in cam_model.h.) */
 /* On the flank `contact`: the follower set on it, or lifted off at once where its contact force is already < 0: the
  * contact after. */
 int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact);
@@ -60,8 +64,6 @@ void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
-/* y of the follower from Model Exchange's x (the follower on its flank, or its gap and rate in flight). */
-void cam_vf_me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY]);
 /* The tangent of cam_vf_me_rates and of the outputs at x along seed[CAM_ME_NX] and du, in the drive's mode
  * (jacobian_follower.c). */
 void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,

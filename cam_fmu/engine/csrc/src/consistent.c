@@ -54,5 +54,5 @@ static void consistent_advice(const CamDrive *d, char *buf, size_t len)
 
 const CamFormulation cam_consistent = {
     "consistent", 1, consistent_init, consistent_set_inputs, consistent_advance, consistent_outputs,
-    consistent_advice, NULL,
+    consistent_advice, NULL, NULL, NULL,
 };

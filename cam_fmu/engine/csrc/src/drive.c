@@ -182,7 +182,7 @@ void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX])
         return;
     }
     memcpy(x, d->x, sizeof d->x);
-    x[CAM_ME_GAP] = x[CAM_ME_RATE] = 0.0;
+    x[CAM_GAP] = x[CAM_RATE] = 0.0;
 }
 
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])

@@ -111,7 +111,7 @@ void cam_etdrk4_step(const CamMethod *method, const CamModel *m, const CamMode *
     double rate, a, y[CAM_NX], n_y[CAM_NX], st_a[CAM_NX], n_a[CAM_NX], st_b[CAM_NX], n_b[CAM_NX];
     double st_c[CAM_NX], n_c[CAM_NX], mix[CAM_NX], wt = 1.0 / 6.0, a_full;
     int slot;
-    if (!m->has_current) {   /* no pole: the classical RK4 (the pair is used only with a pole) */
+    if (!m->has_current || m->follower_states) {   /* no pole (or a follower's slots): the classical RK4 */
         CamMethod rk4 = *method;
         rk4.tableau = &cam_rk4;
         cam_rk_step(&rk4, m, mode, x, u, h, w);

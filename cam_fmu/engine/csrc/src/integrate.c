@@ -13,6 +13,8 @@
 
 #define EVENT_ITERATIONS 60   /* Illinois iterations at most per zero located to a tolerance */
 #define EXACT_ITERATIONS 400  /* and to the last bit (never a hang; 60 halvings alone get there from 1 s) */
+#define PHASE_STEPS 10000000  /* internal steps at most where a formulation's phases bound them (a follower's flight
+                               * resolved at a fixed phase per step): max_steps does not cap those (never a hang) */
 
 /* f(x) into d->solver.k1 unless it is valid already. */
 static void ensure_k1(CamDrive *d, double u)
@@ -286,28 +288,45 @@ static int max_steps_error(const CamDrive *d, const CamMethod *method, double ti
                     cause);
 }
 
+/* Are two modes the same (the rates and the event functions alike)? */
+static int same_mode(const CamMode *a, const CamMode *b)
+{
+    return a->stuck == b->stuck && a->direction == b->direction && a->contact == b->contact
+           && a->s_free == b->s_free && a->side == b->side && a->left == b->left && a->sigma == b->sigma;
+}
+
 /* The loop of one communication step (the state saved by the caller). */
 static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *steps_out, CamError *err)
 {
     const CamModel *m = &d->model;
     double t = 0.0, u = d->u, remaining, dt, target, cut, tau;
     long steps = 0, retries;
-    int was_stuck = d->mode.stuck, next_valid, status;
+    int was_stuck = d->mode.stuck, next_valid, status, at_break;
+    CamMode before = d->mode;
     it->have_before = 0;
-    cam_settle(m, &d->mode, d->x, u, 0);
-    if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck))
+    if (d->form->transition != NULL)   /* the formulation settles its own modes */
+        d->form->transition(d, EV_NONE, time);
+    else
+        cam_settle(m, &d->mode, d->x, u, 0);
+    if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck)
+        || (d->form->transition != NULL && !same_mode(&before, &d->mode)))
         d->solver.k1_valid = 0;
     it->n_events = cam_event_codes(m, &d->mode, it->codes);
     while (h - t > 1e-12 * h) {
         if (d->mode.stuck && !m->has_current && m->slots == CAM_NX_RIGID)
             break;   /* nothing evolves until the input changes */
         steps += 1;
-        if (steps > m->max_steps) {
+        if (steps > m->max_steps && !(d->form->step_limit != NULL && steps <= PHASE_STEPS)) {
             *steps_out = steps;
             return max_steps_error(d, it->method, time + t, h, err);
         }
         remaining = h - t;
+        if (d->form->step_limit != NULL) {   /* the formulation's phases (a follower's flight) bound the step */
+            double limit = d->form->step_limit(d, time + t);
+            remaining = limit < remaining ? limit : remaining;
+        }
         next_valid = 0;   /* does it->f_end hold f at the step's end? */
+        at_break = 0;
         it->exponential = 0;
         if (d->mode.stuck && m->slots == CAM_NX_RIGID) {   /* only the current moves, exactly (shaft, train: solver) */
             dt = remaining;
@@ -340,6 +359,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
                     memcpy(it->x_end, it->x_hit, sizeof it->x_end);
                     next_valid = 0;
                 }
+                at_break = d->form->transition != NULL;   /* the formulation's modes settle past it */
             }
         }
         tau = first_event(d, it, dt);
@@ -349,6 +369,15 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
             d->solver.k1_valid = next_valid;
             if (next_valid)
                 memcpy(d->solver.k1, it->f_end, sizeof d->solver.k1);
+            if (at_break) {   /* a jump of s'' may let the follower go at once */
+                before = d->mode;
+                d->form->transition(d, EV_BREAK, time + t);
+                if (!same_mode(&before, &d->mode)) {
+                    d->solver.k1_valid = 0;
+                    it->n_events = cam_event_codes(m, &d->mode, it->codes);
+                    it->have_before = 0;
+                }
+            }
             continue;
         }
         memcpy(d->x, it->x_hit, sizeof d->x);
@@ -360,7 +389,10 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
             record->time = time + t;
             memcpy(record->x_before, d->x, sizeof d->x);
             record->mode_before = d->mode;
-            cam_apply_event(m, &d->mode, d->x, it->hit, u);
+            if (d->form->transition != NULL)
+                d->form->transition(d, it->hit, time + t);
+            else
+                cam_apply_event(m, &d->mode, d->x, it->hit, u);
             memcpy(record->x_after, d->x, sizeof d->x);
             d->events_logged += 1;
         }

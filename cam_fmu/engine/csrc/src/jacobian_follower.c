@@ -29,12 +29,12 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
                        double ddx[CAM_ME_NX], double dout[])
 {
     const CamModel *m = &d->model;
-    const int contact = (int)d->speed.contact;
-    const double left = d->speed.left, dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
+    const int contact = d->mode.contact;
+    const double left = d->mode.left, dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double y[NY], dy[NY], p[4], base, t, dt, root, ds, dv, da, dF, domega_dot = 0.0, dP = 0.0, P = 0.0, f, df;
     Tangents g = drive_tangents(m, seed, du);
     int k, stuck;
-    cam_vf_me_load(d, x, y);
+    cam_vf_y(m, &d->mode, x, y);
     stuck = y[Y_DIR] == 0.0;
     cam_vf_rates(m, d->form_u, contact, y, dy);   /* the values the tangent needs: omega_dot */
     cam_profile_eval(&m->profile, y[0], p);
@@ -66,14 +66,14 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
         dout[CAM_O_J] = 2.0 * m->m * p[1] * p[2] * dtheta;
     } else {
         int held = m->mu != 0.0 && y[Y_SIGMA] == 0.0;   /* at a halt, held by the guide's friction */
-        ds += left * seed[CAM_ME_GAP];
-        dv += left * seed[CAM_ME_RATE];
+        ds += left * seed[CAM_GAP];
+        dv += left * seed[CAM_RATE];
         domega_dot = stuck ? 0.0 : g.drive / m->J_0;
         da = held ? 0.0 : -m->k_spring * ds / m->m;   /* the free follower's acceleration */
         ddx[CAM_THETA] = domega;
         ddx[CAM_OMEGA] = domega_dot;
-        ddx[CAM_ME_GAP] = seed[CAM_ME_RATE];
-        ddx[CAM_ME_RATE] = left * (da - (p[3] * dtheta * y[1] * y[1] + 2.0 * p[2] * y[1] * domega
+        ddx[CAM_GAP] = seed[CAM_RATE];
+        ddx[CAM_RATE] = left * (da - (p[3] * dtheta * y[1] * y[1] + 2.0 * p[2] * y[1] * domega
                                          + p[2] * dtheta * dy[1] + p[1] * domega_dot));
     }
     base = m->r_b + p[0];

@@ -163,6 +163,10 @@ static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x
 void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], F;
+    if (m->follower_states) {   /* the follower's gap and rate are states (voltage_follower.c) */
+        cam_vf_rhs(m, mode, x, u, dx);
+        return;
+    }
     if (m->compliant) {
         compliant_rhs(m, mode, x, u, dx);
         return;
@@ -177,7 +181,7 @@ void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], dou
                                       mode->contact != 0, m->guide_side ? mode->side : 0.0, F);
     }
     dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega) / m->L : 0.0;
-    if (m->slots == CAM_NX) {   /* a train: its end mass moves, the rigid shaft's slots are held */
+    if (m->train) {   /* a train: its end mass moves, the rigid shaft's slots are held */
         dx[CAM_TWIST] = dx[CAM_OMEGA_M] = 0.0;
         train_rhs(m, x, F, dx);
     }
@@ -393,7 +397,6 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->backlash = model->c > 0.0;
     model->guide_side = model->mu > 0.0 && model->follower;
     model->nx = (model->has_current ? 3 : 2) + (model->compliant ? 2 : 0) + (model->train ? 2 : 0);
-    model->slots = model->compliant || model->train ? CAM_NX : CAM_NX_RIGID;
     model->formulation = (int)v[CAM_P_DRIVE] == CAM_CHOICE_DRIVE_SPEED ? CAM_FORM_SPEED
                          : (CamFormulationId)(int)v[CAM_P_FORMULATION];
     model->solver = (int)v[CAM_P_SOLVER];
@@ -407,6 +410,10 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;
     model->restitution = v[CAM_P_RESTITUTION];
     model->free_follower = cam_own_follower(v);   /* physics/rules.py OWN_FOLLOWER (docs/model.md 13) */
+    model->follower_states = model->free_follower && model->formulation == CAM_FORM_CONSISTENT;
+    model->slots = model->follower_states ? CAM_NX : (model->compliant || model->train ? CAM_NX_SHAFT : CAM_NX_RIGID);
+    if (model->follower_states)
+        model->nx += 2;   /* its gap and rate (0 on a flank) */
     if ((status = cam_check_rules(v, err)) != CAM_OK                  /* physics/rules.py RULES, generated */
         || (status = cam_kind_check(model, err)) != CAM_OK) {      /* then geometry an arm or a face cannot have */
         cam_model_free(model);

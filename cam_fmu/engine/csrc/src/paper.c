@@ -259,5 +259,5 @@ static void paper_advice(const CamDrive *d, char *buf, size_t len)
 }
 
 const CamFormulation cam_paper = {
-    "paper", 1, paper_init, paper_set_inputs, paper_advance, paper_outputs, paper_advice, NULL,
+    "paper", 1, paper_init, paper_set_inputs, paper_advance, paper_outputs, paper_advice, NULL, NULL, NULL,
 };

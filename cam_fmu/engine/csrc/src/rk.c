@@ -80,7 +80,7 @@ static inline double combine(const double *coef, const int *idx, int count, doub
     return x + h * sum;
 }
 
-/* The step over the first n slots: inlined twice below with n a constant (CAM_NX_RIGID, CAM_NX), so that a rigid
+/* The step over the first n slots: inlined below with n a constant (CAM_NX_RIGID, CAM_NX_SHAFT, CAM_NX), so that a rigid
  * drive's loops unroll over its three slots as they did before the compliant shaft's two existed. */
 static inline void rk_step_slots(const CamMethod *method, const CamModel *m, const CamMode *mode,
                                  const double x[CAM_NX], double u, double h, CamStepWork *w, const int n)
@@ -120,6 +120,8 @@ void cam_rk_step(const CamMethod *method, const CamModel *m, const CamMode *mode
 {
     if (m->slots == CAM_NX)
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX);
+    else if (m->slots == CAM_NX_SHAFT)
+        rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_SHAFT);
     else
         rk_step_slots(method, m, mode, x, u, h, w, CAM_NX_RIGID);
 }
@@ -187,10 +189,14 @@ void cam_tableau_step(const CamTableau *t, int n, int width, CamRates rates, voi
 double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWork *w)
 {
     double total = 0.0, scale, atol = m->atol, rtol = m->rtol;
-    int slot;
+    int slot, n = m->nx;
     for (slot = 0; slot < m->slots; slot++) {
         if (slot == CAM_CURRENT && !m->has_current)
             continue;   /* quasi-static: no state */
+        if (slot >= CAM_GAP && x[slot] == 0.0 && w->x_new[slot] == 0.0) {
+            n -= 1;   /* a follower on its flank: its gap and rate are held at 0, no states */
+            continue;
+        }
         scale = fabs(w->x_new[slot]) > fabs(x[slot]) ? fabs(w->x_new[slot]) : fabs(x[slot]);
         if (slot == CAM_THETA && TWO_PI < scale)   /* theta enters the physics mod 2 pi */
             scale = TWO_PI;
@@ -199,5 +205,5 @@ double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWo
         else
             total += pow(w->error[slot] / (atol + rtol * scale), 2.0);
     }
-    return sqrt(total / m->nx);
+    return sqrt(total / n);
 }

@@ -215,5 +215,6 @@ static void speed_advice(const CamDrive *d, char *buf, size_t len)
 }
 
 const CamFormulation cam_speed = {
-    "speed", 0, speed_init, speed_set_inputs, speed_advance, speed_outputs, speed_advice, NULL,
+    "speed", 0, speed_init, speed_set_inputs, speed_advance, speed_outputs, speed_advice, NULL, NULL,
+    NULL,
 };

@@ -49,6 +49,8 @@ void cam_drive_get_state(const CamDrive *d, double s[CAM_STATE_LEN])
     s[CAM_S_CONTACT] = (double)d->mode.contact;
     s[CAM_S_S_FREE] = d->mode.s_free;
     s[CAM_S_SIDE] = d->mode.side;
+    s[CAM_S_LEFT] = (double)d->mode.left;
+    s[CAM_S_SIGMA] = d->mode.sigma;
     s[CAM_S_HAVE_BUDGET] = d->have_budget ? 1.0 : 0.0;
 }
 
@@ -97,20 +99,34 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
                          d->form->name);
     if (m->free_follower) {
         CamSpeedState saved;   /* the entry as the drive's struct (a run of doubles: checked above) */
-        double contact, left, sigma;
+        double contact = m->follower_states ? (double)mode->contact : 0.0, sigma = mode->sigma;
+        int left = mode->left;
         memcpy(&saved, s + CAM_S_SPEED, sizeof saved);
-        contact = saved.contact, left = saved.left, sigma = saved.sigma;
+        if (!m->follower_states)
+            contact = saved.contact;
         if (!(contact == 0.0 || contact == 1.0 || (contact == -1.0 && m->closure == CAM_CHOICE_CLOSURE_FORM)))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower contact %s: allowed +1 (on the flank), 0 (in "
                              "flight)%s", cam_num(contact, a), m->closure == CAM_CHOICE_CLOSURE_FORM
                              ? " or -1 (on the groove's other flank)" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && left != 1.0
-            && left != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1.0 : 1.0))
-            return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %s: allowed +1%s",
-                             cam_num(left, a), m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
-        if (m->formulation == CAM_FORM_CONSISTENT && !(sigma == 0.0 || fabs(sigma) == 1.0))
+        if (m->follower_states && left != 1 && left != (m->closure == CAM_CHOICE_CLOSURE_FORM ? -1 : 1))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower flank left last %d: allowed +1%s", left,
+                             m->closure == CAM_CHOICE_CLOSURE_FORM ? " or -1" : "");
+        if (m->follower_states && !(sigma == 0.0 || fabs(sigma) == 1.0))
             return cam_error(err, CAM_ERR_SIMULATION, "state follower direction in flight %s: allowed -1, 0, +1",
                              cam_num(sigma, a));
+        if (m->follower_states && contact == 0.0
+            && (x[CAM_GAP] < -1e-9 || (m->closure == CAM_CHOICE_CLOSURE_FORM
+                                         && x[CAM_GAP] > 2.0 * m->c * (1.0 + 1e-9) + 1e-9)))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower gap %s m from the flank it left is beyond the "
+                             "clearance c = %g m (the gap lies in [0, 2 c] in a groove, >= 0 on a spring's flank)",
+                             cam_num(x[CAM_GAP], a), m->c);
+        if (m->follower_states && contact != 0.0 && (x[CAM_GAP] != 0.0 || x[CAM_RATE] != 0.0))
+            return cam_error(err, CAM_ERR_SIMULATION, "state follower gap %s m and rate %s m/s on flank %+g: on a "
+                             "flank both are 0", cam_num(x[CAM_GAP], a), cam_num(x[CAM_RATE], b), contact);
+    } else if (x[CAM_GAP] != 0.0 || x[CAM_RATE] != 0.0) {
+        return cam_error(err, CAM_ERR_SIMULATION, "state follower gap %s m and rate %s m/s, but this drive's follower "
+                         "moves with the cam (their slots hold 0)", cam_num(x[CAM_GAP], a),
+                         cam_num(x[CAM_RATE], b));
     }
     if (m->formulation != CAM_FORM_CONSISTENT)
         return CAM_OK;   /* the mode is the consistent formulation's (the others keep cam_initial's) */
@@ -120,6 +136,8 @@ static int consistent_entries(const CamDrive *d, const double s[CAM_STATE_LEN], 
     if (!mode->stuck && mode->direction * x[CAM_OMEGA] < 0.0)
         return cam_error(err, CAM_ERR_SIMULATION, "state direction %+g with omega = %s rad/s: a moving shaft's "
                          "direction is the sign of omega", mode->direction, cam_num(x[CAM_OMEGA], a));
+    if (m->follower_states)
+        return CAM_OK;   /* its contact is the follower's (above) */
     if (!m->backlash && mode->contact != 1)
         return cam_error(err, CAM_ERR_SIMULATION, "state contact %d, but this drive has no backlash (c = 0: the "
                          "follower is always engaged, contact +1)", mode->contact);
@@ -189,8 +207,11 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
     mode.contact = s[CAM_S_CONTACT] == 1.0 ? 1 : (s[CAM_S_CONTACT] == -1.0 ? -1 : 0);   /* checked below */
     mode.s_free = s[CAM_S_S_FREE];
     mode.side = s[CAM_S_SIDE];
+    mode.left = s[CAM_S_LEFT] == -1.0 ? -1 : 1;   /* checked below */
+    mode.sigma = s[CAM_S_SIGMA];
     if ((s[CAM_S_STUCK] != 0.0 && s[CAM_S_STUCK] != 1.0) || (mode.direction != 1.0 && mode.direction != -1.0)
-        || (mode.side != 1.0 && mode.side != -1.0) || (double)mode.contact != s[CAM_S_CONTACT]
+        || (mode.side != 1.0 && mode.side != -1.0 && !(d->model.follower_states && mode.side == 0.0))
+        || (double)mode.left != s[CAM_S_LEFT] || (double)mode.contact != s[CAM_S_CONTACT]
         || (s[CAM_S_HAVE_BUDGET] != 0.0 && s[CAM_S_HAVE_BUDGET] != 1.0))
         return cam_error(err, CAM_ERR_SIMULATION, "state mode (stuck %g, direction %g, contact %g, side %g) is not a "
                         "valid mode", s[CAM_S_STUCK], s[CAM_S_DIRECTION], s[CAM_S_CONTACT], s[CAM_S_SIDE]);

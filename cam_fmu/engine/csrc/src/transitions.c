@@ -8,6 +8,8 @@
 int cam_event_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENTS])
 {
     int n = 0;
+    if (m->follower_states)
+        return cam_vf_codes(m, mode, codes);
     if (mode->stuck) {
         if (m->has_current || m->compliant || m->train)   /* the torque on the held cam changes: a current, a
                                                             * shaft, a train's ringing */
@@ -48,6 +50,8 @@ double cam_breakaway_margin(const CamModel *m, const CamMode *mode, double theta
 double cam_event_value(const CamModel *m, const CamMode *mode, int code, const double x[CAM_NX], double u)
 {
     double theta = x[CAM_THETA], omega = x[CAM_OMEGA], d[4];
+    if (m->follower_states)
+        return cam_vf_value(m, mode, code, x, u);
     if (code == CAM_EV_STOP)
         return omega * mode->direction;
     if (code == CAM_EV_SIDE_FORCE)
@@ -74,6 +78,7 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
     x[CAM_TWIST] = 0.0;   /* a compliant shaft starts relaxed, the rotor at the cam's speed */
     x[CAM_OMEGA_M] = m->compliant ? omega0 : 0.0;
     x[CAM_X_END] = x[CAM_V_END] = 0.0;
+    x[CAM_GAP] = x[CAM_RATE] = 0.0;
     if (m->train) {   /* the end mass at rest relative to the follower, the spring at its static deflection */
         double d[4];
         cam_profile_eval(&m->profile, theta0, d);
@@ -85,6 +90,8 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
     mode->contact = 1;
     mode->s_free = 0.0;
     mode->side = 1.0;
+    mode->left = 1;
+    mode->sigma = 0.0;
     if (m->backlash) {   /* the paper's step 1: the follower starts where the cam is, centred in the gap */
         double d[4];
         cam_profile_eval(&m->profile, theta0, d);

@@ -49,37 +49,6 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     return flank * P >= 0.0 ? flank : 0;
 }
 
-void cam_vf_load_y(const CamDrive *d, double y[NY])
-{
-    y[0] = d->x[CAM_THETA];
-    y[1] = d->x[CAM_OMEGA];
-    y[2] = d->x[CAM_CURRENT];
-    y[3] = d->speed.s;
-    y[4] = d->speed.v;
-    y[Y_TWIST] = d->model.compliant ? d->x[CAM_TWIST] : 0.0;
-    y[Y_ROTOR] = d->model.compliant ? d->x[CAM_OMEGA_M] : 0.0;
-    y[Y_SIGMA] = cam_vf_flight_direction(&d->model, y);
-    y[Y_DIR] = d->mode.stuck ? 0.0 : d->mode.direction;
-}
-
-void cam_vf_store_y(CamDrive *d, const double y[NY])
-{
-    d->x[CAM_THETA] = y[0];
-    d->x[CAM_OMEGA] = y[1];
-    d->x[CAM_CURRENT] = y[2];
-    d->speed.s = y[3];
-    d->speed.v = y[4];
-    if (d->model.compliant) {
-        d->x[CAM_TWIST] = y[Y_TWIST];
-        d->x[CAM_OMEGA_M] = y[Y_ROTOR];
-    }
-    d->speed.theta = y[0];
-    d->speed.speed = y[1];
-    d->mode.stuck = y[Y_DIR] == 0.0;
-    if (y[Y_DIR] != 0.0)
-        d->mode.direction = y[Y_DIR];
-}
-
 /* On the flank `contact`: the follower set on it, or lifted off at once where contact P is already < 0 (a jump of
  * s''): the contact after. */
 int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact)
@@ -188,85 +157,33 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
 
 typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
 
-/* y at Model Exchange's state x: the follower on its flank in contact, else at its gap from the flank left. */
-void cam_vf_me_load(const CamDrive *d, const double x[CAM_ME_NX], double y[NY])
-{
-    const CamModel *m = &d->model;
-    double dd[4];
-    int contact = (int)d->speed.contact, left = (int)d->speed.left;
-    cam_vf_load_y(d, y);
-    y[0] = x[CAM_THETA];
-    y[1] = x[CAM_OMEGA];
-    y[2] = x[CAM_CURRENT];
-    y[Y_TWIST] = m->compliant ? x[CAM_TWIST] : 0.0;
-    y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
-    cam_profile_eval(&m->profile, y[0], dd);
-    if (contact) {
-        y[3] = dd[0] - contact * cam_vf_clearance(m);
-        y[4] = dd[1] * y[1];
-    } else {
-        y[3] = dd[0] - left * cam_vf_clearance(m) + left * x[CAM_ME_GAP];
-        y[4] = dd[1] * y[1] + left * x[CAM_ME_RATE];
-    }
-    y[Y_SIGMA] = d->speed.sigma;
-}
-
 void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX])
 {
-    const CamModel *m = &d->model;
-    double dd[4];
-    int left = (int)d->speed.left;
     memcpy(x, d->x, sizeof d->x);
-    x[CAM_ME_GAP] = x[CAM_ME_RATE] = 0.0;
-    if (d->speed.contact != 0.0)
-        return;
-    cam_profile_eval(&m->profile, d->x[CAM_THETA], dd);
-    x[CAM_ME_GAP] = left * (d->speed.s - (dd[0] - left * cam_vf_clearance(m)));
-    x[CAM_ME_RATE] = left * (d->speed.v - dd[1] * d->x[CAM_OMEGA]);
 }
 
 void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 {
-    double y[NY];
-    memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
-    cam_vf_me_load(d, x, y);
-    d->speed.s = y[3];
-    d->speed.v = y[4];
-    d->speed.theta = y[0];
-    d->speed.speed = y[1];
+    memcpy(d->x, x, sizeof d->x);
     d->stale = 1;
 }
 
 void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
 {
-    double y[NY], dy[NY], dd[4];
-    cam_vf_me_load(d, x, y);
-    cam_vf_rates(&d->model, d->form_u, (int)d->speed.contact, y, dy);
-    dx[CAM_THETA] = dy[0];
-    dx[CAM_OMEGA] = dy[1];
-    dx[CAM_CURRENT] = dy[2];
-    dx[CAM_TWIST] = dy[Y_TWIST];
-    dx[CAM_OMEGA_M] = dy[Y_ROTOR];
-    dx[CAM_X_END] = dx[CAM_V_END] = 0.0;   /* no train on a follower of its own (physics/rules.py): held */
-    dx[CAM_ME_GAP] = dx[CAM_ME_RATE] = 0.0;
-    if (d->speed.contact != 0.0)
-        return;
-    cam_profile_eval(&d->model.profile, y[0], dd);   /* the follower's acceleration less the flank's */
-    dx[CAM_ME_GAP] = x[CAM_ME_RATE];
-    dx[CAM_ME_RATE] = d->speed.left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1]));
+    cam_vf_rhs(&d->model, &d->mode, x, d->form_u, dx);
 }
 
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
 {
     int n = 0, stuck = d->mode.stuck;
     codes[n++] = stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the input and the current may start it */
-    if (d->speed.contact != 0.0) {
+    if (d->mode.contact != 0) {
         if (!stuck)
             codes[n++] = EV_LIFT_OFF;
         return n;
     }
     codes[n++] = EV_TOUCH;
-    if (d->speed.sigma != 0.0 && cam_follower_friction0(&d->model) > 0.0)
+    if (d->mode.sigma != 0.0 && cam_follower_friction0(&d->model) > 0.0)
         codes[n++] = EV_HALT;
     return n;
 }
@@ -274,32 +191,22 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
 {
     const CamModel *m = &d->model;
-    double y[NY], g = x[CAM_ME_GAP];
+    double y[NY], g = x[CAM_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
         return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + CAM_TOUCH;
-    cam_vf_me_load(d, x, y);
-    return cam_vf_event_value(m, d->form_u, code, (int)d->speed.contact, y);
+    cam_vf_y(m, &d->mode, x, y);
+    return cam_vf_event_value(m, d->form_u, code, d->mode.contact, y);
 }
 
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
 {
     const CamModel *m = &d->model;
-    double x[CAM_ME_NX], y[NY], rebound = d->speed.rebound;
-    int contact = (int)d->speed.contact, left = (int)d->speed.left;
-    long dropped = 0;
     (void)err;
     d->step_events[0] = '\0';
-    cam_vf_me_states(d, x);
-    cam_vf_me_load(d, x, y);
     if (code == EV_TOUCH)   /* the nearer flank: a groove's other one past half its width */
-        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && x[CAM_ME_GAP] > cam_vf_clearance(m) ? -left : left) > 0
-               ? EV_TOUCH_UP : EV_TOUCH_DOWN;
-    cam_vf_event_update(d, y, d->form_u, code, &contact, &left, &rebound, d->time, &dropped);
-    cam_vf_store_y(d, y);
-    d->speed.contact = contact;
-    d->speed.left = left;
-    d->speed.sigma = contact ? 0.0 : cam_vf_flight_direction(m, y);
-    d->speed.rebound = rebound;
+        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && d->x[CAM_GAP] > cam_vf_clearance(m) ? -d->mode.left
+                : d->mode.left) > 0 ? EV_TOUCH_UP : EV_TOUCH_DOWN;
+    d->form->transition(d, code, d->time);
     d->stale = 1;
     return CAM_OK;
 }
