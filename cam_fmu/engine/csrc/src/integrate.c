@@ -245,13 +245,11 @@ static double first_event(CamDrive *d, CamIntegrator *it, double dt)
     int n = it->n_events, k;
     double tau, u = d->u;
     if (!it->have_before)
-        for (k = 0; k < n; k++)
-            it->before[k] = cam_event_value(&d->model, &d->mode, it->codes[k], d->x, u);
+        cam_event_values(&d->model, &d->mode, n, it->codes, d->x, u, it->before);
     it->have_before = 0;
     if (n == 0)
         return -1.0;
-    for (k = 0; k < n; k++)
-        it->after[k] = cam_event_value(&d->model, &d->mode, it->codes[k], it->x_end, u);
+    cam_event_values(&d->model, &d->mode, n, it->codes, it->x_end, u, it->after);
     for (k = 0; k < n; k++)
         if (it->before[k] < 0.0 || (it->before[k] == 0.0 && it->after[k] < 0.0)) {
             it->hit = it->codes[k];

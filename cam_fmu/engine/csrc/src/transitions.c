@@ -70,6 +70,18 @@ double cam_event_value(const CamModel *m, const CamMode *mode, int code, const d
     return mode->contact * d[1] * mode->direction;
 }
 
+void cam_event_values(const CamModel *m, const CamMode *mode, int n, const int codes[], const double x[CAM_NX],
+                      double u, double g[])
+{
+    int k;
+    if (m->follower_states) {
+        cam_vf_values(m, mode, n, codes, x, u, g);
+        return;
+    }
+    for (k = 0; k < n; k++)
+        g[k] = cam_event_value(m, mode, codes[k], x, u);
+}
+
 void cam_initial(const CamModel *m, double theta0, double omega0, double i0, double x[CAM_NX], CamMode *mode)
 {
     x[CAM_THETA] = theta0;

@@ -300,10 +300,29 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
     mode->sigma = cam_vf_flight_direction(m, y);
 }
 
+/* cam_vf_y for the rates and the event functions: on a flank without s, v (0: they take them from the flank), in
+ * flight with the profile at theta into dd. */
+static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double y[NY], double dd[4])
+{
+    y[0] = x[CAM_THETA];
+    y[1] = x[CAM_OMEGA];
+    y[2] = x[CAM_CURRENT];
+    y[Y_TWIST] = m->compliant ? x[CAM_TWIST] : 0.0;
+    y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
+    y[Y_SIGMA] = mode->contact ? 0.0 : mode->sigma;
+    y[Y_DIR] = mode->stuck ? 0.0 : mode->direction;
+    y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; flank_terms) */
+    if (!mode->contact) {
+        cam_profile_eval(&m->profile, y[0], dd);
+        y[3] = dd[0] - mode->left * cam_vf_clearance(m) + mode->left * x[CAM_GAP];
+        y[4] = dd[1] * y[1] + mode->left * x[CAM_RATE];
+    }
+}
+
 void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
     double y[NY], dy[NY], dd[4];
-    cam_vf_y(m, mode, x, y);
+    working_y(m, mode, x, y, dd);
     cam_vf_rates(m, u, mode->contact, y, dy);
     dx[CAM_THETA] = dy[0];
     dx[CAM_OMEGA] = dy[1];
@@ -314,8 +333,7 @@ void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     dx[CAM_GAP] = dx[CAM_RATE] = 0.0;
     if (mode->contact)
         return;
-    cam_profile_eval(&m->profile, y[0], dd);   /* the follower's acceleration less the flank's */
-    dx[CAM_GAP] = x[CAM_RATE];
+    dx[CAM_GAP] = x[CAM_RATE];   /* the follower's acceleration less the flank's */
     dx[CAM_RATE] = mode->left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1]));
 }
 
@@ -348,6 +366,21 @@ double cam_vf_value(const CamModel *m, const CamMode *mode, int code, const doub
     return cam_vf_event_value(m, u, code, mode->contact, y);
 }
 
+void cam_vf_values(const CamModel *m, const CamMode *mode, int n, const int codes[], const double x[CAM_NX],
+                   double u, double g[])
+{
+    double y[NY], d[4], omega_dot, P = NAN, n_r = NAN;
+    int k;
+    working_y(m, mode, x, y, d);
+    for (k = 0; k < n; k++) {
+        if ((codes[k] == EV_LIFT_OFF || codes[k] == EV_SIDE) && P != P)   /* the flank's forces, once */
+            flank_terms(m, y, u, mode->contact, d, &omega_dot, &P, &n_r);
+        g[k] = codes[k] == EV_LIFT_OFF ? mode->contact * P
+               : (codes[k] == EV_SIDE ? mode->side * n_r + CAM_SIDE_HYSTERESIS
+                                      : cam_vf_event_value(m, u, codes[k], mode->contact, y));
+    }
+}
+
 /* s: the longest step the follower's phases allow at the drive's state at `time` [s] (the flight's oscillation,
  * a gap's crossing, the electrical pole, the shaft, a rebound; the solver's own limits come on top). */
 static double vf_step_limit(const CamDrive *d, double time)
@@ -360,13 +393,14 @@ static double vf_step_limit(const CamDrive *d, double time)
     double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
                   : 0.0;
     double ws = m->compliant ? cam_shaft_rate(m, m->J_0) : 0.0;
-    cam_vf_y(m, mode, d->x, y);
-    if (y[1] != 0.0 && !mode->contact)   /* in flight a step at most scans the gap's events */
-        dt = fmin(dt, FLIGHT_ANGLE / fabs(y[1]));
+    if (!mode->contact && d->x[CAM_OMEGA] != 0.0)   /* in flight a step at most scans the gap's events */
+        dt = fmin(dt, FLIGHT_ANGLE / fabs(d->x[CAM_OMEGA]));
     if (!mode->contact && wn > 0.0)
         dt = fmin(dt, STEP_PHASE / wn);
     if (!mode->contact && mode->stuck && cam_vf_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
-        double c = cam_vf_clearance(m), A = cam_vf_acceleration_scale(m, y, u);
+        double c = cam_vf_clearance(m), A;
+        cam_vf_y(m, mode, d->x, y);
+        A = cam_vf_acceleration_scale(m, y, u);
         dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
         if (y[4] != 0.0)
             dt = fmin(dt, 0.1 * c / fabs(y[4]));
