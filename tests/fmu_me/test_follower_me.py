@@ -207,6 +207,19 @@ def test_every_mode_of_the_follower_runs_in_model_exchange_as_in_cosimulation(en
         assert np.max(np.abs(me[name] - grid[name])) <= bound * np.max(np.abs(grid[name])), name
 
 
+def _without_grazes(events: list, within: float = 1e-4) -> list:
+    """The events less each lift-off followed by a touch-down within ``within`` [s] (a graze: both dropped)."""
+    kept, k = [], 0
+    while k < len(events):
+        if (k + 1 < len(events) and events[k][0] == "lift-off" and events[k + 1][0] == "touch-down"
+                and events[k + 1][1] - events[k][1] < within):
+            k += 2
+            continue
+        kept.append(events[k])
+        k += 1
+    return kept
+
+
 def test_the_backlash_scene_with_the_form_closure_runs_in_model_exchange(engine_fmu_path):
     """The default-to-be: the backlash scene's groove (c = 0.5 mm) with closure 'form', from rest (the shaft's
     break-away at the start), in CVode against co-simulation: the same transitions (8 in 2 s), at its times, the
@@ -218,7 +231,12 @@ def test_the_backlash_scene_with_the_form_closure_runs_in_model_exchange(engine_
     me, me_events, me_errors = simulate(start, stop, "ModelExchange", scene.output_interval, fmu=engine_fmu_path,
                                         relative_tolerance=RTOL)
     assert cs_errors == me_errors == []
-    assert len(cs_events) >= 2 and [k for k, _ in me_events] == [k for k, _ in cs_events]
+    # The scipy reference (rtol 1e-12) lifts off for a few microseconds after each of the 4 landings and touches
+    # down again at 1e-6 m/s: grazes whose detection depends on where the steps fall (measured: co-simulation at
+    # 1e-5 s steps sees the one at t = 1.16113 s, at the reference's time to 1e-8 s; CVode none). Compared without
+    # them; the landings and lift-offs that carry the motion must agree.
+    cs_events, me_events = _without_grazes(cs_events), _without_grazes(me_events)
+    assert len(cs_events) == 8 and [k for k, _ in me_events] == [k for k, _ in cs_events]
     assert max(abs(a - b) for (_, a), (_, b) in zip(me_events, cs_events)) < EVENT_TIME
     grid = cs[::round(scene.output_interval / CS_STEP)]
     me = on_grid(me, grid["time"])

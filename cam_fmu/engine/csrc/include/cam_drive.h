@@ -43,13 +43,11 @@ typedef struct {
     double (*step_limit)(const struct CamDrive *d, double time);
 } CamFormulation;
 
-/* A formulation's Model Exchange (cam_drive_me_* and fmi/exchange.c call them): its states x[CAM_ME_NX] and back,
- * their rates, its event codes (how many, at most CAM_VF_ME_EVENTS) and functions (> 0: nothing happens), and its
- * event update: the transition `code` (0: none, the mode settled at the state), the one its co-simulation runs. */
+/* A formulation's Model Exchange beyond the model contract's states x and rates cam_rhs (cam_drive_me_* and
+ * fmi/exchange.c call them): its event codes (how many, at most CAM_VF_ME_EVENTS) and functions (> 0: nothing
+ * happens), and its event update: the transition `code` (EV_NONE: none, the mode settled at the state), the one its
+ * co-simulation runs. */
 typedef struct CamExchangeHooks {
-    void (*states)(const struct CamDrive *d, double *x);
-    void (*set_states)(struct CamDrive *d, const double *x);
-    void (*rates)(const struct CamDrive *d, const double *x, double *dx);
     int (*codes)(const struct CamDrive *d, int *codes);
     double (*event)(const struct CamDrive *d, int code, const double *x);
     int (*event_update)(struct CamDrive *d, int code, CamError *err);

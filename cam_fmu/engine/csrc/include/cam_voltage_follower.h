@@ -1,5 +1,6 @@
 /* The voltage drive's follower of its own (docs/model.md 13.6): what voltage_follower.c (its equations and
- * co-simulation's step) shares with voltage_follower_events.c (the one event update, Model Exchange's view).
+ * its model-contract functions) shares with voltage_follower_events.c (its transitions in the one event update,
+ * Model Exchange's indicators).
  * Internal to the engine, not for bindings. y = (theta, omega, i, s, v, phi, omega_m, sigma, dir): see
  * voltage_follower.c. */
 #ifndef CAM_VOLTAGE_FOLLOWER_H
@@ -58,13 +59,10 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
                          double time, long *dropped);
 
 /* Model Exchange's view (the formulation's hooks cam_vf_exchange, cam_drive.h CamExchangeHooks). */
-void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX]);
-void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX]);
-void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX]);
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err);
-/* The tangent of cam_vf_me_rates and of the outputs at x along seed[CAM_ME_NX] and du, in the drive's mode
+/* The tangent of cam_vf_rhs and of the outputs at x along seed[CAM_ME_NX] and du, in the drive's mode
  * (jacobian_follower.c). */
 void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
                        double ddx[CAM_ME_NX], double dout[]);

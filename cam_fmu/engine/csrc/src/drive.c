@@ -177,21 +177,12 @@ int cam_drive_run(CamDrive *d, long n_steps, const double *table, double *out, l
 
 void cam_drive_me_states(const CamDrive *d, double x[CAM_ME_NX])
 {
-    if (d->form->exchange != NULL) {
-        d->form->exchange->states(d, x);
-        return;
-    }
     memcpy(x, d->x, sizeof d->x);
-    x[CAM_GAP] = x[CAM_RATE] = 0.0;
 }
 
 void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 {
-    if (d->form->exchange != NULL) {
-        d->form->exchange->set_states(d, x);
-        return;
-    }
-    /* a rigid drive holds the shaft's slots at 0 (their derivatives are 0: a host's solver leaves them) */
+    /* a drive holds the slots past its own at 0 (their derivatives are 0: a host's solver leaves them) */
     memcpy(d->x, x, (size_t)d->model.slots * sizeof x[0]);
     d->stale = 1;
 }
@@ -199,10 +190,6 @@ void cam_drive_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
 void cam_drive_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
 {
     int k;
-    if (d->form->exchange != NULL) {
-        d->form->exchange->rates(d, x, dx);
-        return;
-    }
     for (k = 0; k < CAM_ME_NX; k++)   /* the held slots */
         dx[k] = 0.0;
     cam_rhs(&d->model, &d->mode, x, d->form_u, dx);

@@ -1,5 +1,5 @@
 /* The tangent of the voltage drive's follower of its own in Model Exchange (forward-mode derivatives, written out by
- * hand, as jacobian.c's for the rigid drive): the directional derivative of cam_vf_me_rates (voltage_follower_events.c)
+ * hand, as jacobian.c's for the rigid drive): the directional derivative of cam_vf_rhs (voltage_follower.c)
  * and of the outputs (voltage_follower.c's vf_outputs) along a seed of the states x[CAM_ME_NX] (theta, omega, i, the
  * shaft's twist and rotor speed; in flight the gap and its rate from the flank last left) and the input u, at the
  * fixed mode: on a flank (moving or stuck), in flight (the cam moving or stuck, the follower sliding or held by the

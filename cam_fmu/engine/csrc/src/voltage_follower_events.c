@@ -157,22 +157,6 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
 
 typedef char cam_vf_me_event_slots[(int)CAM_VF_ME_EVENTS <= (int)CAM_MAX_EVENTS ? 1 : -1];
 
-void cam_vf_me_states(const CamDrive *d, double x[CAM_ME_NX])
-{
-    memcpy(x, d->x, sizeof d->x);
-}
-
-void cam_vf_set_me_states(CamDrive *d, const double x[CAM_ME_NX])
-{
-    memcpy(d->x, x, sizeof d->x);
-    d->stale = 1;
-}
-
-void cam_vf_me_rates(const CamDrive *d, const double x[CAM_ME_NX], double dx[CAM_ME_NX])
-{
-    cam_vf_rhs(&d->model, &d->mode, x, d->form_u, dx);
-}
-
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
 {
     int n = 0, stuck = d->mode.stuck;
@@ -211,7 +195,4 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     return CAM_OK;
 }
 
-const CamExchangeHooks cam_vf_exchange = {
-    cam_vf_me_states, cam_vf_set_me_states, cam_vf_me_rates, cam_vf_me_codes, cam_vf_me_event, cam_vf_me_apply,
-    cam_vf_me_tangent,
-};
+const CamExchangeHooks cam_vf_exchange = {cam_vf_me_codes, cam_vf_me_event, cam_vf_me_apply, cam_vf_me_tangent};
