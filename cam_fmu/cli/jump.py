@@ -18,6 +18,12 @@ k_spring_N_per_m, theta_k_spring, safety with --target-rpm; null where not asked
 parameter's range (physics/parameters.py: F_spring0, k_spring) is null, with the reason in beyond_range (the value
 needed and the range); where neither is in range the command fails (exit 2) naming both, and says whether a spring
 with both changed does it or no spring in range does.
+
+Another follower type (follower_type, docs/model.md 16.2; physics.kind_jump): the spring acts along the roller's
+path, at arm_length L for an arm, omega_jump = min over q'' < 0 of sqrt(C / (I_f |q''|)) with an arm's closing
+torque C = L (F0 + k L psi) + W cos(psi + psi_0) and I_f = J_arm + m L^2 (a translating flat face: the roller's,
+s-based, without guide friction); the forces it reports are along the roller's path and the JSON adds psi_jump
+[rad] (null for a translating follower).
 """
 from __future__ import annotations
 

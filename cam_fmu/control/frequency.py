@@ -11,7 +11,9 @@ Two operating points (docs/control.md section 5, docs/model.md section 12.3):
 ``experiments.frequency.measured_response`` measures the response on the C engine.
 
 ``analytic_response`` is the linearised two-mass system at the frozen angle (docs/model.md
-12.3) as a state-space model, H(j w) = C (j w I - A)^-1 B, evaluated with numpy.
+12.3) as a state-space model, H(j w) = C (j w I - A)^-1 B, evaluated with numpy. Every follower type: another
+kind's J(theta0), holding voltage and gravity's stiffness come from its potential (control.kind_view, docs/model.md
+16.2).
 """
 from __future__ import annotations
 

@@ -21,6 +21,9 @@ sqrt(k_train / m_end) / (2 pi) (the end mass on its spring, which the cam cannot
 f_r_train(theta) = sqrt(k_train (1 / m_end + s'^2 / J_c)) / (2 pi) of the cam (J_c = J_0 + m s'^2, a mass J_c / s'^2
 along X) and the end mass on the spring between them. Plain floats through physics.drive.DriveModel; numpy only for
 the arrays.
+
+Another follower type (a translating flat face, an arm; docs/model.md 16.2): the kind's own terms (control.kind_view,
+physics.kind_drive), J = [J_m +] J_0 + I_f q'^2 and M's parts with q = s or psi; the follower's friction in M_guide.
 """
 from __future__ import annotations
 
