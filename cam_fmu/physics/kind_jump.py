@@ -77,9 +77,9 @@ class KindSpring:
         """omega_jump [rad/s] and where (module doc); Jump.s is the lift s [m] there, Jump.s2 the coordinate's q''."""
         breaks = self.program.breakpoints()
         weakest, theta_w = minimise_over_turn(self.closing, breaks)
-        scale = abs(self.F0) + abs(self.k) * (self.a if self.kind.oscillating else 1.0) + abs(self.model.F_gx) \
-            + abs(self.model.W) / self.a
-        if weakest < -1e-12 * scale:
+        stroke = self.a * self.kind.lift_angle if self.kind.oscillating else self.program.lift  # m, the largest b / a
+        scale = abs(self.F0) + abs(self.k) * stroke + abs(self.model.F_gx) + abs(self.model.W) / self.a
+        if weakest < -1e-12 * scale:  # below the rounding of C / a at a stroke's end
             _, _, q2, s = self.parts(theta_w)
             return Jump(0.0, theta_w, s, q2, f"the closing force along the roller's path is {weakest:.6g} N < 0 at "
                                              f"theta = {theta_w:.6g} rad: the follower is not held even at rest")

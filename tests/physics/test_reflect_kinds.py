@@ -130,3 +130,21 @@ def test_a_spring_closed_kind_is_refused_as_the_roller_is(kind):
         reflected_map(params, 60.0)
     with pytest.raises(ValueError, match="J_cam"):
         reflected_map(dict(BASE, **KINDS[kind], J_cam=0.0, k_shaft=50.0), 60.0)
+
+
+@pytest.mark.parametrize("kind", ["oscillating_roller", "oscillating_flat"])
+def test_an_arms_friction_acts_on_its_lever(kind):
+    """The roller arm's pivot: mu |P| |psi'|; the flat arm's face, whose line lies d sin(delta) from the cam axis at
+    delta = asin(r_b / d) + psi: mu |P| tan(delta) (1 - psi') (docs/model.md 16), with P = I_f psi'' omega^2 (no
+    gravity); sgn(omega) on both."""
+    params = dict(BASE, **KINDS[kind], mu=0.05, gravity=False, shaft_friction=False)
+    delta0 = math.asin(R_B / KINDS[kind]["pivot_distance"])
+    for rpm in (150.0, -150.0):
+        result = reflected_map(params, rpm, points=360)
+        omega, d = rpm * 2.0 * math.pi / 60.0, math.copysign(1.0, rpm)
+        for k, theta in enumerate(result["theta"]):
+            q, q1, q2, I_f = coordinate(kind, float(theta))
+            P = I_f * q2 * omega ** 2
+            lever = abs(q1) if kind == "oscillating_roller" else math.tan(delta0 + q) * (1.0 - q1)
+            assert result["M_guide"][k] == pytest.approx(0.05 * abs(P) * lever * d, rel=1e-9, abs=1e-15)
+            assert result["M"][k] == pytest.approx(P * q1 + result["M_guide"][k], rel=1e-12, abs=1e-15)
