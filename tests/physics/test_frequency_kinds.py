@@ -119,3 +119,17 @@ fit's aliasing of the staircase's harmonics)."""
              / (1j * w) / (periods / f))
         H = analytic_response(params, theta0, [f]).cam[0]
         assert abs(Y / U - H) < 2e-4 * abs(H), f
+
+
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_a_turning_kind_settles_over_its_heaviest_inertias_time_constants(kind):
+    """The turning operating point (bode --u0) waits 8 mechanical time constants R J / (c_e c_m) at the heaviest
+    J = J_m + J_cam + I_f q'^2 (mid-rise here) before it measures; it turns at the speed the engine reached."""
+    from cam_fmu.experiments.frequency import operating_point
+
+    point = operating_point(frozen(kind), u0=40.0)
+    _, q1, _, I_f = coordinate(kind, BETA / 2)
+    R, c_m, c_e = 19.0, 0.015 * G_N, 0.146  # the defaults (physics/parameters.py)
+    assert point.settle == pytest.approx(8.0 * R * (BASE["J_m"] + BASE["J_cam"] + I_f * q1 * q1) / (c_e * c_m),
+                                         rel=1e-12)
+    assert point.f_turn > 0.1 and "turning under u0 = 40 V" in point.note
