@@ -1,7 +1,7 @@
 """`cam-fmu jump` for every follower type other than the translating roller (physics.kind_jump) against the closed
 form evaluated by brute force here, on test_reflect_kinds' hand-written cam: a spring-closed arm at constant speed
 leaves the cam at omega_jump = min over psi'' < 0 of sqrt((L (F0 + k L psi) + W cos(psi + psi_0)) / ((J_arm + m L^2)
-|psi''|)) (W = 0 on a horizontal mounting: the issue's formula); a translating flat face at the roller's, s-based,
+|psi''|)) (W = 0 on a horizontal mounting); a translating flat face at the roller's, s-based,
 sqrt((F0 + k s - F_gx) / (m |s''|)). The preload and the rate found for a target speed give, by the same brute force,
 omega_jump = sqrt(S) target."""
 from __future__ import annotations
