@@ -18,6 +18,12 @@ k_spring_N_per_m, theta_k_spring, safety with --target-rpm; null where not asked
 parameter's range (physics/parameters.py: F_spring0, k_spring) is null, with the reason in beyond_range (the value
 needed and the range); where neither is in range the command fails (exit 2) naming both, and says whether a spring
 with both changed does it or no spring in range does.
+
+Another follower type (follower_type, docs/model.md 16.2; physics.kind_jump): the spring acts along the roller's
+path, at arm_length L for an arm, omega_jump = min over q'' < 0 of sqrt(C / (I_f |q''|)) with an arm's closing
+torque C = L (F0 + k L psi) + W cos(psi + psi_0) and I_f = J_arm + m L^2 (a translating flat face: the roller's,
+s-based, without guide friction); the forces it reports are along the roller's path and the JSON adds psi_jump
+[rad] (null for a translating follower).
 """
 from __future__ import annotations
 
@@ -69,6 +75,8 @@ def report(params, omega: float | None, target: float | None, safety: float) -> 
                          "--set k_spring=...)")
     if not (math.isfinite(safety) and 1.0 <= safety <= 100.0):
         raise ValueError(f"--safety {safety!r}: allowed [1, 100]")
+    if params.get("follower_type", "translating_roller") != "translating_roller":
+        return _kind_report(params, omega, target, safety)
     model = DriveModel(dict(params, drive="speed"))  # a rigid drive at constant speed, whatever the scene drives
     f0 = model.mu * (abs(model.G_y) + model.N_g)
     args = (model.m, model.k_spring, model.F_spring0, model.F_gx, f0)
@@ -86,34 +94,64 @@ def report(params, omega: float | None, target: float | None, safety: float) -> 
                                                              model.k_spring, model.F_gx, f0)
         out["k_spring_N_per_m"], out["theta_k_spring"] = rate_for(model.program, target, safety, model.m,
                                                                   model.F_spring0, model.F_gx, f0)
-        _within_range(out, model, target, safety, f0)
+        _within_range(out, model.k_spring, model.F_spring0, target, safety,
+                      lambda k: preload_for(model.program, target, safety, model.m, k, model.F_gx, f0)[0])
+    return _finite(out)
+
+
+def _finite(out: dict) -> dict:
+    """``out`` with every non-finite float as None (JSON's null)."""
     return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
 
 
-def _within_range(out: dict, model, target: float, safety: float, f0: float) -> None:
+def _kind_report(params, omega: float | None, target: float | None, safety: float) -> dict:
+    """report() for a follower type other than the translating roller (physics.kind_jump: an arm's spring at
+    arm_length along the roller's path; forces along that path); psi_jump [rad] the arm's angle there (None for a
+    translating face)."""
+    from ..physics.kind_jump import KindSpring
+
+    spring = KindSpring(dict(params, drive="speed"))
+    jump = spring.jump()
+    psi = spring.model.coordinate(jump.theta)[0] if spring.kind.oscillating and math.isfinite(jump.theta) else None
+    out = {"omega_jump": jump.omega_jump, "rpm_jump": jump.omega_jump / RPM, "theta_jump": jump.theta,
+           "s_jump": jump.s, "psi_jump": psi, "reason": jump.reason, "margin_N": None, "theta_margin": None,
+           "speed_ratio": None, "preload_N": None, "theta_preload": None, "k_spring_N_per_m": None,
+           "theta_k_spring": None, "safety": None, "beyond_range": None}
+    if omega is not None:
+        out["margin_N"], out["theta_margin"] = spring.margin(omega)
+        out["speed_ratio"] = jump.omega_jump / omega
+    if target is not None:
+        out["safety"] = safety
+        out["preload_N"], out["theta_preload"] = spring.preload_for(target, safety)
+        out["k_spring_N_per_m"], out["theta_k_spring"] = spring.rate_for(target, safety)
+        _within_range(out, spring.k, spring.F0, target, safety,
+                      lambda k: spring.preload_for(target, safety, k)[0])
+    return _finite(out)
+
+
+def _within_range(out: dict, k_spring: float, F_spring0: float, target: float, safety: float, stiffest_preload) -> None:
     """Keep only the spring answers within the parameters' ranges (physics/parameters.py): an answer beyond its
     range becomes None with the reason in out["beyond_range"]; where neither is in range, raise ValueError naming
     each parameter, the value needed and the range, and whether a spring with both changed (the largest rate in
-    range and the preload it needs) does it."""
-    from ..physics.follower import preload_for
+    range and the preload it needs, ``stiffest_preload(k)`` [N]) does it. k_spring [N/m], F_spring0 [N]: the scene's."""
     from ..physics.parameters import BY_NAME
 
     F0_spec, k_spec = BY_NAME["F_spring0"], BY_NAME["k_spring"]
     beyond = []
     if out["preload_N"] > F0_spec.high:
         beyond.append(f"the preload F_spring0 would have to be {out['preload_N']:.6g} N at k_spring = "
-                      f"{model.k_spring:g} N/m, allowed {F0_spec.allowed()}")
+                      f"{k_spring:g} N/m, allowed {F0_spec.allowed()}")
         out["preload_N"] = out["theta_preload"] = None
     if out["k_spring_N_per_m"] is not None and math.isfinite(out["k_spring_N_per_m"]) \
             and out["k_spring_N_per_m"] > k_spec.high:
         beyond.append(f"the spring rate k_spring would have to be {out['k_spring_N_per_m']:.6g} N/m at F_spring0 = "
-                      f"{model.F_spring0:g} N, allowed {k_spec.allowed()}")
+                      f"{F_spring0:g} N, allowed {k_spec.allowed()}")
         out["k_spring_N_per_m"] = out["theta_k_spring"] = None
     out["beyond_range"] = "; ".join(beyond) or None
     if out["preload_N"] is not None or (out["k_spring_N_per_m"] is not None
                                         and math.isfinite(out["k_spring_N_per_m"])):
         return
-    stiffest, _ = preload_for(model.program, target, safety, model.m, k_spec.high, model.F_gx, f0)
+    stiffest = stiffest_preload(k_spec.high)
     if stiffest <= F0_spec.high:
         both = (f"only a spring with both changed: k_spring = {k_spec.high:g} N/m with F_spring0 >= "
                 f"{max(stiffest, 0.0):.6g} N")
@@ -125,9 +163,12 @@ def _within_range(out: dict, model, target: float, safety: float, f0: float) -> 
 
 
 def curves(params, speeds: dict[str, float], points: int = 1440) -> dict:
-    """The figure's columns over a turn: theta [rad], the available force, the needed force at each speed [N]."""
+    """The figure's columns over a turn: theta [rad], the available force, the needed force at each speed [N] (for
+    another follower type, along the roller's path: physics.kind_jump)."""
     from ..physics.drive import DriveModel
 
+    if params.get("follower_type", "translating_roller") != "translating_roller":
+        return _kind_curves(params, speeds, points)
     model = DriveModel(dict(params, drive="speed"))
     f0 = model.mu * (abs(model.G_y) + model.N_g)
     result: dict = {"theta": [], "available": [], "speeds": {}}
@@ -143,6 +184,27 @@ def curves(params, speeds: dict[str, float], points: int = 1440) -> dict:
         for k, omega in enumerate(speeds.values()):
             result[f"need{k}"].append(model.m * max(-s2, 0.0) * omega * omega)
             result[f"margin_need{k}"].append(available + model.m * s2 * omega * omega)
+    return result
+
+
+def _kind_curves(params, speeds: dict[str, float], points: int) -> dict:
+    """curves() for a follower type other than the translating roller (physics.kind_jump)."""
+    from ..physics.kind_jump import KindSpring
+
+    spring = KindSpring(dict(params, drive="speed"))
+    result: dict = {"theta": [], "available": [], "speeds": {}}
+    for k, label in enumerate(speeds):
+        result["speeds"][f"need{k}"] = label
+        result[f"need{k}"], result[f"margin_need{k}"] = [], []
+    for j in range(points):
+        theta = 2.0 * math.pi * j / points
+        available = spring.closing(theta)
+        q2 = spring.parts(theta)[2]
+        result["theta"].append(theta)
+        result["available"].append(available)
+        for k, omega in enumerate(speeds.values()):
+            result[f"need{k}"].append(spring.need(theta, omega))
+            result[f"margin_need{k}"].append(available + spring.model.I_f * q2 * omega * omega / spring.a)
     return result
 
 

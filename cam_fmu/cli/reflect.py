@@ -17,7 +17,8 @@ it leaves the cam); for 'form', whose groove holds the follower on both flanks (
 compliant shaft the CSV adds the columns f_r and f_a [Hz] and the figure a third panel. With a follower train
 (k_train > 0, rigid shaft) the map is the train's low-frequency limit (the end mass carried with the follower in J
 and M) and the CSV and JSON add f_r_train, f_a_train [Hz], the resonance and anti-resonance the train makes
-(control.reflect).
+(control.reflect). Every follower type: a translating flat face or an arm with the kind's own J(theta) and load
+(docs/model.md 16.2).
 """
 from __future__ import annotations
 

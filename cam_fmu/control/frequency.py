@@ -11,7 +11,9 @@ Two operating points (docs/control.md section 5, docs/model.md section 12.3):
 ``experiments.frequency.measured_response`` measures the response on the C engine.
 
 ``analytic_response`` is the linearised two-mass system at the frozen angle (docs/model.md
-12.3) as a state-space model, H(j w) = C (j w I - A)^-1 B, evaluated with numpy.
+12.3) as a state-space model, H(j w) = C (j w I - A)^-1 B, evaluated with numpy. Every follower type: another
+kind's J(theta0), holding voltage and gravity's stiffness come from its potential (control.kind_view, docs/model.md
+16.2).
 """
 from __future__ import annotations
 
@@ -22,6 +24,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..physics.drive import DriveModel
+from .kind_view import KindView, kind_view
 
 SETTLE_TIME_CONSTANTS = 8.0  # time constants of the slowest pole of the linear model, at least
 FROZEN_OFF = {"shaft_friction": False, "guide_friction": False, "backlash": False}
@@ -42,8 +45,10 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
     """The parameters of the drive held at theta0 [rad] (friction and backlash off) and the voltage u0 [V] that
     holds it there against gravity; ValueError when gravity's stiffness makes that equilibrium unstable."""
     p = dict(params or {}, **FROZEN_OFF, theta0=theta0, omega0=0.0)
+    view = kind_view(p)
+    if view is not None:
+        return _kind_frozen(p, view, theta0)
     model = DriveModel(p)
-    model.require_translating_roller("the frequency response at a frozen angle")
     if abs(model.F_gx) <= 1e-12 * p.get("G", 1.0) and model.F_gx != 0.0:
         # a horizontal mounting's gravity along X is sin(pi) G = 1.2e-16 G of rounding: held by a voltage of
         # 1e-15 V, the frictionless cam would crawl at rest and its stops chatter; it is no load at all
@@ -57,6 +62,21 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
                          "< 0, the cam would fall away from a standstill (choose an angle where k_g >= 0, or "
                          "another mounting)")
     u0 = model.R * (-F_x * s1) / model.c_m + 0.0  # + 0.0: no -0 V in a report
+    if model.L > 0.0:
+        p["i0"] = u0 / model.R
+    return p, u0
+
+
+def _kind_frozen(p: dict[str, Any], view: KindView, theta0: float) -> tuple[dict[str, Any], float]:
+    """frozen_parameters for a follower of another kind (control.kind_view): gravity's stiffness k_g = d2V/dtheta2
+    and the holding voltage u0 = R M_g / c_m from the kind's potential."""
+    model = view.model
+    k_g = view.gravity_stiffness(theta0)
+    if k_g < -1e-12:
+        raise ValueError(f"theta0 = {theta0!r} rad: gravity's stiffness there is k_g = d2V/dtheta2 = {k_g:.4g} N m/rad "
+                         f"< 0 (follower_type {model.kind.follower_type!r}), the cam would fall away from a standstill "
+                         "(choose an angle where k_g >= 0, or another mounting)")
+    u0 = model.R * view.gravity_torque(theta0) / model.c_m + 0.0  # + 0.0: no -0 V in a report
     if model.L > 0.0:
         p["i0"] = u0 / model.R
     return p, u0
@@ -89,16 +109,22 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
     (theta - theta0, omega, phi, omega_m[, i][, x_e, v_e]); input u [V]; outputs (omega_m, omega) [rad/s]. A rigid
     shaft is the one-mass limit: states (theta - theta0, omega[, i][, x_e, v_e]), both outputs omega. A follower
     train (k_train > 0) adds its end mass's deviation and velocity, and its weight to gravity's stiffness."""
-    model = DriveModel(dict(params or {}, **FROZEN_OFF))
-    model.require_translating_roller("the linearised drive of the frequency response")
-    _, s1, s2, _ = model.program.derivatives(theta0)
-    J_c = model.J_0 + model.m * s1 * s1
-    k_g = -(model.F_gx + _end_weight(model)) * s2
+    p = dict(params or {}, **FROZEN_OFF)
+    view = kind_view(p)
+    if view is None:
+        model = DriveModel(p)
+        _, s1, s2, _ = model.program.derivatives(theta0)
+        J_c = model.J_0 + model.m * s1 * s1
+        k_g = -(model.F_gx + _end_weight(model)) * s2
+        compliant, k, d, J_m = model.compliant, model.k_shaft, model.d_shaft, model.J_m
+    else:  # another follower type: its J_c(theta0) and gravity's stiffness (control.kind_view), no train
+        model = view.model
+        J_c, k_g = view.cam_side(theta0), view.gravity_stiffness(theta0)
+        compliant, k, d, J_m = view.compliant, view.k_shaft, view.d_shaft, view.J_m
     R, L, c_e, c_m = model.R, model.L, model.c_e, model.c_m
     damping = 0.0 if L > 0.0 else c_m * c_e / R  # L = 0: the back-EMF's torque -c_m c_e omega_m / R
     gain = 0.0 if L > 0.0 else c_m / R  # L = 0: the motor's torque per volt
-    if model.compliant:
-        k, d, J_m = model.k_shaft, model.d_shaft, model.J_m
+    if compliant:
         A = [[0.0, 1.0, 0.0, 0.0],
              [-k_g / J_c, -d / J_c, k / J_c, d / J_c],
              [0.0, -1.0, 0.0, 1.0],
@@ -114,12 +140,12 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
     if L > 0.0:  # the current as a state: L di/dt = u - R i - c_e omega_m; its torque c_m i on the rotor
         n = len(A)
         A = [row + [0.0] for row in A] + [[0.0] * (n + 1)]
-        A[motor_row][n] = c_m / (model.J_m if model.compliant else J_c)
+        A[motor_row][n] = c_m / (J_m if compliant else J_c)
         A[n][speed] = -c_e / L
         A[n][n] = -R / L
         B = B + [1.0 / L]
         C = [row + [0.0] for row in C]
-    if model.train.active:
+    if view is None and model.train.active:
         A, C = _with_train(model, s1, J_c, A, C)
         B = B + [0.0, 0.0]
     return np.array(A), np.array(B), np.array(C)

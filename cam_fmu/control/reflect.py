@@ -21,6 +21,9 @@ sqrt(k_train / m_end) / (2 pi) (the end mass on its spring, which the cam cannot
 f_r_train(theta) = sqrt(k_train (1 / m_end + s'^2 / J_c)) / (2 pi) of the cam (J_c = J_0 + m s'^2, a mass J_c / s'^2
 along X) and the end mass on the spring between them. Plain floats through physics.drive.DriveModel; numpy only for
 the arrays.
+
+Another follower type (a translating flat face, an arm; docs/model.md 16.2): the kind's own terms (control.kind_view,
+physics.kind_drive), J = [J_m +] J_0 + I_f q'^2 and M's parts with q = s or psi; the follower's friction in M_guide.
 """
 from __future__ import annotations
 
@@ -29,8 +32,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..physics.drive import DriveModel, sign, solve_guide_friction
+from ..physics.drive import DriveModel, own_follower, sign, solve_guide_friction
+from ..physics.parameters import resolve
 from ..physics.train import end_weight
+from .kind_view import KindView, kind_view
 
 PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
 COLUMNS = ("theta", "J", "M", *PARTS)
@@ -66,13 +71,17 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
         raise ValueError(f"--rpm {rpm!r}: allowed a finite cam speed other than 0, |rpm| <= 1e6 1/min")
     if points < 8:
         raise ValueError(f"points = {points}: at least 8 angles over a turn")
-    model = DriveModel(params)
-    model.require_translating_roller("the reflected-load map")
-    if model.free_follower:
-        raise FreeFollowerError(model.closure)
     omega = rpm * 2.0 * math.pi / 60.0
     direction = 1.0 if omega > 0.0 else -1.0
     thetas = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
+    p = resolve(params)
+    if p["follower_type"] != "translating_roller":
+        if own_follower(p):  # before the kind's model, which refuses it by the rules' message
+            raise FreeFollowerError(p["closure"])
+        return _kind_map(kind_view(p), omega, direction, thetas)
+    model = DriveModel(params)
+    if model.free_follower:
+        raise FreeFollowerError(model.closure)
     train = model.train if model.train.active else None
     m_end = train.m_end if train else 0.0
     F_ex = end_weight(train, model.params) if train else 0.0
@@ -101,6 +110,31 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
         out["M_guide"][k] = sigma * f * s1
         out["M_shaft"][k] = model.M_f * direction
         out["M"][k] = model.load(float(theta), omega, 0.0, direction, True, carried).M
+    return out
+
+
+def _kind_map(view: KindView, omega: float, direction: float, thetas: np.ndarray) -> dict[str, np.ndarray]:
+    """The map of a follower of another kind (control.kind_view; physics.kind_drive): with q = s or psi and
+    I_f = m or J_arm + m L^2, J = [J_m +] J_c(theta), M_inertial = I_f q'' omega^2 q', M_gravity = V'(q) q', the
+    follower's friction mu |P| lambda sgn(omega) (P = I_f q'' omega^2 + V'(q): a flat face's sliding, an arm's pivot)
+    in M_guide, M_shaft = M_f sgn(omega); with a compliant shaft f_r, f_a of the rotor J_m and J_c(theta)."""
+    model = view.model
+    columns = COLUMNS + (FREQUENCIES if view.compliant else ())
+    out = {name: np.empty(len(thetas)) for name in columns}
+    rotor = view.J_m if view.compliant else 0.0
+    for k, theta in enumerate(thetas):
+        q, q1, q2, s = model.coordinate(float(theta))
+        P = model.I_f * q2 * omega * omega + model.potential_slope(q)
+        J_c = view.cam_side(float(theta))
+        out["theta"][k] = theta
+        out["J"][k] = rotor + J_c
+        if view.compliant:
+            out["f_r"][k], out["f_a"][k] = two_mass_frequencies(view.k_shaft, view.J_m, J_c)
+        out["M_inertial"][k] = model.I_f * q2 * omega * omega * q1
+        out["M_gravity"][k] = model.potential_slope(q) * q1
+        out["M_guide"][k] = model.mu * abs(P) * (model.lever(q, q1, s) if model.mu else 0.0) * direction
+        out["M_shaft"][k] = model.M_f * direction
+        out["M"][k] = model.load(float(theta), omega, 0.0, direction).M
     return out
 
 

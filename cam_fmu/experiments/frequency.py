@@ -23,6 +23,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..control.frequency import SETTLE_TIME_CONSTANTS, Response, frozen_parameters, settle_time
+from ..control.kind_view import kind_view
 from ..fmu.engine import DriveSimulator
 from ..physics.drive import DriveModel
 from ..physics.variables import OUTPUT_NAMES
@@ -153,10 +154,15 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
     if u0 is None or not math.isfinite(u0):
         raise ValueError("give the operating point: theta0 (a frozen angle) or a finite u0 [V] (a mean speed)")
     p = dict(params or {})
-    model = DriveModel(p)
-    model.require_translating_roller("the frequency response")
-    J_heavy = max(model.J_0 + model.m * model.program.derivatives(t)[1] ** 2
-                  for t in np.linspace(0.0, 2.0 * math.pi, 361)) + (model.J_m if model.compliant else 0.0)
+    view = kind_view(p)
+    angles = np.linspace(0.0, 2.0 * math.pi, 361)
+    if view is None:
+        model = DriveModel(p)
+        J_heavy = max(model.J_0 + model.m * model.program.derivatives(t)[1] ** 2
+                      for t in angles) + (model.J_m if model.compliant else 0.0)
+    else:  # another follower type: its J(theta) (control.kind_view); the engine runs it on a rigid shaft
+        model = view.model
+        J_heavy = max(view.cam_side(float(t)) for t in angles) + (view.J_m if view.compliant else 0.0)
     settle = SETTLE_TIME_CONSTANTS * model.R * J_heavy / (model.c_e * model.c_m)  # the slowest mechanical pole
     h = 1e-3
     run = DriveSimulator(p).run(_table(np.full(max(1, math.ceil(settle / h / OUTPUTS_PER_HOLD)), u0), h))

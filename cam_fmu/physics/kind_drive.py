@@ -119,6 +119,12 @@ class KindDriveModel(DriveModel):
             return self.W * math.cos(q + self.kind.psi_0) if self.W else 0.0
         return -self.F_gx
 
+    def potential_curvature(self, q: float) -> float:
+        """d2V/dq2 [N/m, or N m/rad for an arm]: 0 translating (V linear in s), -W sin(psi + psi_0) for an arm."""
+        if self.kind.oscillating:
+            return -self.W * math.sin(q + self.kind.psi_0) if self.W else 0.0
+        return 0.0
+
     def potential(self, theta: float) -> float:
         """V [J] at theta (0 at zero lift for an arm level with psi_0 = 0)."""
         q, _, _, s = self.coordinate(theta)

@@ -126,18 +126,12 @@ def test_the_reference_refuses_the_same_geometry(params):
 
 
 @pytest.mark.parametrize("kind", ["translating_flat", "oscillating_roller"])
-def test_the_maps_that_model_the_roller_only_refuse_another_type_by_name(kind):
-    """reflect, bode's linear model and frozen angle, its turning measurement and the residual through the drive compute
-    the translating roller's formulas (physics/drive.py): with another follower type they refuse, naming it, rather
-    than map a roller in its place."""
-    from cam_fmu.control.frequency import frozen_parameters, linear_model
-    from cam_fmu.control.reflect import reflected_map
-    from cam_fmu.experiments.frequency import operating_point
+def test_the_residual_through_the_drive_refuses_another_type_by_name(kind):
+    """The residual through the drive computes the translating roller's formulas (physics/drive.py): with another
+    follower type it refuses, naming it, rather than compute a roller in its place. (reflect and bode take every type:
+    tests/physics/test_reflect_kinds.py, tests/physics/test_frequency_kinds.py.)"""
     from cam_fmu.reference.train_residual import residual_scene
 
     params = dict(KINDS[kind], mu=0.0)
-    for call in (lambda: reflected_map(params, 60.0), lambda: linear_model(params, 1.0),
-                 lambda: frozen_parameters(params, 1.0), lambda: operating_point(params, u0=3.5),
-                 lambda: residual_scene(params)):
-        with pytest.raises(ParameterError, match=f"'follower_type' = '{kind}'.*translating roller only"):
-            call()
+    with pytest.raises(ParameterError, match=f"'follower_type' = '{kind}'.*translating roller only"):
+        residual_scene(params)
