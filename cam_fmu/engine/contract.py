@@ -60,10 +60,11 @@ STRUCTS: dict[str, tuple[tuple[str, str, str], ...]] = {
     "CamMode": (   # the discrete mode (physics.formulations.consistent.Mode)
         ("int", "stuck", "1: the shaft is held by static friction"),
         ("double", "direction", "+1/-1: sgn(omega) while moving (the trial direction at rest)"),
-        ("int", "contact", "backlash: +1 the cam drives the follower up, -1 down, 0 free in the gap; 1 without"),
+        ("CamFlank", "contact", "the follower on the lower flank (+1: the cam drives it along +X), the upper (-1), in "
+                                "flight or free in a backlash's gap (0); +1 without a clearance"),
         ("double", "s_free", "m: the follower's position while contact == 0"),
         ("double", "side", "+1/-1: sign of the guide's side force N_r (the friction branch)"),
-        ("int", "left", "a follower of its own: the flank it left last (+1, -1), its gap's origin"),
+        ("CamFlank", "left", "a follower of its own: the flank it left last (+1, -1), its gap's origin"),
         ("double", "sigma", "a follower of its own in flight: sgn(v) held between events (0: halted by friction)"),
     ),
     "CamEventRecord": (   # one transition, as the event log keeps it (not part of the saved state)
@@ -135,9 +136,15 @@ LAW_SEGMENTS, SEGMENT_FIELDS = 7, 7   # segments of one law; doubles per segment
 CONSTANTS = {"CAM_NX": NX, "CAM_MESSAGE_LEN": MESSAGE_LEN, "CAM_LAW_SEGMENTS": LAW_SEGMENTS,
              "CAM_SEGMENT_FIELDS": SEGMENT_FIELDS,
              "CAM_G_N": G_N}   # m/s2: standard gravity, the end mass's weight (physics/train.py)
-ENUMS: dict[str, tuple[tuple[str, int], ...]] = {"CamProgramKind": (("CAM_PROGRAM_LAWS", 0), ("CAM_PROGRAM_TABLE", 1))}
+ENUMS: dict[str, tuple[tuple[str, int], ...]] = {
+    "CamProgramKind": (("CAM_PROGRAM_LAWS", 0), ("CAM_PROGRAM_TABLE", 1)),
+    # where the follower is (physics/modes.py Follower; docs/model.md 13.7), its value the flank's sign along X:
+    # a flying follower held by the guide's friction is CAM_IN_FLIGHT with CamMode.sigma 0 (halted)
+    "CamFlank": (("CAM_ON_UPPER_FLANK", -1), ("CAM_IN_FLIGHT", 0), ("CAM_ON_LOWER_FLANK", 1)),
+}
 _CTYPES = {"int": ctypes.c_int, "double": ctypes.c_double, "char": ctypes.c_char, "size_t": ctypes.c_size_t,
-           "double*": ctypes.POINTER(ctypes.c_double), "CamStatus": ctypes.c_int, "CamProgramKind": ctypes.c_int}
+           "double*": ctypes.POINTER(ctypes.c_double), "CamStatus": ctypes.c_int, "CamProgramKind": ctypes.c_int,
+           "CamFlank": ctypes.c_int}
 
 
 def _ctype(c_type: str) -> type:

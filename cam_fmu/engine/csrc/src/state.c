@@ -204,10 +204,11 @@ int cam_drive_set_state(CamDrive *d, const double s[CAM_STATE_LEN], CamError *er
                             cam_num(s[k], shown));
     mode.stuck = s[CAM_S_STUCK] != 0.0;
     mode.direction = s[CAM_S_DIRECTION];
-    mode.contact = s[CAM_S_CONTACT] == 1.0 ? 1 : (s[CAM_S_CONTACT] == -1.0 ? -1 : 0);   /* checked below */
+    mode.contact = s[CAM_S_CONTACT] == 1.0 ? CAM_ON_LOWER_FLANK
+                   : (s[CAM_S_CONTACT] == -1.0 ? CAM_ON_UPPER_FLANK : CAM_IN_FLIGHT);   /* checked below */
     mode.s_free = s[CAM_S_S_FREE];
     mode.side = s[CAM_S_SIDE];
-    mode.left = s[CAM_S_LEFT] == -1.0 ? -1 : 1;   /* checked below */
+    mode.left = s[CAM_S_LEFT] == -1.0 ? CAM_ON_UPPER_FLANK : CAM_ON_LOWER_FLANK;   /* checked below */
     mode.sigma = s[CAM_S_SIGMA];
     if ((s[CAM_S_STUCK] != 0.0 && s[CAM_S_STUCK] != 1.0) || (mode.direction != 1.0 && mode.direction != -1.0)
         || (mode.side != 1.0 && mode.side != -1.0 && !(d->model.follower_states && mode.side == 0.0))

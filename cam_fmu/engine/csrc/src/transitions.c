@@ -99,15 +99,15 @@ void cam_initial(const CamModel *m, double theta0, double omega0, double i0, dou
     }
     mode->stuck = omega0 == 0.0;
     mode->direction = omega0 >= 0.0 ? 1.0 : -1.0;
-    mode->contact = 1;
+    mode->contact = CAM_ON_LOWER_FLANK;
     mode->s_free = 0.0;
     mode->side = 1.0;
-    mode->left = 1;
+    mode->left = CAM_ON_LOWER_FLANK;
     mode->sigma = 0.0;
     if (m->backlash) {   /* the paper's step 1: the follower starts where the cam is, centred in the gap */
         double d[4];
         cam_profile_eval(&m->profile, theta0, d);
-        mode->contact = 0;
+        mode->contact = CAM_IN_FLIGHT;   /* free in the gap */
         mode->s_free = d[0];
     }
 }
@@ -174,7 +174,7 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
     mode->direction = direction;
     if (leaves) {
         mode->s_free = d[0] - m->c * mode->contact;
-        mode->contact = 0;
+        mode->contact = CAM_IN_FLIGHT;
     }
 }
 
@@ -203,11 +203,11 @@ void cam_apply_event(const CamModel *m, CamMode *mode, double x[CAM_NX], int cod
     case CAM_EV_CONTACT:
         cam_profile_eval(&m->profile, x[CAM_THETA], d);
         mode->s_free = d[0] - m->c * mode->contact;
-        mode->contact = 0;
+        mode->contact = CAM_IN_FLIGHT;
         break;
     default:   /* ENGAGE_UP, ENGAGE_DOWN: a plastic impact keeps the generalised momentum J_0 omega of the
                 * cam side (a compliant shaft's rotor is not in the impact: the shaft's torque is finite) */
-        mode->contact = code == CAM_EV_ENGAGE_UP ? 1 : -1;
+        mode->contact = code == CAM_EV_ENGAGE_UP ? CAM_ON_LOWER_FLANK : CAM_ON_UPPER_FLANK;
         cam_profile_eval(&m->profile, x[CAM_THETA], d);
         x[CAM_OMEGA] = m->J_0 * x[CAM_OMEGA] / (m->J_0 + m->m * d[1] * d[1]);
         cam_choose_side(m, mode, x, u);

@@ -284,8 +284,8 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
     mode->stuck = y[Y_DIR] == 0.0;
     if (y[Y_DIR] != 0.0)
         mode->direction = y[Y_DIR];
-    mode->contact = contact;
-    mode->left = left;
+    mode->contact = (CamFlank)contact;
+    mode->left = (CamFlank)left;
     x[CAM_GAP] = x[CAM_RATE] = 0.0;
     mode->sigma = 0.0;
     mode->side = 0.0;
@@ -442,8 +442,8 @@ static int vf_init(CamDrive *d, CamError *err)
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
     d->form_u = d->u;
     memset(&d->speed, 0, sizeof d->speed);
-    d->mode.contact = 1;   /* on the flank +1, or (a groove) on its other flank where that one holds */
-    d->mode.left = 1;
+    d->mode.contact = CAM_ON_LOWER_FLANK;   /* or (a groove) on its upper flank where that one holds */
+    d->mode.left = CAM_ON_LOWER_FLANK;
     d->mode.s_free = 0.0;
     d->x[CAM_GAP] = d->x[CAM_RATE] = 0.0;
     {
