@@ -331,9 +331,9 @@ def test_every_solver_runs_a_follower_of_its_own_at_its_order(reference_runs):
 
 def test_rk23_reaches_1e_4_rad_on_the_follower_at_third_order(reference_runs):
     """Issue 38's cheap setting: solver 'rk23' (Bogacki-Shampine 3(2), 3 new stages a step where rk45 takes 6) on
-    `backlash` (closure form) against the reference: rtol 5e-7 (atol 5e-10) is within 1e-4 rad (measured 9.7e-5 rad
-    at 1.08x the kinematic run's cost, docs/performance.md), and the error falls as rtol^(3/4) or so when rtol
-    tightens 10-fold (an error-per-step controller of a third-order pair; measured 9.7e-5 -> 1.6e-5 rad)."""
+    `backlash` (closure form) against the reference: rtol 5e-7 (atol 5e-10) is within 1e-4 rad (measured 8.7e-5 rad
+    at 1.20x the kinematic run's instructions, docs/performance.md), and the error falls as rtol^(3/4) or so when
+    rtol tightens 10-fold (an error-per-step controller of a third-order pair)."""
     errors = {}
     for rtol in (5e-7, 5e-8):
         got, want = _backlash_theta(dict(solver="rk23", rtol=rtol, atol=rtol * 1e-3), reference_runs)

@@ -405,6 +405,12 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->atol = v[CAM_P_ATOL];
     model->max_steps = (long)v[CAM_P_MAX_STEPS];
     model->feature_angle = model->profile.feature_angle;
+    model->lift_scale = model->profile.kind == CAM_PROGRAM_LAWS ? model->profile.lift : 0.0;
+    if (model->profile.kind == CAM_PROGRAM_TABLE) {
+        size_t k;
+        for (k = 0; k < model->profile.table.n; k++)
+            model->lift_scale = fmax(model->lift_scale, fabs(model->profile.table.lift[k]));
+    }
     model->closure = (int)v[CAM_P_CLOSURE];
     model->k_spring = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_K_SPRING] : 0.0;
     model->F_spring0 = model->closure == CAM_CHOICE_CLOSURE_SPRING ? v[CAM_P_F_SPRING0] : 0.0;

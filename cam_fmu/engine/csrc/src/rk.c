@@ -200,6 +200,10 @@ double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWo
         scale = fabs(w->x_new[slot]) > fabs(x[slot]) ? fabs(w->x_new[slot]) : fabs(x[slot]);
         if (slot == CAM_THETA && TWO_PI < scale)   /* theta enters the physics mod 2 pi */
             scale = TWO_PI;
+        if (slot >= CAM_GAP) {   /* the follower's gap: its error is the follower's, on the scale of the lift */
+            double at = slot == CAM_GAP ? m->lift_scale : m->lift_scale * fabs(x[CAM_OMEGA]);
+            scale = at > scale ? at : scale;
+        }
         if (slot == 0)
             total = pow(w->error[slot] / (atol + rtol * scale), 2.0);
         else
