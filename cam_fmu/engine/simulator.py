@@ -243,8 +243,9 @@ class DriveSimulator:
 
     def events(self) -> list[dict[str, Any]]:
         """The transitions of the consistent formulation kept by the engine's log (the last 256), oldest
-        first: its index (counted from the drive's first transition), name, time [s], the state (theta,
-        omega, i) before and after, the mode before."""
+        first: its index (counted from the drive's first transition), name, time [s], the state x before and
+        after (theta, omega, i; all NX slots with a compliant shaft, a train or a follower of its own, whose gap
+        and rate are the last two), the mode before (a follower of its own: its contact, flank left, sigma)."""
         lib = self._lib
         if lib.cam_event_record_sizeof() != ctypes.sizeof(CamEventRecord):
             raise RuntimeError("the engine's CamEventRecord differs from the binding's")
@@ -260,7 +261,8 @@ class DriveSimulator:
             out.append({"index": k, "name": EVENT_NAMES[r.code], "time": r.time,
                         "before": list(r.x_before)[:slots], "after": list(r.x_after)[:slots],
                         "mode_before": {"stuck": bool(mode.stuck), "direction": mode.direction,
-                                        "contact": mode.contact, "s_free": mode.s_free, "side": mode.side}})
+                                        "contact": mode.contact, "s_free": mode.s_free, "side": mode.side,
+                                        "left": mode.left, "sigma": mode.sigma}})
         return out
 
     def run(self, table: Any) -> Any:

@@ -340,3 +340,39 @@ def test_rk23_reaches_1e_4_rad_on_the_follower_at_third_order(reference_runs):
         errors[rtol] = np.max(np.abs(got - want))
     assert errors[5e-7] < 1e-4, errors
     assert 3.0 < errors[5e-7] / errors[5e-8] < 20.0, errors
+
+
+def test_the_followers_transitions_are_the_one_event_tables_in_the_drives_log():
+    """Issue 38: the follower of its own runs in the one hybrid driver, so its transitions are the model's events,
+    logged with the one table's names (lift-off is 'contact', touch-down +1 'engage_up', -1 'engage_down', 'halt') and
+    the state x before and after (its gap and rate the last two slots). On `backlash` (closure form, 2 s at 1 ms):
+    every touch-down ends on the flank (gap and rate 0, plastic) from flight (contact 0 before), every lift-off leaves
+    a flank with the gap at 0; the four landings that carry the motion (|w| > 1 mm/s) are the scipy reference's, at
+    its times to 1e-8 s. The reference (rtol 1e-12) also re-touches at 1e-6 m/s four times on the dwells, where a
+    groove without gravity or spring holds the follower with a contact force of 0 (rounding decides a lift-off there):
+    the engine's grazes, if any, fall on the reference's to 1e-8 s."""
+    from cam_fmu.reference.voltage_flight import VoltageFollowerRun
+
+    scene = find_scene("backlash")
+    params, u = dict(scene.primary.params, closure="form"), scene.u.value(0.0)
+    sim = DriveSimulator(params)
+    sim.set_inputs(u, 0.0, 0.0)
+    for k in range(2000):
+        sim.do_step(k * 1e-3, 1e-3, u, 0.0, 0.0)
+    events = sim.events()
+    assert {e["name"] for e in events} <= {"contact", "engage_up", "engage_down", "halt"}
+    touches = [e for e in events if e["name"].startswith("engage")]
+    for e in touches:
+        assert e["mode_before"]["contact"] == 0 and e["after"][7:] == [0.0, 0.0], e
+    for e in (e for e in events if e["name"] == "contact"):
+        assert e["mode_before"]["contact"] in (1, -1) and e["after"][7] == 0.0, e
+    ref = VoltageFollowerRun(DriveModel(params), scene.u, 1e-12, 1e-13, False, None)
+    ref.run(np.arange(2001) * 1e-3)
+    carrying = [t for t, w, _ in ref.impacts if abs(w) > 1e-3]
+    landings = [e["time"] for e in touches if abs(e["before"][8]) > 1e-3]
+    assert len(carrying) == 4 and len(landings) == 4
+    assert np.max(np.abs(np.array(landings) - carrying)) < 1e-8, (landings, carrying)
+    grazes = [t for t, w, _ in ref.impacts if abs(w) <= 1e-3]
+    for e in touches:
+        if abs(e["before"][8]) <= 1e-3:
+            assert min(abs(e["time"] - t) for t in grazes) < 1e-8, (e["time"], grazes)
