@@ -15,7 +15,7 @@ share everything else::
     u = 3.5                        # or a table: [u] type = "step", time = 0.5, before = 0, after = 3.5
     stop_time = 2.0                # s
     output_interval = 1e-3         # s
-    plot = "fig6"                  # figure kind: 'fig4', 'fig5', 'fig6' or 'time' (default)
+    plot = "fig6"                  # figure kind: a key of plots.scene.PLOTS ('time', the default)
 
     [parameters]                   # names and SI units of parameters.PARAMETERS; angles in rad
     gamma = 3.141592653589793

@@ -92,6 +92,15 @@ def _time(plt: Any, results: Results, drive: str = "voltage") -> tuple[Any, list
     return _panels(plt, results, "time", panels, ncols=2, figsize=(11, 3.6 * ((len(panels) + 1) // 2) + 0.6))
 
 
+ARM_PANEL = ("psi", "arm angle psi", "deg", 180.0 / np.pi)   # an oscillating follower's motion (docs/model.md 16)
+
+
+def _arm_time(plt: Any, results: Results, drive: str = "voltage") -> tuple[Any, list]:
+    """_time with the arm's angle psi where the lift s would be (an oscillating follower's scene)."""
+    panels = tuple(ARM_PANEL if panel[0] == "s" else panel for panel in TIME_PANELS[drive])
+    return _panels(plt, results, "time", panels, ncols=2, figsize=(11, 3.6 * ((len(panels) + 1) // 2) + 0.6))
+
+
 def _panels(plt: Any, results: Results, xname: str, quantities, ncols: int, figsize) -> tuple[Any, list]:
     """One axes per quantity (x = time [s]); with 2+ runs, below each a smaller axes of
     every further run's difference to the primary run (interpolated onto its grid)."""
@@ -157,7 +166,8 @@ def _train(plt: Any, results: Results, drive: str = "voltage") -> tuple[Any, lis
 
 
 PLOTS: dict[str, Callable[[Any, Results, str], tuple[Any, list]]] = {
-    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time, "follower": _follower, "train": _train,
+    "fig4": _fig4, "fig5": _fig5, "fig6": _fig6, "time": _time, "arm_time": _arm_time, "follower": _follower,
+    "train": _train,
 }
 
 

@@ -112,7 +112,8 @@ def test_voltage_drive_time_figure_has_no_voltage_panel():
 def test_every_kind_is_written(tmp_path):
     for kind in PLOTS:
         scene = find_scene({"fig4": "paper_fig4", "fig5": "paper_fig5a", "fig6": "paper_fig6",
-                            "time": "speed_drive", "follower": "spring_bounce", "train": "train_voltage"}[kind])
+                            "time": "speed_drive", "follower": "spring_bounce", "train": "train_voltage",
+                            "arm_time": "packaging_rocker"}[kind])
         assert scene.plot == kind
         path = plot_scene(scene, _fake_results([run.label for run in scene.runs]), tmp_path / f"{kind}.png")
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -239,3 +240,18 @@ def test_the_paper_figures_of_the_speed_drive_show_the_voltage_needed(reference_
         first = next(iter(results.values()))
         assert np.allclose(line.get_ydata(), first["voltage"])
         plt.close(fig)
+
+
+def test_an_oscillating_followers_scene_shows_the_arm_angle():
+    """The packaging rocker (an oscillating roller) draws psi in degrees where a translating follower shows s: its
+    panel is the output psi times 180/pi (here psi = 0.2 rad everywhere: 11.459 deg)."""
+    scene = find_scene("packaging_rocker")
+    results = _fake_results([run.label for run in scene.runs])
+    for r in results.values():
+        r["psi"] = np.full_like(r["time"], 0.2)
+    fig = draw_scene(plt, scene, results)
+    ylabels = _ylabels(fig)
+    line = fig.axes[ylabels.index("arm angle psi [deg]")].get_lines()[0]
+    plt.close(fig)
+    assert "follower s [mm]" not in ylabels
+    assert np.allclose(line.get_ydata(), 0.2 * 180.0 / np.pi)
