@@ -57,22 +57,19 @@ static double lever_rate(const CamModel *m, const double q[4])
 }
 
 double cam_kind_branch(const CamModel *m, const double q[4], double omega, double drive, double direction,
-                       double side, double axial, double *P, double *branch)
+                       double side, double axial, CamKindBranch *out)
 {
-    double A = m->I_f * q[2] * omega * omega + cam_kind_slope(m, q[0]) + axial, J, k, den, omega_dot, b;
-    if (m->mu == 0.0) {
-        J = m->J_0 + m->I_f * q[1] * q[1];
-        omega_dot = (drive - A * q[1]) / J;
-        *branch = 0.0;
-    } else {
-        b = side != 0.0 ? side : (A * m->J_0 + m->I_f * q[1] * drive < 0.0 ? -1.0 : 1.0);
-        k = q[1] + m->mu * cam_kind_lever(m, q) * direction * b;
-        den = m->J_0 + m->I_f * q[1] * k;
-        /* wedged (refused before the run on a 0.1 deg grid, cam_kind_check): no finite answer, the guards stop */
-        omega_dot = den > 0.0 ? (drive - A * k) / den : NAN;
-        *branch = b;
+    double A = m->I_f * q[2] * omega * omega + cam_kind_slope(m, q[0]) + axial, omega_dot;
+    out->b = 0.0;
+    out->k = q[1];
+    if (m->mu != 0.0) {
+        out->b = side != 0.0 ? side : (A * m->J_0 + m->I_f * q[1] * drive < 0.0 ? -1.0 : 1.0);
+        out->k = q[1] + m->mu * cam_kind_lever(m, q) * direction * out->b;
     }
-    *P = A + m->I_f * q[1] * omega_dot;
+    out->den = m->J_0 + m->I_f * q[1] * out->k;
+    /* wedged (refused before the run on a 0.1 deg grid, cam_kind_check): no finite answer, the guards stop */
+    omega_dot = out->den > 0.0 ? (drive - A * out->k) / out->den : NAN;
+    out->P = A + m->I_f * q[1] * omega_dot;
     return omega_dot;
 }
 
@@ -232,8 +229,9 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
 {
     double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, A, dA, dJ, V2, domega_dot = 0.0, P, dP;
-    double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, kk, dk, den;
-    double b = 0.0, sP, Pc, dPc;
+    double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, dk;
+    double sP, Pc, dPc;
+    CamKindBranch branch;
     int n, moving = !mode->stuck, engaged = mode->contact != 0;
     cam_kind_eval(m, theta, q);
     V2 = m->arm && m->W != 0.0 ? -m->W * sin(q[0] + m->psi_0) : 0.0;   /* d2V/dq2 */
@@ -250,13 +248,11 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     }
     A = m->I_f * q[2] * w * w + cam_kind_slope(m, q[0]);
     dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
-    if (moving && m->follower) {   /* (J_0 + I_f q' k) omega_dot = T - M_f d - A k, k = q' + mu lambda d b */
-        if (m->mu != 0.0)   /* the branch cam_rhs holds (model.c: mode->side, or the one that holds) */
-            cam_kind_branch(m, q, w, T - m->M_f * d, d, m->guide_side ? mode->side : 0.0, 0.0, &P, &b);
-        kk = q[1] + m->mu * lam * d * b;
-        dk = q[2] * dtheta + m->mu * d * b * dlam;
-        den = m->J_0 + m->I_f * q[1] * kk;
-        domega_dot = (dT - dA * kk - A * dk - omega_dot * m->I_f * (q[2] * dtheta * kk + q[1] * dk)) / den;
+    if (moving && m->follower) {   /* den omega_dot = T - M_f d - A k on the branch cam_rhs holds (model.c) */
+        cam_kind_branch(m, q, w, T - m->M_f * d, d, m->guide_side ? mode->side : 0.0, 0.0, &branch);
+        dk = q[2] * dtheta + m->mu * d * branch.b * dlam;
+        domega_dot = (dT - dA * branch.k - A * dk - omega_dot * m->I_f * (q[2] * dtheta * branch.k + q[1] * dk))
+                     / branch.den;
     } else if (moving) {
         domega_dot = dT / m->J_0;
     }

@@ -67,12 +67,13 @@ double cam_omega_dot(const CamModel *m, double theta, double omega, double torqu
                      double side, double axial)
 {
     Terms t;
-    double drive = torque - m->M_f * direction, q[4], P, branch;
+    double drive = torque - m->M_f * direction, q[4];
+    CamKindBranch branch;
     if (!(engaged && m->follower))
         return drive / m->J_0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq, its friction */
         cam_kind_eval(m, theta, q);
-        return cam_kind_branch(m, q, omega, drive, direction, side, axial, &P, &branch);
+        return cam_kind_branch(m, q, omega, drive, direction, side, axial, &branch);
     }
     load_terms(m, theta, omega, drive, direction, side, axial, &t);
     if (m->mu == 0.0)
@@ -84,13 +85,14 @@ double cam_side_force(const CamModel *m, double theta, double omega, double torq
                       double axial)
 {
     Terms t;
-    double q[4], P, branch;
+    double q[4];
+    CamKindBranch branch;
     if (m->mu == 0.0 || !m->follower)
         return 0.0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* P: its sign is the kind's friction branch */
         cam_kind_eval(m, theta, q);
-        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, axial, &P, &branch);
-        return P;
+        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, axial, &branch);
+        return branch.P;
     }
     load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, axial, &t);
     return t.n0 + t.sigma * t.kappa * t.f;
