@@ -425,7 +425,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
         cam_model_free(model);
         return status;
     }
-    if (model->mu > 0.0 && model->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* a kind's: cam_kind_check */
+    /* the roller's self-locking in its guide (another type's friction: cam_kind_check's wedge) */
+    if (model->mu > 0.0 && model->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
         double alpha = 0.0, theta = 0.0, locking;
         char a[40], b[40];
         if ((status = max_pressure_angle(&model->profile, model->r_b, &alpha, &theta, err)) != CAM_OK) {
