@@ -126,7 +126,8 @@ _MODEL = (
     _P("M_f", "N.m", 0.012, "shaft friction torque (Coulomb)", low=0.0, high=1e3),
     _P("m", "kg", 0.4, "follower mass", low=0.0, high=1e4),
     _P("G", "N", 4.0, "follower weight", low=0.0, high=1e5),
-    _P("mu", "1", 0.001, "guide friction coefficient", low=0.0, high=0.5),
+    _P("mu", "1", 0.001, "guide friction coefficient (another follower type: its face's sliding or its arm's pivot, "
+       "docs/model.md 16)", low=0.0, high=0.5),
     _P("gamma", "rad", math.pi, "angle of gravity to Z (pi: horizontal mounting)", low=-2 * math.pi, high=2 * math.pi),
     _P("beta", "rad", 0.0, "angle of gravity's XY component to the rise direction X", low=-2 * math.pi, high=2 * math.pi),
     _P("r_b", "m", 0.1, "base-circle radius (keeps the paper profile's pressure angle under 30 deg)", low=1e-4, high=10.0),

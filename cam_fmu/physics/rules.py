@@ -143,7 +143,6 @@ FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_F
 OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
 TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
-GUIDE_FRICTION_ON = Where(Cmp(Num("guide_friction"), "!="), Num("mu"))    # 1: mu where the effect is on
 # The follower's kind (docs/model.md 16): an arm's fields with their units, the arm's three it needs first.
 OSCILLATING = Is("follower_type", ("oscillating_roller", "oscillating_flat"))
 OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
@@ -224,10 +223,6 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),
          "parameter 'follower_type' = {follower_type}: the paper's formulation (steps 1-9) has the translating "
          "roller only; allowed with it: 'translating_roller' (or formulation 'consistent', docs/model.md 16)"),
-    Rule(AllOf(OTHER_KIND, Cmp(GUIDE_FRICTION_ON, "!=")),
-         "parameter 'follower_type' = {follower_type}: the engine runs its friction (mu) not yet; allowed with "
-         "mu = {mu}: 'translating_roller' (or mu = 0 or guide_friction false; the scipy reference runs it: "
-         "simulate_reference(..., follower=FollowerKind(...)))"),
     *(Rule(AllOf(COMPLIANT, Is(name, (choice,))),
            f"parameter 'k_shaft' = {{k_shaft}} N.m/rad: {reason}; allowed with {name} {choice!r}: k_shaft = 0"
            f"{instead}") for (name, choice), (reason, instead) in RIGID_ONLY.items()),

@@ -37,15 +37,28 @@ FOLLOWER = {
     "groove_stuck": {"omega0": 0.0, "u": 0.0, "c": 5e-4},
 }
 # The follower's kind (kind.c, docs/model.md 16) on the scene's cam: an arm with a roller or a flat face, gravity
-# tilted; no guide friction (the engine refuses it with a kind so far).
+# tilted; without and with the type's friction (mu: the face's sliding, the arm's pivot; the branch sgn(P) held).
 ARM = {"arm_length": 0.15, "pivot_distance": 0.18, "J_arm": 2e-3, "m_arm": 0.2, "r_cm_arm": 0.07, "psi_0": 0.3,
        "mu": 0.0, "gamma": 1.2}
+# With friction, a cycloidal rise, dwell, return, dwell of 90 deg each (its s'' of one sign over most of a rise: the
+# lever's rate psi'' is not small where the default law's middle runs at nearly constant speed).
+CYCLOID = {"rise_law": "cycloidal", "return_law": "cycloidal", "rise_angle": math.pi / 2, "upper_dwell": math.pi / 2,
+           "return_angle": math.pi / 2, "lower_dwell": math.pi / 2, "lift": 0.02, "r_b": 0.08, "J_cam": 2e-4}
 KIND = {
     "oscillating_roller": {"omega0": 20.0, "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM},
     "oscillating_roller_stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3, "theta0": 1.0,
                                    "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM},
     "oscillating_flat_L": {"omega0": 20.0, "L": 1e-3, "follower_type": "oscillating_flat", "lift_angle": 0.15, **ARM},
     "translating_flat": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.0, "gamma": 1.2, "beta": 0.7},
+    "oscillating_roller_friction": {"omega0": 20.0, "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM,
+                                    **CYCLOID, "mu": 0.05},
+    "oscillating_roller_friction_stuck_L": {"omega0": 0.0, "u": 0.0, "L": 1e-3, "theta0": 1.0,
+                                            "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM,
+                                            **CYCLOID, "mu": 0.05},
+    "oscillating_flat_friction_L": {"omega0": 20.0, "L": 1e-3, "follower_type": "oscillating_flat",
+                                    "lift_angle": 0.15, **ARM, **CYCLOID, "mu": 0.05},
+    "translating_flat_friction": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2,
+                                  "beta": 0.7, **CYCLOID},
 }
 FLIGHT = {"spring_in_flight", "spring_in_flight_tilted", "spring_in_flight_L", "spring_in_flight_compliant_L"}
 CASES = {

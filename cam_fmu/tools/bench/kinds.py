@@ -1,6 +1,6 @@
 """Each follower type's cost against the translating roller's on the same law (issue 40; docs/model.md 16;
 variants.py measures): the consistent voltage drive at 3.5 V for 2 s at 1 ms steps, the default rk45, guide
-friction off (the engine runs the other types without it so far), base circle 80 mm, the arm's geometry of
+friction off (the runs differ by the follower's geometry and inertia alone), base circle 80 mm, the arm's geometry of
 tests/engine/test_engine_follower_kinds.py."""
 from __future__ import annotations
 

@@ -3,7 +3,8 @@
  * seed of the states and the input u, at a fixed mode. Exact to rounding, no differencing; the FMI 2.0 Model
  * Exchange glue forwards fmi2GetDirectionalDerivative here (fmi/directional.c; docs/fmu.md, "Model Exchange").
  * Every mode of the drive whose cam carries the follower (rigid or compliant, L = 0 or L > 0, engaged with or without
- * guide friction, free in the clearance, stuck); a follower of its own: jacobian_follower.c. */
+ * guide friction, free in the clearance, stuck; every follower type, kind.c's cam_kind_tangent); a follower of its
+ * own: jacobian_follower.c. */
 #include <math.h>
 
 #include "cam_model.h"
@@ -93,8 +94,9 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     double w, dw, s1, ds1, t, dt, a, da, push, root, i_dot, sigma, f, df, along, dalong, F, dF = 0.0;
     int k, engaged = mode->contact != 0, moving = !mode->stuck;
     cam_rhs(m, mode, x, u, dx);
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: rigid shaft, no train, no guide friction */
-        return cam_kind_tangent(m, mode, x, seed, dT_motor, du, dx[CAM_OMEGA], ddx, dout);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: rigid shaft, no train */
+        return cam_kind_tangent(m, mode, x, seed, cam_drive_torque(m, x, omega, u), dT_motor, du, dx[CAM_OMEGA], ddx,
+                                dout);
     cam_profile_eval(&m->profile, theta, d);
     for (k = 0; k < CAM_NX; k++)
         ddx[k] = 0.0;

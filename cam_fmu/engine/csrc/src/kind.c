@@ -1,12 +1,17 @@
 /* The follower's kind in the drive (docs/model.md 16; physics/kind_drive.py, the reference): a translating flat
  * face, or an arm about a pivot with a roller or a flat face. One degree of freedom, theta: the follower's coordinate
  * q = s (translating) or psi = lift_angle s / lift (an arm), its inertia I_f = m or J_arm + m L^2, its potential
- * V = -F_gx s or W sin(psi + psi_0); P = I_f (q'' omega^2 + q' omega_dot) + dV/dq moves it, M = M_f sgn + P q'. */
+ * V = -F_gx s or W sin(psi + psi_0); P = I_f (q'' omega^2 + q' omega_dot) + dV/dq moves it, and the load torque is
+ * M = M_f d + P q' + mu |P| lambda d (d = sgn(omega)), the friction's lever lambda >= 0 the type's (cam_kind_lever).
+ * The drive equation J_0 omega_dot = T - M_f d - P q' - mu |P| lambda d is solved on the branch b = sgn(P):
+ * (J_0 + I_f q' k) omega_dot = T - M_f d - A k, A = I_f q'' omega^2 + dV/dq, k = q' + mu lambda d b (cam_kind_branch,
+ * the one place of that equation). */
 #include <math.h>
 
 #include "cam_model.h"
 
 #define PI 3.141592653589793
+#define WEDGE_GRID 3600   /* angles over a turn where the friction's wedging is tested (kind_drive.LOCKING_GRID) */
 
 void cam_kind_eval(const CamModel *m, double theta, double q[4])
 {
@@ -29,6 +34,45 @@ double cam_kind_potential(const CamModel *m, double q, double s)
     return m->arm ? m->W * sin(q + m->psi_0) : -m->F_gx * s;
 }
 
+double cam_kind_lever(const CamModel *m, const double q[4])
+{
+    if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_FLAT)   /* the face slides at r_b + s from the cam axis */
+        return m->r_b + q[0];
+    if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT)   /* p / l: the cam's offset over the contact's arm */
+        return tan(m->delta0 + q[0]) * (1.0 - q[1]);
+    return fabs(q[1]);   /* the roller arm: the pivot's Coulomb torque mu |P| against the arm's turn */
+}
+
+/* d(lambda)/d(theta) at q (q[4]): the lever's rate along the cam (cam_kind_lever). */
+static double lever_rate(const CamModel *m, const double q[4])
+{
+    double t;
+    if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_FLAT)
+        return q[1];
+    if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT) {
+        t = tan(m->delta0 + q[0]);
+        return (1.0 + t * t) * q[1] * (1.0 - q[1]) - t * q[2];
+    }
+    return (q[1] > 0.0 ? 1.0 : (q[1] < 0.0 ? -1.0 : 0.0)) * q[2];
+}
+
+double cam_kind_branch(const CamModel *m, const double q[4], double omega, double drive, double direction,
+                       double side, double axial, CamKindBranch *out)
+{
+    double A = m->I_f * q[2] * omega * omega + cam_kind_slope(m, q[0]) + axial, omega_dot;
+    out->b = 0.0;
+    out->k = q[1];
+    if (m->mu != 0.0) {
+        out->b = side != 0.0 ? side : (A * m->J_0 + m->I_f * q[1] * drive < 0.0 ? -1.0 : 1.0);
+        out->k = q[1] + m->mu * cam_kind_lever(m, q) * direction * out->b;
+    }
+    out->den = m->J_0 + m->I_f * q[1] * out->k;
+    /* wedged (refused before the run on a 0.1 deg grid, cam_kind_check): no finite answer, the guards stop */
+    omega_dot = out->den > 0.0 ? (drive - A * out->k) / out->den : NAN;
+    out->P = A + m->I_f * q[1] * omega_dot;
+    return omega_dot;
+}
+
 void cam_kind_outputs(const CamModel *m, double theta, double omega, double out[])
 {
     double q[4];
@@ -42,7 +86,7 @@ void cam_kind_outputs(const CamModel *m, double theta, double omega, double out[
 void cam_kind_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
                    CamLoad *out)
 {
-    double q[4], P, alpha = 0.0, N;
+    double q[4], P, alpha = 0.0, N, friction;
     int k;
     cam_profile_eval(&m->profile, theta, q);
     out->s_cam = q[0];
@@ -58,20 +102,51 @@ void cam_kind_load(const CamModel *m, double theta, double omega, double omega_d
         return;
     }
     P = m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0]);
+    friction = m->mu != 0.0 ? m->mu * fabs(P) * cam_kind_lever(m, q) : 0.0;   /* N m on the cam, against its turn */
     N = P;
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {   /* the rocker's triangle (15.1) */
-        double delta = m->delta0 + q[0], d = m->pivot_distance, L = m->arm_length;
+        double delta = m->delta0 + q[0], d = m->pivot_distance, L = m->arm_length, turn = q[1] * direction;
         alpha = atan2(d * cos(delta) - L * (1.0 - q[1]), d * sin(delta));
-        N = P / (L * cos(alpha));
+        /* the contact supplies P and the pivot's friction against the arm's turn */
+        N = (m->mu != 0.0 ? P + m->mu * fabs(P) * (turn > 0.0 ? 1.0 : (turn < 0.0 ? -1.0 : 0.0)) : P)
+            / (L * cos(alpha));
     } else if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT) {   /* the face at l from the pivot (15.2) */
         N = P * (1.0 - q[1]) / (m->pivot_distance * cos(m->delta0 + q[0]));
     }
     out->alpha = alpha;
-    out->M = m->M_f * direction + P * q[1];
+    out->M = m->mu != 0.0 ? m->M_f * direction + P * q[1] + friction * direction : m->M_f * direction + P * q[1];
+    out->f = m->mu * fabs(N);   /* the reference's friction field (no output of its own) */
     out->J = m->J_0 + m->I_f * q[1] * q[1];
     out->N = N;
     out->v = q[1] / m->q_scale * omega;   /* the law's lift rates, as the reference's */
     out->a = q[2] / m->q_scale * omega * omega + q[1] / m->q_scale * omega_dot;
+}
+
+/* The friction's wedging (kind_drive.KindDriveModel._check_locking): the drive equation's J_0 + I_f q' k must stay
+ * > 0 on either branch, J_0 + I_f (q'^2 - |q'| mu lambda) > 0 at every 0.1 deg, else refused with the reference's
+ * message. */
+static int wedge_check(const CamModel *m, CamError *err)
+{
+    double worst = INFINITY, at = 0.0, theta, value, q[4];
+    char a[40], b[40];
+    int k;
+    if (m->mu == 0.0 || m->I_f == 0.0)
+        return CAM_OK;
+    for (k = 0; k <= WEDGE_GRID; k++) {
+        theta = 2.0 * PI * k / WEDGE_GRID;
+        cam_kind_eval(m, theta, q);
+        value = m->J_0 + m->I_f * (q[1] * q[1] - fabs(q[1]) * m->mu * cam_kind_lever(m, q));
+        if (value < worst) {
+            worst = value;
+            at = theta;
+        }
+    }
+    if (worst <= 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameters 'mu' = %s and 'r_b' = %s m wedge the %s follower by its "
+                         "friction at theta = %.4g deg (J_0 + I_f q' (q' - mu lambda) = %.4g kg m2 <= 0): allowed "
+                         "where it stays > 0 (lower mu or add inertia J_cam)", cam_num(m->mu, a), cam_num(m->r_b, b),
+                         cam_param_spec(CAM_P_FOLLOWER_TYPE)->choices[m->kind], at * (180.0 / PI), worst);
+    return CAM_OK;
 }
 
 /* The refusals of geometry that cannot be built whose limits are closed forms (kinematics/follower_checks.py and
@@ -101,7 +176,7 @@ int cam_kind_check(const CamModel *m, CamError *err)
                              "perpendicular to the cam axis; allowed < pi/2 - delta0 = %.6g rad (sin delta0 = r_b / d)",
                              cam_num(lift_angle, a), top);
     }
-    return CAM_OK;
+    return wedge_check(m, err);
 }
 
 void cam_kind_init(CamModel *m)
@@ -150,11 +225,13 @@ static void contact_tangent(const CamModel *m, const double q[4], double P, doub
 }
 
 int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], const double seed[CAM_NX],
-                     double dT, double du, double omega_dot, double ddx[CAM_NX], double dout[])
+                     double T, double dT, double du, double omega_dot, double ddx[CAM_NX], double dout[])
 {
     double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
-    double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, B, dB, J, dJ, V2, domega_dot = 0.0, P, dP;
-    double k = m->q_scale, dalpha, dN;
+    double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, A, dA, dJ, V2, domega_dot = 0.0, P, dP;
+    double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, dk;
+    double sP, Pc, dPc;
+    CamKindBranch branch;
     int n, moving = !mode->stuck, engaged = mode->contact != 0;
     cam_kind_eval(m, theta, q);
     V2 = m->arm && m->W != 0.0 ? -m->W * sin(q[0] + m->psi_0) : 0.0;   /* d2V/dq2 */
@@ -164,12 +241,22 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         omega_dot = 0.0;
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
-    J = m->J_0 + m->I_f * q[1] * q[1];
     dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;
-    if (moving) {   /* J omega_dot = T - M_f d - (I_f q'' w^2 + V'(q)) q' */
-        B = m->I_f * q[2] * w * w + cam_kind_slope(m, q[0]);
-        dB = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
-        domega_dot = (dT - dB * q[1] - B * q[2] * dtheta - omega_dot * dJ) / J;
+    if (m->mu != 0.0) {   /* the friction's lever and its rate */
+        lam = cam_kind_lever(m, q);
+        dlam = lever_rate(m, q) * dtheta;
+    }
+    A = m->I_f * q[2] * w * w + cam_kind_slope(m, q[0]);
+    dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
+    if (moving && m->follower) {   /* den omega_dot = T - M_f d - A k on the branch cam_rhs holds (model.c) */
+        cam_kind_branch(m, q, w, T - m->M_f * d, d, m->guide_side ? mode->side : 0.0, 0.0, &branch);
+        dk = q[2] * dtheta + m->mu * d * branch.b * dlam;
+        domega_dot = (dT - dA * branch.k - A * dk - omega_dot * m->I_f * (q[2] * dtheta * branch.k + q[1] * dk))
+                     / branch.den;
+    } else if (moving) {
+        domega_dot = dT / m->J_0;
+    }
+    if (moving) {
         ddx[CAM_THETA] = domega;
         ddx[CAM_OMEGA] = domega_dot;
     }
@@ -182,16 +269,23 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     dout[CAM_O_I] = m->has_current ? di : (du - m->c_e * domega) / m->R;
     dout[CAM_O_VOLTAGE] = du;
     dout[CAM_O_S] = dout[CAM_O_S_CAM] = q[1] / k * dtheta;
-    if (engaged) {
-        P = m->I_f * (q[2] * w * w + q[1] * omega_dot) + cam_kind_slope(m, q[0]);
-        dP = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot + q[1] * domega_dot)
-             + V2 * q[1] * dtheta;
-        contact_tangent(m, q, P, dP, dtheta, &dalpha, &dN);
+    if (engaged) {   /* cam_kind_load at the state's omega_dot */
+        P = A + m->I_f * q[1] * omega_dot;
+        dP = dA + m->I_f * (q[2] * dtheta * omega_dot + q[1] * domega_dot);
+        sP = P > 0.0 ? 1.0 : (P < 0.0 ? -1.0 : 0.0);
+        Pc = P;   /* the roller arm's contact supplies P and the pivot's friction against the arm's turn */
+        dPc = dP;
+        if (m->mu != 0.0 && m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {
+            double turn = q[1] * d, st = turn > 0.0 ? 1.0 : (turn < 0.0 ? -1.0 : 0.0);
+            Pc = P + m->mu * fabs(P) * st;
+            dPc = dP + m->mu * sP * dP * st;
+        }
+        contact_tangent(m, q, Pc, dPc, dtheta, &dalpha, &dN);
         dout[CAM_O_J] = dJ;
         dout[CAM_O_V] = (q[2] * dtheta * w + q[1] * dw) / k;
         dout[CAM_O_A] = (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot
                          + q[1] * domega_dot) / k;
-        dout[CAM_O_M] = dP * q[1] + P * q[2] * dtheta;
+        dout[CAM_O_M] = dP * q[1] + P * q[2] * dtheta + m->mu * d * (sP * dP * lam + fabs(P) * dlam);
         dout[CAM_O_ALPHA] = dalpha;
         dout[CAM_O_N_CONTACT] = dN;
     }

@@ -46,12 +46,6 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
                        double axial, Terms *t)
 {
     double s, s1, mass, J, inertial, tan_a;
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq (no guide friction) */
-        cam_kind_eval(m, theta, t->d);
-        t->J = m->J_0 + m->I_f * t->d[1] * t->d[1];
-        t->x0 = (drive - (m->I_f * t->d[2] * omega * omega + cam_kind_slope(m, t->d[0]) + axial) * t->d[1]) / t->J;
-        return;
-    }
     cam_profile_eval(&m->profile, theta, t->d);
     s = t->d[0];
     s1 = t->d[1];
@@ -73,9 +67,14 @@ double cam_omega_dot(const CamModel *m, double theta, double omega, double torqu
                      double side, double axial)
 {
     Terms t;
-    double drive = torque - m->M_f * direction;
+    double drive = torque - m->M_f * direction, q[4];
+    CamKindBranch branch;
     if (!(engaged && m->follower))
         return drive / m->J_0;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq, its friction */
+        cam_kind_eval(m, theta, q);
+        return cam_kind_branch(m, q, omega, drive, direction, side, axial, &branch);
+    }
     load_terms(m, theta, omega, drive, direction, side, axial, &t);
     if (m->mu == 0.0)
         return t.x0;
@@ -86,8 +85,15 @@ double cam_side_force(const CamModel *m, double theta, double omega, double torq
                       double axial)
 {
     Terms t;
+    double q[4];
+    CamKindBranch branch;
     if (m->mu == 0.0 || !m->follower)
         return 0.0;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* P: its sign is the kind's friction branch */
+        cam_kind_eval(m, theta, q);
+        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, axial, &branch);
+        return branch.P;
+    }
     load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, axial, &t);
     return t.n0 + t.sigma * t.kappa * t.f;
 }
@@ -425,7 +431,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
         cam_model_free(model);
         return status;
     }
-    if (model->mu > 0.0) {
+    /* the roller's self-locking in its guide (another type's friction: cam_kind_check's wedge) */
+    if (model->mu > 0.0 && model->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
         double alpha = 0.0, theta = 0.0, locking;
         char a[40], b[40];
         if ((status = max_pressure_angle(&model->profile, model->r_b, &alpha, &theta, err)) != CAM_OK) {
