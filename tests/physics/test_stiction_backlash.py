@@ -57,7 +57,9 @@ def _run_sim(params, u, steps, h=1e-3, events=None):
             fresh = [e for e in sim.events() if e["index"] > seen]
             assert not fresh or fresh[0]["index"] == seen + 1, "the log dropped transitions"
             seen = fresh[-1]["index"] if fresh else seen
-            events += [(e["name"], e["before"], e["after"], Mode(**e["mode_before"])) for e in fresh]
+            events += [(e["name"], e["before"], e["after"],   # the rigid drive's mode (no follower's own fields)
+                        Mode(**{k: v for k, v in e["mode_before"].items() if k not in ("left", "sigma")}))
+                       for e in fresh]
     return {name: np.array([r[name] for r in rows]) for name in rows[0]}
 
 

@@ -113,9 +113,9 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
             snprintf(e, sizeof e, "%g", time);
             *dt_out = dt;
             return cam_error(err, CAM_ERR_REJECTED,
-                            "solver 'rk45' cannot meet rtol = %s, atol = %s: its step fell below %s s (1e-12 of "
+                            "solver '%s' cannot meet rtol = %s, atol = %s: its step fell below %s s (1e-12 of "
                             "the communication step) at t = %s s: loosen rtol/atol, or check the inputs and "
-                            "parameters for a near-singular drive%s", a, b, c, e, cause);
+                            "parameters for a near-singular drive%s", it->method->name, a, b, c, e, cause);
         }
     }
 }
