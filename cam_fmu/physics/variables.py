@@ -67,8 +67,8 @@ def output_record(**values: Any) -> dict[str, float]:
              "psi_dot": 0.0}
     return {name: values[name] if name in values else rigid[name] for name in OUTPUT_NAMES}
 
-# Model Exchange's states: the engine's x[CAM_NX] (cam_model.h's slots, in order), then a free follower's gap and
-# its rate (cam_contract.h CAM_ME_GAP, generated from engine/contract.py ME_SLOTS; docs/model.md 13.6), each with
+# Model Exchange's states: the engine's x[CAM_NX] (engine/contract.py X_SLOTS, in order), whose last two are a free
+# follower's gap and its rate (CAM_GAP, CAM_RATE; docs/model.md 13.6), each with
 # its derivative variable ``der(<name>)``; value references after the parameters (the co-simulation references
 # above stay where they were). The C build checks the count against CAM_ME_NX. A rigid drive carries the first three only: x_twist and x_omega_m are then held
 # (derivative 0); x_gap and x_gap_rate are held at 0 in contact and without a follower of its own.
