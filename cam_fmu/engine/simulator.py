@@ -22,7 +22,8 @@ from .library import load
 __all__ = ["DriveSimulator", "run_scene"]
 
 N_OUTPUTS = len(OUTPUT_NAMES)
-NX, NX_RIGID = contract.NX, contract.NX_RIGID  # the state slots (theta, omega, i, twist, omega_m)
+NX, NX_RIGID = contract.NX, contract.NX_RIGID  # the state slots (contract.X_SLOTS)
+STATE_NAMES = tuple(name.lower() for name, _ in contract.X_SLOTS)  # theta, omega, current, twist, omega_m, ...
 SLOTS = contract.state_slots()  # the saved state's entries (CAM_S_*), from the one layout
 S_TIME, S_U, S_OMEGA_REF, S_OMEGA_DOT_REF = SLOTS["TIME"], SLOTS["U"], SLOTS["OMEGA_REF"], SLOTS["OMEGA_DOT_REF"]
 S_H_NEXT, S_STEPS_TAKEN, S_X, S_STUCK = SLOTS["H_NEXT"], SLOTS["STEPS_TAKEN"], SLOTS["X"], SLOTS["STUCK"]
@@ -223,7 +224,7 @@ class DriveSimulator:
         y = [float(v) for v in state["y"]]
         if len(y) != nx:
             raise SimulationError(f"state 'y' has length {len(y)}, this drive's state has {nx} "
-                                  "(theta, omega" + {2: ")", 3: ", i)", 5: ", i, twist, omega_m)"}[nx])
+                                  f"({', '.join(STATE_NAMES[:nx])})")
         mode = state["mode"]
         s[S_TIME], s[S_U], s[S_OMEGA_REF] = float(state["time"]), float(state["u"]), float(state["omega_ref"])
         s[S_OMEGA_DOT_REF], s[S_H_NEXT] = float(state["omega_dot_ref"]), float(state["h_next"])

@@ -205,3 +205,16 @@ def test_property_a_restored_state_is_one_the_drive_can_be_in_and_a_refused_one_
     out = sim.outputs()
     assert all(math.isfinite(v) for v in out.values())
     assert abs(out["s"] - out["s_cam"]) <= params.get("c", 0.0) * (1 + 1e-9) + 1e-12
+
+
+@pytest.mark.parametrize("params", [{}, {"k_shaft": 40.0, "J_cam": 2e-5}, {"c": 5e-4}],
+                         ids=["rigid", "compliant", "own follower"])
+def test_a_state_of_the_wrong_length_is_refused_naming_the_slots(params):
+    """A saved 'y' one slot short: the error names both lengths and this drive's slots (a drive with all nine slots
+    raised KeyError here before)."""
+    sim = _moving(params)
+    state = sim.get_state()
+    n = len(state["y"])
+    state["y"] = state["y"][:-1]
+    with pytest.raises(SimulationError, match=rf"length {n - 1}, this drive's state has {n} \(theta, omega"):
+        sim.set_state(state)

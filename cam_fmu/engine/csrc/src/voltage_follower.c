@@ -172,10 +172,7 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     return fabs(net) > cam_follower_friction0(m) ? sgn(net) : 0.0;
 }
 
-/* cam_vf_rates, and on a moving flank the contact's force *P [N] along X and the guide's side force *n_r [N] (else
- * both untouched). */
-static void flank_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY], double *P,
-                        double *n_r)
+void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
     dy[0] = y[1];
@@ -189,8 +186,8 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
         return;
     }
     if (contact) {
-        double d[4];
-        flank_terms(m, y, u, contact, d, &dy[1], P, n_r);
+        double d[4], P, n_r;
+        flank_terms(m, y, u, contact, d, &dy[1], &P, &n_r);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         return;
@@ -198,12 +195,6 @@ static void flank_rates(const CamModel *m, double u, int contact, const double y
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
-}
-
-void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
-{
-    double P, n_r;
-    flank_rates(m, u, contact, y, dy, &P, &n_r);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -249,26 +240,6 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
  * its relative accuracy, not with theta's absolute error times s' (docs/model.md 13.6). The mode holds the contact
  * (+1, -1 on a flank, 0 off them), the flank left last, the flying direction sigma and the shaft's (stuck,
  * direction). */
-
-void cam_vf_y(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double y[NY])
-{
-    double dd[4];
-    y[0] = x[CAM_THETA];
-    y[1] = x[CAM_OMEGA];
-    y[2] = x[CAM_CURRENT];
-    y[Y_TWIST] = m->compliant ? x[CAM_TWIST] : 0.0;
-    y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
-    cam_profile_eval(&m->profile, y[0], dd);
-    if (mode->contact) {
-        y[3] = dd[0] - mode->contact * cam_vf_clearance(m);
-        y[4] = dd[1] * y[1];
-    } else {
-        y[3] = dd[0] - mode->left * cam_vf_clearance(m) + mode->left * x[CAM_GAP];
-        y[4] = dd[1] * y[1] + mode->left * x[CAM_RATE];
-    }
-    y[Y_SIGMA] = mode->contact ? 0.0 : mode->sigma;
-    y[Y_DIR] = mode->stuck ? 0.0 : mode->direction;
-}
 
 void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int left, double x[CAM_NX],
               CamMode *mode)
@@ -319,6 +290,14 @@ static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM
     }
 }
 
+void cam_vf_y(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double y[NY])
+{
+    double dd[4];
+    working_y(m, mode, x, y, dd);
+    if (mode->contact)
+        cam_vf_set_on_flank(m, y, mode->contact);
+}
+
 void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
     double y[NY], dy[NY], dd[4];
@@ -357,15 +336,6 @@ int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENT
     return n;
 }
 
-double cam_vf_value(const CamModel *m, const CamMode *mode, int code, const double x[CAM_NX], double u)
-{
-    double y[NY];
-    cam_vf_y(m, mode, x, y);
-    if (code == EV_SIDE)   /* the side force past 0 by CAM_SIDE_HYSTERESIS against its sign at the step's start */
-        return mode->side * side_force(m, y, u, mode->contact) + CAM_SIDE_HYSTERESIS;
-    return cam_vf_event_value(m, u, code, mode->contact, y);
-}
-
 void cam_vf_values(const CamModel *m, const CamMode *mode, int n, const int codes[], const double x[CAM_NX],
                    double u, double g[])
 {
@@ -379,6 +349,13 @@ void cam_vf_values(const CamModel *m, const CamMode *mode, int n, const int code
                : (codes[k] == EV_SIDE ? mode->side * n_r + CAM_SIDE_HYSTERESIS
                                       : cam_vf_event_value(m, u, codes[k], mode->contact, y));
     }
+}
+
+double cam_vf_value(const CamModel *m, const CamMode *mode, int code, const double x[CAM_NX], double u)
+{
+    double g;
+    cam_vf_values(m, mode, 1, &code, x, u, &g);
+    return g;
 }
 
 /* s: the longest step the follower's phases allow at the drive's state at `time` [s] (the flight's oscillation,
@@ -422,11 +399,11 @@ static void vf_transition(CamDrive *d, int code, double time)
     double y[NY], rebound = d->speed.rebound > time ? d->speed.rebound - time : 0.0;
     int contact = d->mode.contact, left = d->mode.left;
     long dropped = 0;
-    cam_vf_y(m, &d->mode, d->x, y);
     if (code == EV_SIDE) {   /* the friction's branch turned: nothing else happens */
         d->mode.side = -d->mode.side;
         return;
     }
+    cam_vf_y(m, &d->mode, d->x, y);
     cam_vf_event_update(d, y, d->form_u, code, &contact, &left, &rebound, time, &dropped);
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),

@@ -175,11 +175,10 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
 {
     const CamModel *m = &d->model;
-    double y[NY], g = x[CAM_GAP];
+    double g = x[CAM_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
         return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + CAM_TOUCH;
-    cam_vf_y(m, &d->mode, x, y);
-    return cam_vf_event_value(m, d->form_u, code, d->mode.contact, y);
+    return cam_vf_value(m, &d->mode, code, x, d->form_u);
 }
 
 int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
