@@ -214,11 +214,17 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(OSCILLATING, Cmp(Num("gravity"), "!="), Cmp(Num("beta"), "!=")),
          "parameter 'beta' = {beta} rad is not used by follower_type {follower_type} (the arm's angle to gravity is "
          "its psi_0): leave it at 0"),
-    Rule(AllOf(OTHER_KIND, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="), COMPLIANT, TRAIN,
-                                 AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
-         "parameter 'follower_type' = {follower_type}: runs with the follower on the cam (closure 'kinematic', or "
-         "'form' without clearance), a rigid shaft, no follower train and a solver other than 'etdrk4' (which "
-         "integrates the roller's electrical pole) so far; allowed with closure {closure}, c = {c} m, k_shaft = "
+    Rule(AllOf(OTHER_KIND, Cmp(CLEARANCE, "!="), Not(OWN_FOLLOWER)),
+         "parameter 'c' = {c} m with follower_type {follower_type}: a clearance needs the follower as a body of its "
+         "own (closure 'form' with the follower's mass m > 0, in the consistent formulation or the speed drive; "
+         "docs/model.md 16.3); allowed with closure {closure}: c = 0"),
+    Rule(AllOf(OSCILLATING, OWN_FOLLOWER, Is("drive", ("speed",)), Cmp(Num("gravity"), "!=")),
+         "parameter 'gravity' = {gravity} with follower_type {follower_type} and closure {closure} in the speed "
+         "drive: its flight is integrated in closed form (a spring and a constant force), which an arm's weight "
+         "torque W cos(psi + psi_0) is not; allowed with it: gravity false (or drive 'voltage', docs/model.md 16.3)"),
+    Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, TRAIN, AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
+         "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train and a solver "
+         "other than 'etdrk4' (which integrates the roller's electrical pole) so far; allowed with k_shaft = "
          "{k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: 'translating_roller'"),
     Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),
          "parameter 'follower_type' = {follower_type}: the paper's formulation (steps 1-9) has the translating "
