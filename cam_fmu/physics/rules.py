@@ -219,7 +219,7 @@ RULES: tuple[Rule, ...] = (
          "own (closure 'form' with the follower's mass m > 0, in the consistent formulation or the speed drive; "
          "docs/model.md 16.3); allowed with closure {closure}: c = 0"),
     Rule(AllOf(OSCILLATING, OWN_FOLLOWER, Is("drive", ("speed",)), Cmp(Num("gravity"), "!=")),
-         "parameter 'gravity' = {gravity} with follower_type {follower_type} and closure {closure} in the speed "
+         "parameter 'gravity' = true with follower_type {follower_type} and closure {closure} in the speed "
          "drive: its flight is integrated in closed form (a spring and a constant force), which an arm's weight "
          "torque W cos(psi + psi_0) is not; allowed with it: gravity false (or drive 'voltage', docs/model.md 16.3)"),
     Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, TRAIN, AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),

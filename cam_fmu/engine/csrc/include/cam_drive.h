@@ -105,10 +105,6 @@ int cam_locate_first_event(int n, const int codes[], double a, double b, const d
 typedef enum { EV_NONE = -2, EV_BREAK = -1, EV_STOP = CAM_EV_STOP, EV_LIFT_OFF = CAM_EV_CONTACT,
                EV_TOUCH_UP = CAM_EV_ENGAGE_UP, EV_TOUCH_DOWN = CAM_EV_ENGAGE_DOWN, EV_BREAK_AWAY = CAM_EV_BREAK_AWAY,
                EV_SIDE = CAM_EV_SIDE_FORCE, EV_HALT = CAM_EV_HALT } CamFollowerEvent;
-/* N: the force closing the follower onto its +1 flank at s [m], F_spring0 + k_spring s - F_gx, and the guide's
- * friction at no contact force, mu (|G_y| + |N_g|): both drives' followers' (follower.c). */
-double cam_follower_closing(const CamModel *m, double s);
-double cam_follower_friction0(const CamModel *m);
 #define CAM_TOUCH 1e-12         /* m: a touch-down is located this far inside the flank (reference/flight.py TOUCH) */
 #define CAM_ZENO_HEIGHT 1e-9    /* m: a rebound rising less ends in contact (physics/speed_follower.py ZENO_HEIGHT) */
 

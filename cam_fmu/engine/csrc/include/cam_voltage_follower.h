@@ -18,8 +18,6 @@
 /* N m: what drives the cam side (the motor's torque, or a compliant shaft's) less the shaft's friction against the
  * direction dir (0: the drive alone). */
 double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, double dir);
-/* m: a groove's clearance (closure 'form'), 0 for a spring's one flank. */
-double cam_vf_clearance(const CamModel *m);
 /* The flying follower's direction sgn(v), or at a halt where the net force pushes it (0: held by friction). */
 double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
 /* The rates of y on the flank `contact` (0: in flight) under the input u [V]. */

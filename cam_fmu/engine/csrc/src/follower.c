@@ -46,20 +46,39 @@ static double theta_at(const Motion *mo, double tau)
     return mo->theta0 + (mo->omega0 + 0.5 * mo->omega_dot * tau) * tau;
 }
 
-double cam_follower_closing(const CamModel *m, double s)
+double cam_follower_closing(const CamModel *m, double q)
 {
-    return m->F_spring0 + m->k_spring * s - m->F_gx;
+    if (m->arm)
+        return m->arm_length * (m->F_spring0 + m->k_spring * m->arm_length * q) + cam_kind_slope(m, q);
+    return m->F_spring0 + m->k_spring * q - m->F_gx;
 }
 
 double cam_follower_friction0(const CamModel *m)
 {
-    return m->mu * (fabs(m->G_y) + m->N_g);
+    return m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER ? m->mu * (fabs(m->G_y) + m->N_g) : 0.0;
+}
+
+double cam_follower_stiffness(const CamModel *m)
+{
+    return m->arm ? m->k_spring * m->arm_length * m->arm_length : m->k_spring;
+}
+
+double cam_follower_clearance(const CamModel *m)
+{
+    if (m->closure != CAM_CHOICE_CLOSURE_FORM)
+        return 0.0;
+    return m->arm ? m->c / m->arm_length : m->c;
+}
+
+double cam_follower_length(const CamModel *m)
+{
+    return m->arm ? m->arm_length : 1.0;
 }
 
 /* The follower on the flank `contact`: d = (s, s', s'', s_cam). */
 static void on_flank(const Motion *mo, double theta, double contact, double d[4])
 {
-    cam_profile_eval(&mo->m->profile, theta, d);
+    cam_kind_eval(mo->m, theta, d);
     d[3] = d[0];
     d[0] = d[3] - contact * mo->c;
 }
@@ -72,7 +91,7 @@ static double held(const Motion *mo, double theta, double omega, double omega_do
     on_flank(mo, theta, contact, d);
     v = d[1] * omega;
     friction = v > 0.0 ? mo->f0 : (v < 0.0 ? -mo->f0 : 0.0);
-    return contact * (m->m * (d[2] * omega * omega + d[1] * omega_dot) + cam_follower_closing(m, d[0]) + friction);
+    return contact * (m->I_f * (d[2] * omega * omega + d[1] * omega_dot) + cam_follower_closing(m, d[0]) + friction);
 }
 
 /* m/s2 in flight with the friction's direction -sigma; sigma = 0 at a halt: 0 while static friction holds. */
@@ -84,7 +103,7 @@ static double free_acceleration(const Motion *mo, double s, double sigma)
             return 0.0;
         sigma = net > 0.0 ? 1.0 : -1.0;
     }
-    return (net - sigma * mo->f0) / mo->m->m;
+    return (net - sigma * mo->f0) / mo->m->I_f;
 }
 
 /* The closed-form flight (physics.follower.Flight) tau - tau0 after the piece's start. */
@@ -97,13 +116,14 @@ static void fly(const Motion *mo, const Piece *p, double tau, double *s, double 
         *v = 0.0;
         return;
     }
-    force = -m->F_spring0 + m->F_gx - p->sigma * mo->f0;
+    force = -cam_follower_closing(m, 0.0) - p->sigma * mo->f0;   /* its constant part (an arm's weight: refused) */
     if (m->k_spring > 0.0) {
-        double wn = sqrt(m->k_spring / m->m), s_eq = force / m->k_spring, c = cos(wn * t), sn = sin(wn * t);
+        double k = cam_follower_stiffness(m), wn = sqrt(k / m->I_f), s_eq = force / k, c = cos(wn * t);
+        double sn = sin(wn * t);
         *s = s_eq + (p->s0 - s_eq) * c + p->v0 / wn * sn;
         *v = -(p->s0 - s_eq) * wn * sn + p->v0 * c;
     } else {
-        double b = force / m->m;
+        double b = force / m->I_f;
         *s = p->s0 + p->v0 * t + 0.5 * b * t * t;
         *v = p->v0 + b * t;
     }
@@ -118,8 +138,9 @@ static double event_value(const Motion *mo, const Piece *p, double contact, int 
     fly(mo, p, tau, &s, &v);
     if (code == EV_HALT)
         return p->sigma * v;
-    cam_profile_eval(&mo->m->profile, theta, d);
-    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + CAM_TOUCH : (d[0] + mo->c) - s + CAM_TOUCH;
+    cam_kind_eval(mo->m, theta, d);
+    return code == EV_TOUCH_UP ? s - (d[0] - mo->c) + CAM_TOUCH / cam_follower_length(mo->m)
+                               : (d[0] + mo->c) - s + CAM_TOUCH / cam_follower_length(mo->m);
 }
 
 /* m/s2: a bound of the follower's acceleration relative to the flank near theta (speed_follower.acceleration_scale). */
@@ -127,7 +148,7 @@ static double acceleration_scale(const Motion *mo, double theta, double omega, d
 {
     double d[4];
     on_flank(mo, theta, 1.0, d);
-    return fabs(free_acceleration(mo, d[0], 1.0)) + mo->f0 / mo->m->m + fabs(d[2]) * omega * omega
+    return fabs(free_acceleration(mo, d[0], 1.0)) + mo->f0 / mo->m->I_f + fabs(d[2]) * omega * omega
            + fabs(d[1] * omega_dot) + 1e-300;
 }
 
@@ -161,7 +182,8 @@ static int first_event(const Motion *mo, const Piece *p, double contact, double 
     }
     spacing = omega_max > 0.0 ? SCAN_ANGLE / omega_max : end - tau;
     if (contact == 0.0 && mo->m->k_spring > 0.0)
-        spacing = fmin(spacing, 0.05 * sqrt(mo->m->m / mo->m->k_spring));   /* a twentieth of the flight's period */
+        spacing = fmin(spacing, 0.05 * sqrt(mo->m->I_f / cam_follower_stiffness(mo->m)));   /* a twentieth of the
+                                                                                                 * flight's period */
     for (k = 0; k < n; k++)
         fa[k] = event_value(mo, p, contact, codes[k], a);
     while (a < end && found == EV_NONE) {
@@ -196,7 +218,7 @@ void cam_follower_note(char *events, size_t len, long *dropped, const char *form
 /* The contact the follower starts in at the inputs omega, omega_dot (reference/flight.py _start_contact). */
 void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot)
 {
-    Motion mo = {m, st->theta, omega, omega_dot, cam_follower_friction0(m), m->c,
+    Motion mo = {m, st->theta, omega, omega_dot, cam_follower_friction0(m), cam_follower_clearance(m),
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double d[4], side;
     st->contact = held(&mo, st->theta, omega, omega_dot, 1.0) >= 0.0 ? 1.0
@@ -221,7 +243,7 @@ static void strike(const Motion *mo, CamSpeedState *st, double flank, double the
     w_after = v_after - d[1] * omega;
     st->s = d[0];
     st->impacts += 1.0;
-    if (w_after * w_after < 2.0 * scale * CAM_ZENO_HEIGHT)
+    if (w_after * w_after < 2.0 * scale * (CAM_ZENO_HEIGHT / cam_follower_length(m)))
         w_after = 0.0;   /* the Zeno guard: a plastic impact */
     cam_follower_note(events, events_len, dropped, "follower: touch-down on flank %+d at t = %.9g s (theta = %.6g rad), "
                       "relative speed %.6g m/s, after %.6g m/s; ", (int)flank, time, theta, w, w_after);
@@ -245,7 +267,7 @@ static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, doubl
     double d[4], w;
     on_flank(mo, st->theta, st->contact, d);
     w = st->v - d[1] * omega0;
-    if (w * w < 2.0 * acceleration_scale(mo, st->theta, omega0, omega_dot) * CAM_ZENO_HEIGHT)
+    if (w * w < 2.0 * acceleration_scale(mo, st->theta, omega0, omega_dot) * (CAM_ZENO_HEIGHT / cam_follower_length(mo->m)))
         return;
     if (st->contact * w > 0.0) {
         cam_follower_note(events, events_len, dropped, "follower: lift-off from flank %+d at t = %.9g s (theta = %.6g "
@@ -261,7 +283,7 @@ static void speed_step(const Motion *mo, CamSpeedState *st, double omega0, doubl
 int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
                          double time, char *events, size_t events_len, CamError *err)
 {
-    Motion mo = {m, st->theta, omega0, omega_dot, cam_follower_friction0(m), m->c,
+    Motion mo = {m, st->theta, omega0, omega_dot, cam_follower_friction0(m), cam_follower_clearance(m),
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double tau = 0.0, d[4];
     long count = 0, dropped = 0;
@@ -314,15 +336,69 @@ int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, do
     }
 }
 
+/* N m: another type's load torque on the flank `contact` at theta (docs/model.md 16.3), its load into *load. */
+static double kind_torque(const Motion *mo, double theta, double omega, double omega_dot, double contact,
+                          double direction, CamLoad *load)
+{
+    const CamModel *m = mo->m;
+    double q[4], P;
+    on_flank(mo, theta, contact, q);
+    P = m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_follower_closing(m, q[0]);
+    q[0] = q[3];   /* the lever and the geometry at the cam's q */
+    cam_kind_contact_load(m, q, P, direction, load);
+    return load->M;
+}
+
+/* The speed drive's outputs for another type (docs/model.md 16.3): kind_torque on a flank, the follower's own q,
+ * q_dot in the law's lift units, an arm's psi, psi_dot. */
+static void kind_outputs(const Motion *mo, const CamSpeedState *st, double omega_dot, double direction, double out[])
+{
+    const CamModel *m = mo->m;
+    double omega = st->speed, theta = st->theta, q[4], s_cam[4], i, voltage, a;
+    CamLoad load, shifted;
+    cam_kind_eval(m, theta, q);
+    cam_profile_eval(&m->profile, theta, s_cam);
+    load.alpha = load.f = load.N = 0.0;
+    load.M = m->M_f * direction;
+    load.J = m->J_0;
+    a = free_acceleration(mo, st->s, sgn(st->v));
+    if (st->contact != 0.0) {
+        double step = 1e-6, ahead, behind;
+        kind_torque(mo, theta, omega, omega_dot, st->contact, direction, &load);
+        a = q[2] * omega * omega + q[1] * omega_dot;
+        ahead = kind_torque(mo, theta + step, omega, omega_dot, st->contact, direction, &shifted);
+        behind = kind_torque(mo, theta - step, omega, omega_dot, st->contact, direction, &shifted);
+        i = (m->J_0 * omega_dot + load.M) / m->c_m;
+        voltage = m->R * i + m->c_e * omega;
+        if (m->L > 0.0 && omega != 0.0)   /* the voltage's L di/dt = L omega dM/dtheta / c_m */
+            voltage += m->L * omega * ((ahead - behind) / (2.0 * step)) / m->c_m;
+    } else {
+        i = (m->J_0 * omega_dot + load.M) / m->c_m;
+        voltage = m->R * i + m->c_e * omega;
+    }
+    load.v = st->v / m->q_scale;
+    load.a = a / m->q_scale;
+    load.s_cam = s_cam[0];
+    cam_record_outputs(&load, omega, theta, st->s / m->q_scale, i, voltage, out);
+    if (m->arm) {
+        out[CAM_O_PSI] = st->s;
+        out[CAM_O_PSI_DOT] = st->v;
+    }
+}
+
 /* physics.speed_follower.SpeedFollower.outputs: the speed drive's outputs with the follower's own s, v, a. */
 void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction, double out[])
 {
-    Motion mo = {m, st->theta, st->speed, omega_dot, cam_follower_friction0(m), m->c,
+    Motion mo = {m, st->theta, st->speed, omega_dot, cam_follower_friction0(m), cam_follower_clearance(m),
                  m->closure == CAM_CHOICE_CLOSURE_FORM};
     double omega = st->speed, theta = st->theta, d[4], tan_a, shaft, i, voltage, s = st->s, v = st->v, a;
     double M, J, N = 0.0;
     CamLoad load;
-    cam_profile_eval(&m->profile, theta, d);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
+        kind_outputs(&mo, st, omega_dot, direction, out);
+        return;
+    }
+    cam_kind_eval(m, theta, d);
     tan_a = d[1] / (m->r_b + d[0]);
     shaft = m->M_f * direction;
     if (st->contact != 0.0) {

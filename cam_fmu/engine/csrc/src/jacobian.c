@@ -95,8 +95,8 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     int k, engaged = mode->contact != 0, moving = !mode->stuck;
     cam_rhs(m, mode, x, u, dx);
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: rigid shaft, no train */
-        return cam_kind_tangent(m, mode, x, seed, cam_drive_torque(m, x, omega, u), dT_motor, du, dx[CAM_OMEGA], ddx,
-                                dout);
+        return cam_kind_tangent(m, mode, x, seed, cam_drive_torque(m, x, omega, u), dT_motor, du, dx[CAM_OMEGA], 0,
+                                ddx, dout);
     cam_profile_eval(&m->profile, theta, d);
     for (k = 0; k < CAM_NX; k++)
         ddx[k] = 0.0;

@@ -25,6 +25,54 @@ static Tangents drive_tangents(const CamModel *m, const double seed[CAM_ME_NX], 
     return t;
 }
 
+/* Another type's follower of its own (docs/model.md 16.3; rigid shaft: the rules): on its flank kind.c's tangent
+ * with the closing force at the flank; in flight the cam alone and the follower under Q_close(q_f). */
+static void kind_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
+                         double ddx[CAM_ME_NX], double dout[])
+{
+    const CamModel *m = &d->model;
+    const double left = d->mode.left, dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
+    double y[NY], dy[NY], q[4], s_cam[4], dq, dq_dot, dq_dd, domega_dot, V2;
+    Tangents g = drive_tangents(m, seed, du);
+    int k, stuck = d->mode.stuck;
+    cam_vf_y(m, &d->mode, x, y);
+    cam_vf_rates(m, d->form_u, d->mode.contact, y, dy);
+    if (d->mode.contact) {
+        cam_kind_tangent(m, &d->mode, x, seed, cam_vf_torque_toward(m, y, d->form_u, 0.0), g.drive, du, dy[1], 1,
+                         ddx, dout);
+        return;
+    }
+    cam_kind_eval(m, y[0], q);
+    cam_profile_eval(&m->profile, y[0], s_cam);
+    for (k = 0; k < CAM_ME_NX; k++)
+        ddx[k] = 0.0;
+    for (k = 0; k < CAM_N_OUTPUTS; k++)
+        dout[k] = 0.0;
+    V2 = cam_follower_stiffness(m) + (m->arm && m->W != 0.0 ? -m->W * sin(y[3] + m->psi_0) : 0.0);
+    dq = q[1] * dtheta + left * seed[CAM_GAP];
+    dq_dot = q[2] * dtheta * y[1] + q[1] * domega + left * seed[CAM_RATE];
+    dq_dd = -V2 * dq / m->I_f;   /* I_f q_f_dd = -Q_close(q_f) */
+    domega_dot = stuck ? 0.0 : g.drive / m->J_0;
+    ddx[CAM_THETA] = stuck ? 0.0 : domega;
+    ddx[CAM_OMEGA] = domega_dot;
+    ddx[CAM_CURRENT] = m->has_current ? (du - m->R * seed[CAM_CURRENT] - m->c_e * g.omega_m) / m->L : 0.0;
+    ddx[CAM_GAP] = seed[CAM_RATE];
+    ddx[CAM_RATE] = left * (dq_dd - (q[3] * dtheta * y[1] * y[1] + 2.0 * q[2] * y[1] * domega
+                                     + q[2] * dtheta * dy[1] + q[1] * domega_dot));
+    dout[CAM_O_OMEGA] = dout[CAM_O_OMEGA_M] = domega;
+    dout[CAM_O_THETA] = dout[CAM_O_THETA_M] = dtheta;
+    dout[CAM_O_I] = g.current;
+    dout[CAM_O_VOLTAGE] = du;
+    dout[CAM_O_S_CAM] = s_cam[1] * dtheta;
+    dout[CAM_O_S] = dout[CAM_O_S_END] = dq / m->q_scale;
+    dout[CAM_O_V] = dout[CAM_O_V_END] = dq_dot / m->q_scale;
+    dout[CAM_O_A] = dout[CAM_O_A_END] = dq_dd / m->q_scale;
+    if (m->arm) {
+        dout[CAM_O_PSI] = dq;
+        dout[CAM_O_PSI_DOT] = dq_dot;
+    }
+}
+
 void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,
                        double ddx[CAM_ME_NX], double dout[])
 {
@@ -34,10 +82,14 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     double y[NY], dy[NY], p[4], base, t, dt, root, ds, dv, da, dF, domega_dot = 0.0, dP = 0.0, P = 0.0, f, df;
     Tangents g = drive_tangents(m, seed, du);
     int k, stuck;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
+        kind_tangent(d, x, seed, du, ddx, dout);
+        return;
+    }
     cam_vf_y(m, &d->mode, x, y);
     stuck = y[Y_DIR] == 0.0;
     cam_vf_rates(m, d->form_u, contact, y, dy);   /* the values the tangent needs: omega_dot */
-    cam_profile_eval(&m->profile, y[0], p);
+    cam_kind_eval(m, y[0], p);
     for (k = 0; k < CAM_ME_NX; k++)
         ddx[k] = 0.0;
     for (k = 0; k < CAM_N_OUTPUTS; k++)

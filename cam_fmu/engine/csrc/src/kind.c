@@ -57,9 +57,9 @@ static double lever_rate(const CamModel *m, const double q[4])
 }
 
 double cam_kind_branch(const CamModel *m, const double q[4], double omega, double drive, double direction,
-                       double side, double axial, CamKindBranch *out)
+                       double side, double force, CamKindBranch *out)
 {
-    double A = m->I_f * q[2] * omega * omega + cam_kind_slope(m, q[0]) + axial, omega_dot;
+    double A = m->I_f * q[2] * omega * omega + force, omega_dot;
     out->b = 0.0;
     out->k = q[1];
     if (m->mu != 0.0) {
@@ -83,25 +83,9 @@ void cam_kind_outputs(const CamModel *m, double theta, double omega, double out[
     out[CAM_O_PSI_DOT] = q[1] * omega;
 }
 
-void cam_kind_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
-                   CamLoad *out)
+void cam_kind_contact_load(const CamModel *m, const double q[4], double P, double direction, CamLoad *out)
 {
-    double q[4], P, alpha = 0.0, N, friction;
-    int k;
-    cam_profile_eval(&m->profile, theta, q);
-    out->s_cam = q[0];
-    if (m->arm)
-        for (k = 0; k < 4; k++)
-            q[k] = m->q_scale * q[k];
-    out->alpha = 0.0;
-    out->f = 0.0;
-    if (!engaged) {
-        out->M = m->M_f * direction;
-        out->J = m->J_0;
-        out->v = out->a = out->N = 0.0;
-        return;
-    }
-    P = m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0]);
+    double alpha = 0.0, N, friction;
     friction = m->mu != 0.0 ? m->mu * fabs(P) * cam_kind_lever(m, q) : 0.0;   /* N m on the cam, against its turn */
     N = P;
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {   /* the rocker's triangle (15.1) */
@@ -118,6 +102,28 @@ void cam_kind_load(const CamModel *m, double theta, double omega, double omega_d
     out->f = m->mu * fabs(N);   /* the reference's friction field (no output of its own) */
     out->J = m->J_0 + m->I_f * q[1] * q[1];
     out->N = N;
+}
+
+void cam_kind_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
+                   CamLoad *out)
+{
+    double q[4];
+    int k;
+    cam_profile_eval(&m->profile, theta, q);
+    out->s_cam = q[0];
+    if (m->arm)
+        for (k = 0; k < 4; k++)
+            q[k] = m->q_scale * q[k];
+    out->alpha = 0.0;
+    out->f = 0.0;
+    if (!engaged) {
+        out->M = m->M_f * direction;
+        out->J = m->J_0;
+        out->v = out->a = out->N = 0.0;
+        return;
+    }
+    cam_kind_contact_load(m, q, m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0]),
+                          direction, out);
     out->v = q[1] / m->q_scale * omega;   /* the law's lift rates, as the reference's */
     out->a = q[2] / m->q_scale * omega * omega + q[1] / m->q_scale * omega_dot;
 }
@@ -225,16 +231,20 @@ static void contact_tangent(const CamModel *m, const double q[4], double P, doub
 }
 
 int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], const double seed[CAM_NX],
-                     double T, double dT, double du, double omega_dot, double ddx[CAM_NX], double dout[])
+                     double T, double dT, double du, double omega_dot, int own, double ddx[CAM_NX], double dout[])
 {
     double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, A, dA, dJ, V2, domega_dot = 0.0, P, dP;
     double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, dk;
-    double sP, Pc, dPc;
+    double sP, Pc, dPc, qf, force, side = own ? mode->contact : (m->guide_side ? mode->side : 0.0);
     CamKindBranch branch;
     int n, moving = !mode->stuck, engaged = mode->contact != 0;
     cam_kind_eval(m, theta, q);
-    V2 = m->arm && m->W != 0.0 ? -m->W * sin(q[0] + m->psi_0) : 0.0;   /* d2V/dq2 */
+    qf = q[0] - (own ? mode->contact * cam_follower_clearance(m) : 0.0);   /* where the follower is */
+    V2 = m->arm && m->W != 0.0 ? -m->W * sin(qf + m->psi_0) : 0.0;   /* d2V/dq2 */
+    force = own ? cam_follower_closing(m, qf) : cam_kind_slope(m, q[0]);   /* its load beside its inertia */
+    if (own)
+        V2 += cam_follower_stiffness(m);   /* the spring's */
     for (n = 0; n < CAM_NX; n++)
         ddx[n] = 0.0;
     if (!moving)
@@ -246,10 +256,10 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         lam = cam_kind_lever(m, q);
         dlam = lever_rate(m, q) * dtheta;
     }
-    A = m->I_f * q[2] * w * w + cam_kind_slope(m, q[0]);
+    A = m->I_f * q[2] * w * w + force;
     dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
     if (moving && m->follower) {   /* den omega_dot = T - M_f d - A k on the branch cam_rhs holds (model.c) */
-        cam_kind_branch(m, q, w, T - m->M_f * d, d, m->guide_side ? mode->side : 0.0, 0.0, &branch);
+        cam_kind_branch(m, q, w, T - m->M_f * d, d, side, force, &branch);
         dk = q[2] * dtheta + m->mu * d * branch.b * dlam;
         domega_dot = (dT - dA * branch.k - A * dk - omega_dot * m->I_f * (q[2] * dtheta * branch.k + q[1] * dk))
                      / branch.den;

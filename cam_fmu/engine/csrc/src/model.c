@@ -73,7 +73,7 @@ double cam_omega_dot(const CamModel *m, double theta, double omega, double torqu
         return drive / m->J_0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq, its friction */
         cam_kind_eval(m, theta, q);
-        return cam_kind_branch(m, q, omega, drive, direction, side, axial, &branch);
+        return cam_kind_branch(m, q, omega, drive, direction, side, cam_kind_slope(m, q[0]) + axial, &branch);
     }
     load_terms(m, theta, omega, drive, direction, side, axial, &t);
     if (m->mu == 0.0)
@@ -91,7 +91,8 @@ double cam_side_force(const CamModel *m, double theta, double omega, double torq
         return 0.0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* P: its sign is the kind's friction branch */
         cam_kind_eval(m, theta, q);
-        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, axial, &branch);
+        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, cam_kind_slope(m, q[0]) + axial,
+                        &branch);
         return branch.P;
     }
     load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, axial, &t);

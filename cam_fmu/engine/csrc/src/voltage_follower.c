@@ -73,12 +73,6 @@ static double torque(const CamModel *m, const double y[NY], double u)
     return cam_vf_torque_toward(m, y, u, shaft_direction(y));
 }
 
-/* m: the clearance of a groove (closure 'form'), 0 for a spring's one flank. */
-double cam_vf_clearance(const CamModel *m)
-{
-    return m->closure == CAM_CHOICE_CLOSURE_FORM ? m->c : 0.0;
-}
-
 /* On the flank `contact` at y, the shaft moving toward `dir`: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the
  * force P [N] along X of the coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot
  * (model.c load_terms with F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
@@ -86,8 +80,15 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
                          double *omega_dot, double *P, double *n_r)
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
-    cam_profile_eval(&m->profile, y[0], d);
-    F = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
+    cam_kind_eval(m, y[0], d);
+    F = cam_follower_closing(m, d[0] - contact * cam_follower_clearance(m));
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c's equation, the flank's b = contact */
+        CamKindBranch branch;
+        *omega_dot = cam_kind_branch(m, d, omega, cam_vf_torque_toward(m, y, u, dir), dir, contact, F, &branch);
+        *P = branch.P;
+        *n_r = 0.0;   /* no side event: the friction's kink is the lift-off itself (docs/model.md 16.3) */
+        return;
+    }
     if (m->mu == 0.0) {
         *omega_dot = (cam_vf_torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
                      / (m->J_0 + m->m * d[1] * d[1]);
@@ -114,8 +115,8 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
                         double *P, double *n_r)
 {
     if (y[Y_DIR] == 0.0) {
-        cam_profile_eval(&m->profile, y[0], d);
-        *P = cam_follower_closing(m, d[0] - contact * cam_vf_clearance(m));
+        cam_kind_eval(m, y[0], d);
+        *P = cam_follower_closing(m, d[0] - contact * cam_follower_clearance(m));
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -158,7 +159,14 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
 /* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
 static double free_acceleration(const CamModel *m, double s, double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-cam_follower_closing(m, s) - sigma * cam_follower_friction0(m)) / m->m;
+    return sigma == 0.0 ? 0.0 : (-cam_follower_closing(m, s) - sigma * cam_follower_friction0(m)) / m->I_f;
+}
+
+/* The flying follower's acceleration at y (the guide's friction only where it acts in flight). */
+static double flight_acceleration(const CamModel *m, const double y[NY])
+{
+    return cam_follower_friction0(m) == 0.0 ? -cam_follower_closing(m, y[3]) / m->I_f
+                                            : free_acceleration(m, y[3], y[Y_SIGMA]);
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
@@ -194,15 +202,15 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
     }
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
-    dy[4] = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+    dy[4] = flight_acceleration(m, y);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
 void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact)
 {
     double d[4];
-    cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - contact * cam_vf_clearance(m);
+    cam_kind_eval(m, y[0], d);
+    y[3] = d[0] - contact * cam_follower_clearance(m);
     y[4] = d[1] * y[1];
 }
 
@@ -220,17 +228,17 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
     }
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
-    cam_profile_eval(&m->profile, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_vf_clearance(m)) + CAM_TOUCH
-                               : (d[0] + cam_vf_clearance(m)) - y[3] + CAM_TOUCH;
+    cam_kind_eval(m, y[0], d);
+    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_follower_clearance(m)) + CAM_TOUCH / cam_follower_length(m)
+                               : (d[0] + cam_follower_clearance(m)) - y[3] + CAM_TOUCH / cam_follower_length(m);
 }
 
 /* m/s2: a bound of the follower's acceleration relative to the flank near y (voltage_follower.acceleration_scale). */
 double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u)
 {
     double d[4];
-    cam_profile_eval(&m->profile, y[0], d);
-    return fabs(cam_follower_closing(m, d[0]) / m->m) + cam_follower_friction0(m) / m->m + fabs(d[2]) * y[1] * y[1]
+    cam_kind_eval(m, y[0], d);
+    return fabs(cam_follower_closing(m, d[0]) / m->I_f) + cam_follower_friction0(m) / m->I_f + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -265,8 +273,8 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
             mode->side = sgn(side_force(m, y, u, contact));
         return;
     }
-    cam_profile_eval(&m->profile, y[0], dd);
-    x[CAM_GAP] = left * (y[3] - (dd[0] - left * cam_vf_clearance(m)));
+    cam_kind_eval(m, y[0], dd);
+    x[CAM_GAP] = left * (y[3] - (dd[0] - left * cam_follower_clearance(m)));
     x[CAM_RATE] = left * (y[4] - dd[1] * y[1]);
     mode->sigma = cam_vf_flight_direction(m, y);
 }
@@ -284,8 +292,8 @@ static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM
     y[Y_DIR] = mode->stuck ? 0.0 : mode->direction;
     y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; flank_terms) */
     if (!mode->contact) {
-        cam_profile_eval(&m->profile, y[0], dd);
-        y[3] = dd[0] - mode->left * cam_vf_clearance(m) + mode->left * x[CAM_GAP];
+        cam_kind_eval(m, y[0], dd);
+        y[3] = dd[0] - mode->left * cam_follower_clearance(m) + mode->left * x[CAM_GAP];
         y[4] = dd[1] * y[1] + mode->left * x[CAM_RATE];
     }
 }
@@ -366,7 +374,7 @@ static double vf_step_limit(const CamDrive *d, double time)
     const CamMode *mode = &d->mode;
     const CamMethod *method = cam_method(m->solver);
     double y[NY], dt = HUGE_VAL, u = d->form_u;
-    double wn = m->k_spring > 0.0 ? sqrt(m->k_spring / m->m) : 0.0;
+    double wn = m->k_spring > 0.0 ? sqrt(cam_follower_stiffness(m) / m->I_f) : 0.0;
     double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
                   : 0.0;
     double ws = m->compliant ? cam_shaft_rate(m, m->J_0) : 0.0;
@@ -374,8 +382,8 @@ static double vf_step_limit(const CamDrive *d, double time)
         dt = fmin(dt, FLIGHT_ANGLE / fabs(d->x[CAM_OMEGA]));
     if (!mode->contact && wn > 0.0)
         dt = fmin(dt, STEP_PHASE / wn);
-    if (!mode->contact && mode->stuck && cam_vf_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
-        double c = cam_vf_clearance(m), A;
+    if (!mode->contact && mode->stuck && cam_follower_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
+        double c = cam_follower_clearance(m), A;
         cam_vf_y(m, mode, d->x, y);
         A = cam_vf_acceleration_scale(m, y, u);
         dt = fmin(dt, 0.1 * sqrt(2.0 * c / A));
@@ -454,20 +462,40 @@ static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError 
     return cam_integrate(d, h, time, steps, err);
 }
 
-/* voltage_follower.outputs: the follower's own s, v, a; in flight M = M_f sgn(omega) and J = J_0. */
+/* Another type's load on its flank at y (docs/model.md 16.3): kind.c's with the flank's P, the follower's q, q_dot
+ * and acceleration in y[3], y[4] and *a. */
+static void kind_flank_load(const CamModel *m, const double y[NY], double u, int contact, double *a, CamLoad *load)
+{
+    double q[4], omega_dot, P;
+    cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P);
+    if (y[Y_DIR] == 0.0) {   /* stuck: static friction takes it all, the flank holds the follower at rest */
+        cam_kind_contact_load(m, q, P, 0.0, load);
+        load->M = cam_vf_torque_toward(m, y, u, 0.0);
+    } else {
+        cam_kind_contact_load(m, q, P, shaft_direction(y), load);
+    }
+    *a = q[2] * y[1] * y[1] + q[1] * omega_dot;
+}
+
+/* voltage_follower.outputs: the follower's own s, v, a (another type: its own q, q_dot, in the law's lift units, and
+ * an arm's psi, psi_dot); in flight M = M_f sgn(omega) and J = J_0. */
 static void vf_outputs(CamDrive *d, double out[])
 {
     const CamModel *m = &d->model;
-    double y[NY], dd[4], omega_dot, P, i;
+    double y[NY], dd[4], omega_dot, P, i, a;
     CamLoad load;
     cam_vf_y(m, &d->mode, d->x, y);
-    cam_profile_eval(&m->profile, y[0], dd);
+    cam_kind_eval(m, y[0], dd);
     i = current(m, y, d->form_u);
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
     load.s_cam = dd[0];
     load.f = 0.0;
     load.N = 0.0;   /* in flight */
-    if (d->mode.contact != 0) {
+    if (d->mode.contact != 0 && m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
+        kind_flank_load(m, y, d->form_u, d->mode.contact, &a, &load);
+        load.v = y[4];
+        load.a = a;
+    } else if (d->mode.contact != 0) {
         int contact = d->mode.contact;
         double tan_a = dd[1] / (m->r_b + dd[0]);
         cam_vf_on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
@@ -478,14 +506,29 @@ static void vf_outputs(CamDrive *d, double out[])
         load.J = m->J_0 + m->m * dd[1] * dd[1];
         load.v = dd[1] * y[1];
         load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
-        y[3] = dd[0] - contact * cam_vf_clearance(m);
+        y[3] = dd[0] - contact * cam_follower_clearance(m);
     } else {
         load.M = m->M_f * shaft_direction(y);
         load.J = m->J_0;
         load.v = y[4];
-        load.a = m->mu == 0.0 ? -cam_follower_closing(m, y[3]) / m->m : free_acceleration(m, y[3], y[Y_SIGMA]);
+        load.a = flight_acceleration(m, y);
     }
-    cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* q in the law's lift units; the cam's s_cam */
+        double s_cam[4];
+        cam_profile_eval(&m->profile, y[0], s_cam);
+        load.s_cam = s_cam[0];
+        if (d->mode.contact == 0)
+            load.alpha = 0.0;   /* no contact, no pressure angle (kind.c's disengaged load) */
+        load.v /= m->q_scale;
+        load.a /= m->q_scale;
+        cam_record_outputs(&load, y[1], y[0], y[3] / m->q_scale, i, d->form_u, out);
+        if (m->arm) {
+            out[CAM_O_PSI] = y[3];
+            out[CAM_O_PSI_DOT] = y[4];
+        }
+    } else {
+        cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
+    }
     if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too (outputs.c cam_outputs) */
         out[CAM_O_J] = load.J + m->J_m;
         out[CAM_O_THETA_M] = y[0] + y[Y_TWIST];

@@ -11,9 +11,9 @@
 /* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
 static void impact(const CamModel *m, double y[NY], double s1, double e)
 {
-    double w = y[4] - s1 * y[1], m_eff = m->m * m->J_0 / (m->J_0 + m->m * s1 * s1);
+    double w = y[4] - s1 * y[1], m_eff = m->I_f * m->J_0 / (m->J_0 + m->I_f * s1 * s1);
     double P = -(1.0 + e) * m_eff * w;
-    y[4] += P / m->m;
+    y[4] += P / m->I_f;
     y[1] -= s1 * P / m->J_0;
 }
 
@@ -31,17 +31,17 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
 {
     double d[4], before[NY], w, omega_dot, P, scale = cam_vf_acceleration_scale(m, y, u);
     memcpy(before, y, sizeof before);
-    cam_profile_eval(&m->profile, y[0], d);
-    y[3] = d[0] - flank * cam_vf_clearance(m);
+    cam_kind_eval(m, y[0], d);
+    y[3] = d[0] - flank * cam_follower_clearance(m);
     impact(m, y, d[1], m->restitution);
     unstick(y);
     w = y[4] - d[1] * y[1];
-    if (w * w >= 2.0 * scale * CAM_ZENO_HEIGHT) {
+    if (w * w >= 2.0 * scale * (CAM_ZENO_HEIGHT / cam_follower_length(m))) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * cam_vf_acceleration_scale(m, y, u)) : 0.0;
         return 0;
     }
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0] - flank * cam_vf_clearance(m);
+    y[3] = d[0] - flank * cam_follower_clearance(m);
     impact(m, y, d[1], 0.0);
     unstick(y);
     y[4] = d[1] * y[1];
@@ -87,7 +87,7 @@ int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact
         *left = contact;
         return 0;
     }
-    cam_profile_eval(&m->profile, y[0], dd);
+    cam_kind_eval(m, y[0], dd);
     w_before = y[4] - dd[1] * y[1];
     *rebound = 0.0;
     contact = land(m, y, u, flank, rebound);
@@ -177,7 +177,8 @@ double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
     const CamModel *m = &d->model;
     double g = x[CAM_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
-        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_vf_clearance(m) - g) : g) + CAM_TOUCH;
+        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_follower_clearance(m) - g) : g)
+               + CAM_TOUCH / cam_follower_length(m);
     return cam_vf_value(m, &d->mode, code, x, d->form_u);
 }
 
@@ -187,7 +188,7 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     (void)err;
     d->step_events[0] = '\0';
     if (code == EV_TOUCH)   /* the nearer flank: a groove's other one past half its width */
-        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && d->x[CAM_GAP] > cam_vf_clearance(m) ? -d->mode.left
+        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && d->x[CAM_GAP] > cam_follower_clearance(m) ? -d->mode.left
                 : d->mode.left) > 0 ? EV_TOUCH_UP : EV_TOUCH_DOWN;
     d->form->transition(d, code, d->time);
     d->stale = 1;
