@@ -87,6 +87,11 @@ static double arm_energy(const CamEnergy *e, const double out[])
 static double mechanical(const CamEnergy *e, const double out[])
 {
     double omega = out[CAM_O_OMEGA], twist, omega_m, s = out[CAM_O_S], v = out[CAM_O_V];
+    if (e->own_follower && e->arm_length > 0.0) {   /* an arm's (rigid shaft: the rules): about its pivot, 16.3 */
+        double psi = out[CAM_O_PSI], L = e->arm_length, rate = out[CAM_O_PSI_DOT];
+        return 0.5 * e->J_0 * omega * omega + 0.5 * e->m * rate * rate + L * e->F_spring0 * psi
+               + 0.5 * e->k_spring * L * L * psi * psi + arm_energy(e, out);
+    }
     if (e->own_follower) {   /* the cam side's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
         double own = 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s
                      + 0.5 * e->k_spring * s * s - e->F_gx * s;
@@ -117,7 +122,8 @@ void cam_energy_init(CamEnergy *e, const CamModel *m, const double out[])
     e->J_m = m->J_m;
     e->own_follower = m->free_follower && m->formulation == CAM_FORM_CONSISTENT;
     e->J_0 = m->J_0;
-    e->m = m->m;
+    e->m = m->I_f;
+    e->arm_length = m->arm ? m->arm_length : 0.0;
     e->k_spring = m->k_spring;
     e->F_spring0 = m->F_spring0;
     e->k_train = m->k_train;
