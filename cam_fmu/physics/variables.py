@@ -81,8 +81,9 @@ STATES: tuple[tuple[str, str, str, str], ...] = (
     ("x_end", "m", "m/s", "continuous state: the follower train's end mass position (= output s_end; held at 0 "
      "without a train, k_train = 0)"),
     ("x_v_end", "m/s", "m/s2", "continuous state: the end mass velocity (= output v_end; held at 0 without a train)"),
-    ("x_gap", "m", "m/s", "continuous state: a free follower's gap to the flank it left last, in flight (closures "
-     "'form', 'spring'; held at 0 in contact and without one)"),
+    ("x_gap", "m", "m/s", "continuous state: a free follower's gap to the flank it left last, in flight, along its "
+     "path (an arm: the roller's arc L (psi - psi_flank); closures 'form', 'spring'; held at 0 in contact and "
+     "without one)"),
     ("x_gap_rate", "m/s", "m/s2", "continuous state: the rate of x_gap (held at 0 in contact and without a free "
      "follower)"),
 )
@@ -131,8 +132,8 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "v_end": ("x_theta", "x_omega", "x_v_end", "x_gap_rate"),
     "a_end": _FLIGHT + _TRAIN,
     "F_train": ("x_theta", "x_omega") + _TRAIN,
-    "psi": ("x_theta",),   # an arm's angle (docs/model.md 16; 0 for a translating follower)
-    "psi_dot": ("x_theta", "x_omega"),
+    "psi": ("x_theta", "x_gap"),   # an arm's angle (docs/model.md 16, 16.3; 0 for a translating follower)
+    "psi_dot": ("x_theta", "x_omega", "x_gap_rate"),
 }
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).

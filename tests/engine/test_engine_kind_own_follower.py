@@ -105,6 +105,7 @@ def test_an_impact_keeps_the_momentum_and_reverses_the_relative_rate_by_restitut
     p, _, events = coast(kind, "form", e, steps=400)
     J0, I = p["J_m"] + p["J_cam"], inertia(p)
     scale = p["lift_angle"] / LIFT if kind.startswith("oscillating") else 1.0
+    along = p["arm_length"] if kind.startswith("oscillating") else 1.0   # the gap's slots: m along the path
     checked = 0
     for event in events:
         if event["name"] not in ("engage_up", "engage_down"):
@@ -115,7 +116,7 @@ def test_an_impact_keeps_the_momentum_and_reverses_the_relative_rate_by_restitut
         if left != flank or after[-1] == 0.0:   # a rebound off the flank it left: w and -e w relative to it
             continue
         w_before, w_after = left * before[-1], left * after[-1]   # the gap's rate is signed by the flank left
-        momentum = [J0 * x[1] + I * q1 * (q1 * x[1] + left * x[-1]) for x in (before, after)]
+        momentum = [J0 * x[1] + I * q1 * (q1 * x[1] + left * x[-1] / along) for x in (before, after)]
         assert abs(momentum[1] - momentum[0]) < 1e-12 * abs(momentum[0])
         assert abs(w_after + e * w_before) < 1e-12 * abs(w_before)
         checked += 1

@@ -120,6 +120,25 @@ FOLLOWER_CASES = {
     "backlash_spring/contact": (_BACKLASH_SPRING, "contact", 0.0),
     "backlash_spring/flight": (_BACKLASH_SPRING, "flight", 150.0),
 }
+# Every follower type as a body of its own (docs/model.md 16.3): an arm in a groove (its gap an angle) and on a
+# spring about its pivot, a flat face on a spring; the weight tilted and each type's friction on.
+_ARM_OWN = {**CYCLOID, **ARM, "follower_type": "oscillating_roller", "lift_angle": 0.3, "mu": 0.05, "M_f": 0.01,
+            "G": 4.0}
+_ARM_GROOVE = {**_ARM_OWN, "closure": "form", "c": 5e-4, "restitution": 0.5, "omega0": 20.0}
+_ARM_SPRING = {**_ARM_OWN, "follower_type": "oscillating_flat", "lift_angle": 0.15, "closure": "spring",
+               "k_spring": 300.0, "F_spring0": 3.0, "omega0": 20.0, "L": 1e-3}
+_FLAT_SPRING = {**CYCLOID, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2, "beta": 0.7, "G": 4.0,
+                "closure": "spring", "k_spring": 300.0, "F_spring0": 3.0, "omega0": 20.0}
+FOLLOWER_CASES.update({
+    "arm_groove/contact": (_ARM_GROOVE, "contact", 0.0),
+    "arm_groove/flight": (_ARM_GROOVE, "flight", 100.0),
+    "arm_groove/flight_stuck": (_ARM_GROOVE, "flight_stuck", 100.0),
+    "arm_spring_L/contact": (_ARM_SPRING, "contact", 0.0),
+    "arm_spring_L/stuck": ({**_ARM_SPRING, "omega0": 0.0, "u": 0.0, "theta0": 2.0}, "stuck", 0.0),   # a dwell
+    "arm_spring_L/flight": (_ARM_SPRING, "flight", 150.0),
+    "flat_spring/contact": (_FLAT_SPRING, "contact", 0.0),
+    "flat_spring/flight": (_FLAT_SPRING, "flight", 150.0),
+})
 
 
 class Me:
@@ -349,7 +368,7 @@ def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_pa
     rng = np.random.default_rng(11)
     me = Me(engine_fmu_path, start)
     def draw() -> None:
-        random_follower_state(me, rng, mode, start.get("c", 1e-3))
+        random_follower_state(me, rng, mode, start.get("c", 1e-3))   # an arm's gap too: m along its roller's arc
         assert_follower_mode(me.x(), me.f()[:NX], mode)
 
     def moving(analytic: np.ndarray) -> None:

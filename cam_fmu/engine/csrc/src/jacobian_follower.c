@@ -37,28 +37,33 @@ static void kind_tangent(const CamDrive *d, const double x[CAM_ME_NX], const dou
     int k, stuck = d->mode.stuck;
     cam_vf_y(m, &d->mode, x, y);
     cam_vf_rates(m, d->form_u, d->mode.contact, y, dy);
+    cam_kind_eval(m, y[0], q);
     if (d->mode.contact) {
         cam_kind_tangent(m, &d->mode, x, seed, cam_vf_torque_toward(m, y, d->form_u, 0.0), g.drive, du, dy[1], 1,
                          ddx, dout);
+        if (stuck) {   /* the follower rides the flank at the state's omega, q' omega, as the outputs take it */
+            dq_dot = q[2] * dtheta * y[1] + q[1] * domega;
+            dout[CAM_O_V] = dout[CAM_O_V_END] = dq_dot / m->q_scale;
+            dout[CAM_O_PSI_DOT] = m->arm ? dq_dot : 0.0;
+        }
         return;
     }
-    cam_kind_eval(m, y[0], q);
     cam_profile_eval(&m->profile, y[0], s_cam);
     for (k = 0; k < CAM_ME_NX; k++)
         ddx[k] = 0.0;
     for (k = 0; k < CAM_N_OUTPUTS; k++)
         dout[k] = 0.0;
     V2 = cam_follower_stiffness(m) + (m->arm && m->W != 0.0 ? -m->W * sin(y[3] + m->psi_0) : 0.0);
-    dq = q[1] * dtheta + left * seed[CAM_GAP];
-    dq_dot = q[2] * dtheta * y[1] + q[1] * domega + left * seed[CAM_RATE];
+    dq = q[1] * dtheta + left * seed[CAM_GAP] / cam_follower_length(m);   /* the gap's slots in m along the path */
+    dq_dot = q[2] * dtheta * y[1] + q[1] * domega + left * seed[CAM_RATE] / cam_follower_length(m);
     dq_dd = -V2 * dq / m->I_f;   /* I_f q_f_dd = -Q_close(q_f) */
     domega_dot = stuck ? 0.0 : g.drive / m->J_0;
-    ddx[CAM_THETA] = stuck ? 0.0 : domega;
+    ddx[CAM_THETA] = domega;   /* the rates' theta_dot = omega in flight, the cam stuck at omega = 0 too */
     ddx[CAM_OMEGA] = domega_dot;
     ddx[CAM_CURRENT] = m->has_current ? (du - m->R * seed[CAM_CURRENT] - m->c_e * g.omega_m) / m->L : 0.0;
     ddx[CAM_GAP] = seed[CAM_RATE];
-    ddx[CAM_RATE] = left * (dq_dd - (q[3] * dtheta * y[1] * y[1] + 2.0 * q[2] * y[1] * domega
-                                     + q[2] * dtheta * dy[1] + q[1] * domega_dot));
+    ddx[CAM_RATE] = left * cam_follower_length(m) * (dq_dd - (q[3] * dtheta * y[1] * y[1] + 2.0 * q[2] * y[1] * domega
+                                                              + q[2] * dtheta * dy[1] + q[1] * domega_dot));
     dout[CAM_O_OMEGA] = dout[CAM_O_OMEGA_M] = domega;
     dout[CAM_O_THETA] = dout[CAM_O_THETA_M] = dtheta;
     dout[CAM_O_I] = g.current;

@@ -201,7 +201,7 @@ double cam_error_norm(const CamModel *m, const double x[CAM_NX], const CamStepWo
         if (slot == CAM_THETA && TWO_PI < scale)   /* theta enters the physics mod 2 pi */
             scale = TWO_PI;
         if (slot >= CAM_GAP) {   /* the follower's gap: its error is the follower's, on the scale of the lift */
-            double lift = m->lift_scale * m->q_scale;   /* q's: an arm's gap is an angle */
+            double lift = m->lift_scale * m->q_scale * cam_follower_length(m);   /* along the path: an arm's arc */
             double at = slot == CAM_GAP ? lift : lift * fabs(x[CAM_OMEGA]);
             scale = at > scale ? at : scale;
         }

@@ -274,8 +274,8 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
         return;
     }
     cam_kind_eval(m, y[0], dd);
-    x[CAM_GAP] = left * (y[3] - (dd[0] - left * cam_follower_clearance(m)));
-    x[CAM_RATE] = left * (y[4] - dd[1] * y[1]);
+    x[CAM_GAP] = left * (y[3] - (dd[0] - left * cam_follower_clearance(m))) * cam_follower_length(m);
+    x[CAM_RATE] = left * (y[4] - dd[1] * y[1]) * cam_follower_length(m);
     mode->sigma = cam_vf_flight_direction(m, y);
 }
 
@@ -293,8 +293,8 @@ static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM
     y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; flank_terms) */
     if (!mode->contact) {
         cam_kind_eval(m, y[0], dd);
-        y[3] = dd[0] - mode->left * cam_follower_clearance(m) + mode->left * x[CAM_GAP];
-        y[4] = dd[1] * y[1] + mode->left * x[CAM_RATE];
+        y[3] = dd[0] - mode->left * cam_follower_clearance(m) + mode->left * x[CAM_GAP] / cam_follower_length(m);
+        y[4] = dd[1] * y[1] + mode->left * x[CAM_RATE] / cam_follower_length(m);
     }
 }
 
@@ -321,7 +321,7 @@ void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     if (mode->contact)
         return;
     dx[CAM_GAP] = x[CAM_RATE];   /* the follower's acceleration less the flank's */
-    dx[CAM_RATE] = mode->left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1]));
+    dx[CAM_RATE] = mode->left * (dy[4] - (dd[2] * y[1] * y[1] + dd[1] * dy[1])) * cam_follower_length(m);
 }
 
 int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENTS])

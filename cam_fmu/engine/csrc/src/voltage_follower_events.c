@@ -177,8 +177,7 @@ double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX])
     const CamModel *m = &d->model;
     double g = x[CAM_GAP];
     if (code == EV_TOUCH)   /* the flank left at g = 0, a groove's other at g = 2 c, each TOUCH inside */
-        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * cam_follower_clearance(m) - g) : g)
-               + CAM_TOUCH / cam_follower_length(m);
+        return (m->closure == CAM_CHOICE_CLOSURE_FORM ? fmin(g, 2.0 * m->c - g) : g) + CAM_TOUCH;
     return cam_vf_value(m, &d->mode, code, x, d->form_u);
 }
 
@@ -188,7 +187,7 @@ int cam_vf_me_apply(CamDrive *d, int code, CamError *err)
     (void)err;
     d->step_events[0] = '\0';
     if (code == EV_TOUCH)   /* the nearer flank: a groove's other one past half its width */
-        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && d->x[CAM_GAP] > cam_follower_clearance(m) ? -d->mode.left
+        code = (m->closure == CAM_CHOICE_CLOSURE_FORM && d->x[CAM_GAP] > m->c ? -d->mode.left
                 : d->mode.left) > 0 ? EV_TOUCH_UP : EV_TOUCH_DOWN;
     d->form->transition(d, code, d->time);
     d->stale = 1;
