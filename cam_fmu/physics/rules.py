@@ -201,9 +201,14 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(TRAIN, Is("formulation", ("paper",))),
          "parameter 'k_train' = {k_train} N/m: the paper's formulation (steps 1-9) has no follower train; allowed "
          "with it: k_train = 0, or formulation 'consistent' (docs/model.md 14.6)"),
-    Rule(AllOf(TRAIN, AnyOf(OWN_FOLLOWER, Cmp(CLEARANCE, "!="))),
-         "parameter 'k_train' = {k_train} N/m: the train runs with the follower on the cam (closure 'kinematic', or "
-         "'form' without clearance) so far; allowed with closure {closure} and c = {c} m: k_train = 0"),
+    Rule(AllOf(TRAIN, Cmp(CLEARANCE, "!="), Not(OWN_FOLLOWER)),
+         "parameter 'k_train' = {k_train} N/m: a train on a follower in a clearance needs the follower as a body of "
+         "its own (closure 'form' with its mass m > 0, docs/model.md 14.6); allowed with closure {closure} and c = "
+         "{c} m: k_train = 0"),
+    Rule(AllOf(TRAIN, OWN_FOLLOWER, Is("drive", ("speed",))),
+         "parameter 'k_train' = {k_train} N/m: the speed drive integrates a follower of its own's flight in closed "
+         "form (a spring and a constant force), which the train's end mass is not; allowed with closure {closure} "
+         "in the speed drive: k_train = 0 (or drive 'voltage', docs/model.md 14.6)"),
     *(Rule(AllOf(Not(OSCILLATING), Cmp(Num(name), "!=")),
            f"parameter {name!r} = {{{name}}} {unit} is not used by follower_type {{follower_type}} (only by the "
            f"oscillating types): leave it at its default 0") for name, unit in ARM_UNITS),

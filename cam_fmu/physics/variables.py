@@ -97,12 +97,14 @@ FEEDTHROUGH_INPUTS: tuple[str, ...] = ("u",)
 # the union over every drive-train, effect and mode. Probed numerically by tests/fmu_me/test_directional_me.py (central
 # differences of the FMU's derivatives and outputs, a follower of its own in flight among the cases), which finds
 # exactly these. In flight (voltage_follower_events.c) der(x_gap) = x_gap_rate, and der(x_gap_rate), s and a depend on
-# the gap through the spring at the follower's position, not on its rate (the guide's friction keeps the flight's
-# direction over the mode); the load M and N_contact never depend on the gap (0 and M_f in flight).
+# the gap through the spring at the follower's position, and on its rate through a train's damper (the guide's
+# friction keeps the flight's direction over the mode); the load M and N_contact never depend on the gap (0 and M_f
+# in flight); a train's end mass feels the follower's own gap and rate.
 _TRAIN = ("x_end", "x_v_end")     # the train's force pulls the cam's follower (docs/model.md 14.6)
 _SHAFT = ("x_theta", "x_omega", "x_i", "x_twist", "x_omega_m", "u")
 _CAM = _SHAFT + _TRAIN
-_FLIGHT = _SHAFT + ("x_gap",)   # a follower of its own carries no train (physics/rules.py)
+_GAP = ("x_gap", "x_gap_rate")   # a follower of its own's (its train's damper takes the gap's rate too)
+_FLIGHT = _SHAFT + _GAP
 DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "der(x_theta)": ("x_omega",),
     "der(x_omega)": _CAM,
@@ -110,9 +112,9 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "der(x_twist)": ("x_omega", "x_omega_m"),
     "der(x_omega_m)": ("x_omega", "x_i", "x_twist", "x_omega_m", "u"),
     "der(x_end)": ("x_v_end",),
-    "der(x_v_end)": ("x_theta", "x_omega") + _TRAIN,
+    "der(x_v_end)": ("x_theta", "x_omega") + _TRAIN + _GAP,
     "der(x_gap)": ("x_gap_rate",),
-    "der(x_gap_rate)": _FLIGHT,
+    "der(x_gap_rate)": _FLIGHT + _TRAIN,
     "omega": ("x_omega",),
     "theta": ("x_theta",),
     "s": ("x_theta", "x_gap"),
@@ -131,7 +133,7 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "s_end": ("x_theta", "x_end", "x_gap"),   # without a train the end is the follower: s's
     "v_end": ("x_theta", "x_omega", "x_v_end", "x_gap_rate"),
     "a_end": _FLIGHT + _TRAIN,
-    "F_train": ("x_theta", "x_omega") + _TRAIN,
+    "F_train": ("x_theta", "x_omega") + _TRAIN + _GAP,
     "psi": ("x_theta", "x_gap"),   # an arm's angle (docs/model.md 16, 16.3; 0 for a translating follower)
     "psi_dot": ("x_theta", "x_omega", "x_gap_rate"),
 }

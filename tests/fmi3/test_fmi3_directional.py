@@ -89,7 +89,8 @@ class Host3(Host):
 
 
 @pytest.mark.parametrize("case", ["groove_voltage/flight", "spring_voltage/stuck", "spring_compliant/contact",
-                                  "backlash_form/flight_stuck", "groove_friction_L/contact"])
+                                  "backlash_form/flight_stuck", "groove_friction_L/contact", "spring_train/flight",
+                                  "arm_groove/flight"])
 def test_fmi3_follower_of_its_own_derivatives(cam3_fmu_path, engine_fmu_path, case):
     """A follower of its own in each mode (reached by each version's own event updates): fmi3GetDirectionalDerivative
     is fmi2GetDirectionalDerivative at the same state to the bit, and central differences of cam3.fmu's own
@@ -102,8 +103,9 @@ def test_fmi3_follower_of_its_own_derivatives(cam3_fmu_path, engine_fmu_path, ca
     unknowns = me.ders + me.outputs
     checked = 0
     try:
-        enter_follower_mode(me, mode, speed)
-        enter_follower_mode(host, mode, speed)
+        train = start.get("k_train", 0.0) > 0.0
+        enter_follower_mode(me, mode, speed, train)
+        enter_follower_mode(host, mode, speed, train)
         for _ in range(20):
             random_follower_state(me, rng, mode, start.get("c", 1e-3))
             z = me.knowns_now()

@@ -129,7 +129,15 @@ _ARM_SPRING = {**_ARM_OWN, "follower_type": "oscillating_flat", "lift_angle": 0.
                "k_spring": 300.0, "F_spring0": 3.0, "omega0": 20.0, "L": 1e-3}
 _FLAT_SPRING = {**CYCLOID, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2, "beta": 0.7, "G": 4.0,
                 "closure": "spring", "k_spring": 300.0, "F_spring0": 3.0, "omega0": 20.0}
+# A follower train on the follower of its own (docs/model.md 14.6): its end mass rings on the flank and in flight.
+_TRAIN = {"k_train": 2e4, "d_train": 5.0, "m_end": 0.2}
 FOLLOWER_CASES.update({
+    "spring_train/contact": ({**_SPRING, **_TRAIN}, "contact", 0.0),
+    "spring_train/stuck": ({**_SPRING, **_TRAIN, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
+    "spring_train/flight": ({**_SPRING, **_TRAIN}, "flight", 150.0),
+    "groove_train_friction_L/contact": ({**_GROOVE, **_TRAIN, **_FRICTION_L}, "contact", 0.0),
+    "groove_train_friction_L/flight": ({**_GROOVE, **_TRAIN, **_FRICTION_L}, "flight", 60.0),
+    "groove_train/flight_stuck": ({**_GROOVE, **_TRAIN}, "flight_stuck", 60.0),
     "arm_groove/contact": (_ARM_GROOVE, "contact", 0.0),
     "arm_groove/flight": (_ARM_GROOVE, "flight", 100.0),
     "arm_groove/flight_stuck": (_ARM_GROOVE, "flight_stuck", 100.0),
@@ -252,16 +260,19 @@ def random_states(me: Me, rng: np.random.Generator, stuck: bool) -> None:
         me.set_x(x)
 
 
-def enter_follower_mode(me, mode: str, speed: float) -> None:
+def enter_follower_mode(me, mode: str, speed: float, train: bool = False) -> None:
     """Put a follower of its own (in contact after the start) into `mode` (FOLLOWER_CASES) by the FMU's own event
     updates: the first cam angle (of 721) where the contact force at `speed` is < 0 (indicator slot 1), an event
     there (the lift-off); for 'flight_stuck' then u = 0 and the cam a hair past its stop, an event (stuck). `me` is an
-    FMI 2.0 (Me) or FMI 3.0 host with x, set_x, indicators, event and set_u."""
+    FMI 2.0 (Me) or FMI 3.0 host with x, set_x, indicators, event and set_u; `train`: a follower train's end mass is
+    put where it pulls the follower off."""
     if mode in ("contact", "stuck"):
         return
     x = me.x()
     for theta in np.linspace(0.0, 2 * math.pi, 721):
         x[0], x[1] = theta, speed
+        if train:   # the train's end mass 5 cm above the follower pulls it off
+            x[5], x[6] = 0.05, 0.0
         me.set_x(x)
         if me.indicators()[1] < 0.0:
             break
@@ -375,7 +386,7 @@ def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_pa
         assert np.abs(analytic[NX - 1 if mode == "flight" else slice(None)]).max() > 0.0
 
     try:
-        enter_follower_mode(me, mode, speed)
+        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) > 0.0)
         assert_matches_differences(me, case, draw, moving)
     finally:
         me.close()
@@ -409,7 +420,7 @@ def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
         me.close()
     for start, mode, speed in FOLLOWER_CASES.values():   # and in every mode the event updates reach
         me = Me(engine_fmu_path, start)
-        enter_follower_mode(me, mode, speed)
+        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) > 0.0)
         for _ in range(3):
             random_follower_state(me, rng, mode, start.get("c", 1e-3))
             fd = me.central(1e-6)

@@ -8,11 +8,13 @@
 
 #include "cam_drive.h"
 
-#define NY 9
+#define NY 11
 #define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
 #define Y_ROTOR 6
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
 #define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
+#define Y_XE 9                  /* y[9], y[10]: a follower train's end mass [m, m/s] (docs/model.md 14.6; 0 without) */
+#define Y_VE 10
 
 
 /* N m: what drives the cam side (the motor's torque, or a compliant shaft's) less the shaft's friction against the

@@ -85,6 +85,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     const int contact = d->mode.contact;
     const double left = d->mode.left, dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double y[NY], dy[NY], p[4], base, t, dt, root, ds, dv, da, dF, domega_dot = 0.0, dP = 0.0, P = 0.0, f, df;
+    double F_t = 0.0, dF_t = 0.0, dF_out = 0.0;   /* a train's force on the follower (docs/model.md 14.6) */
     Tangents g = drive_tangents(m, seed, du);
     int k, stuck;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
@@ -105,16 +106,20 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     ds = p[1] * dtheta;   /* the follower's position: on the flank, s_cam's */
     dv = p[2] * dtheta * y[1] + p[1] * domega;
     if (contact) {
-        dF = m->k_spring * p[1] * dtheta;   /* the closing force at s = s_cam - contact c */
+        if (m->train) {   /* on a stuck flank the rates take the follower at rest */
+            F_t = m->k_train * (y[3] - y[Y_XE]) + m->d_train * ((stuck ? 0.0 : y[4]) - y[Y_VE]);
+            dF_t = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * ((stuck ? 0.0 : dv) - seed[CAM_V_END]);
+        }
+        dF = m->k_spring * p[1] * dtheta + dF_t;   /* the closing force at s = s_cam - contact c, a train's */
         if (!stuck) {
             double dq[4] = {dtheta, domega, g.drive, dF};
             domega_dot = cam_flank_tangent(m, p, y[1], cam_vf_torque_toward(m, y, d->form_u, 0.0),
-                                           cam_follower_closing(m, y[3]), y[Y_DIR], 0.0, dq, &f, &df);
+                                           cam_follower_closing(m, y[3]) + F_t, y[Y_DIR], 0.0, dq, &f, &df);
             ddx[CAM_THETA] = domega;
             ddx[CAM_OMEGA] = domega_dot;
             cam_vf_on_flank(m, y, d->form_u, contact, p, &dy[1], &P);
         } else {
-            P = cam_follower_closing(m, y[3]);
+            P = cam_follower_closing(m, y[3]) + F_t;
             f = df = 0.0;
         }
         da = p[3] * dtheta * y[1] * y[1] + 2.0 * p[2] * y[1] * domega + p[2] * dtheta * dy[1] + p[1] * domega_dot;
@@ -126,7 +131,9 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
         ds += left * seed[CAM_GAP];
         dv += left * seed[CAM_RATE];
         domega_dot = stuck ? 0.0 : g.drive / m->J_0;
-        da = held ? 0.0 : -m->k_spring * ds / m->m;   /* the free follower's acceleration */
+        if (m->train)
+            dF_t = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]);
+        da = held ? 0.0 : -(m->k_spring * ds + dF_t) / m->m;   /* the free follower's acceleration */
         ddx[CAM_THETA] = domega;
         ddx[CAM_OMEGA] = domega_dot;
         ddx[CAM_GAP] = seed[CAM_RATE];
@@ -150,8 +157,17 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     dout[CAM_O_THETA_M] = dtheta + (m->compliant ? seed[CAM_TWIST] : 0.0);
     dout[CAM_O_OMEGA_M] = g.omega_m;
     dout[CAM_O_M_SHAFT] = m->compliant ? g.shaft : 0.0;
-    dout[CAM_O_S_END] = ds;   /* no train on a follower of its own (physics/rules.py): the end is the follower */
+    dout[CAM_O_S_END] = ds;   /* without a train the end is the follower */
     dout[CAM_O_V_END] = dv;
     dout[CAM_O_A_END] = da;
     dout[CAM_O_F_TRAIN] = 0.0;
+    if (m->train) {   /* the end mass's rows, its force at the follower's own s, v (the rates': at rest if stuck) */
+        dF_out = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]);
+        ddx[CAM_X_END] = seed[CAM_V_END];
+        ddx[CAM_V_END] = (contact ? dF_t : dF_out) / m->m_end;
+        dout[CAM_O_S_END] = seed[CAM_X_END];
+        dout[CAM_O_V_END] = seed[CAM_V_END];
+        dout[CAM_O_A_END] = dF_out / m->m_end;
+        dout[CAM_O_F_TRAIN] = dF_out;
+    }
 }

@@ -94,7 +94,7 @@ static double mechanical(const CamEnergy *e, const double out[])
     }
     if (e->own_follower) {   /* the cam side's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
         double own = 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s
-                     + 0.5 * e->k_spring * s * s - e->F_gx * s;
+                     + 0.5 * e->k_spring * s * s - e->F_gx * s + train_energy(e, out);
         if (e->k_shaft == 0.0)
             return own;
         twist = out[CAM_O_THETA_M] - out[CAM_O_THETA];   /* and a compliant shaft's rotor and elastic energy */

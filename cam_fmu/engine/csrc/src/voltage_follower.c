@@ -31,6 +31,7 @@
 #define SHAFT_PHASE_RK45 0.03  /* rad: the shaft's phase in one rk45 step. Its error norm alone left M_shaft's damper
                                  * term 1.8e-8 of M_shaft off the reference (0.1: 2.2e-9; 0.03 and below: 2.1e-10, the
                                  * reference's own floor); STEP_PHASE there took 56x the steps for no gain (measured) */
+#define TRAIN_PHASE 0.05        /* rad: the flying follower's phase on the train's spring in one step */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
 
@@ -38,6 +39,19 @@
 static double sgn(double x)
 {
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
+}
+
+/* N: the train's force F_train = k_train (s - x_e) + d_train (v - v_e) on its end mass, the follower at s [m] moving
+ * at v [m/s]; its reaction loads the follower (docs/model.md 14.6; 0 without a train). */
+static double train_force(const CamModel *m, const double y[NY], double s, double v)
+{
+    return m->train ? m->k_train * (s - y[Y_XE]) + m->d_train * (v - y[Y_VE]) : 0.0;
+}
+
+/* N: what closes the follower onto its +1 flank at s, v: the return spring and gravity, and a train's force. */
+static double closing_at(const CamModel *m, const double y[NY], double s, double v)
+{
+    return m->train ? cam_follower_closing(m, s) + train_force(m, y, s, v) : cam_follower_closing(m, s);
 }
 
 /* A: the armature current, the state's with L > 0, else quasi-static at the rotor's speed. */
@@ -81,7 +95,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
 {
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_kind_eval(m, y[0], d);
-    F = cam_follower_closing(m, d[0] - contact * cam_follower_clearance(m));
+    F = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), d[1] * omega);
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c's equation, the flank's b = contact */
         CamKindBranch branch;
         *omega_dot = cam_kind_branch(m, d, omega, cam_vf_torque_toward(m, y, u, dir), dir, contact, F, &branch);
@@ -116,7 +130,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
 {
     if (y[Y_DIR] == 0.0) {
         cam_kind_eval(m, y[0], d);
-        *P = cam_follower_closing(m, d[0] - contact * cam_follower_clearance(m));
+        *P = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), 0.0);
         *omega_dot = 0.0;
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
@@ -156,17 +170,17 @@ static double side_force(const CamModel *m, const double y[NY], double u, int co
     return n_r;
 }
 
-/* m/s2: the flying follower's acceleration with the friction's direction -sigma (0: held by it). */
-static double free_acceleration(const CamModel *m, double s, double sigma)
+/* m/s2: the flying follower's acceleration at y with the friction's direction -sigma (0: held by it). */
+static double free_acceleration(const CamModel *m, const double y[NY], double sigma)
 {
-    return sigma == 0.0 ? 0.0 : (-cam_follower_closing(m, s) - sigma * cam_follower_friction0(m)) / m->I_f;
+    return sigma == 0.0 ? 0.0 : (-closing_at(m, y, y[3], y[4]) - sigma * cam_follower_friction0(m)) / m->I_f;
 }
 
 /* The flying follower's acceleration at y (the guide's friction only where it acts in flight). */
 static double flight_acceleration(const CamModel *m, const double y[NY])
 {
-    return cam_follower_friction0(m) == 0.0 ? -cam_follower_closing(m, y[3]) / m->I_f
-                                            : free_acceleration(m, y[3], y[Y_SIGMA]);
+    return cam_follower_friction0(m) == 0.0 ? -closing_at(m, y, y[3], y[4]) / m->I_f
+                                            : free_acceleration(m, y, y[Y_SIGMA]);
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
@@ -176,13 +190,20 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
     double net;
     if (y[4] != 0.0)
         return sgn(y[4]);
-    net = -cam_follower_closing(m, y[3]);
+    net = -closing_at(m, y, y[3], 0.0);
     return fabs(net) > cam_follower_friction0(m) ? sgn(net) : 0.0;
+}
+
+/* A train's end mass: its rates under the follower at s [m] moving at v [m/s] (held at 0 without a train). */
+static void end_mass_rates(const CamModel *m, const double y[NY], double s, double v, double dy[NY])
+{
+    dy[Y_XE] = m->train ? y[Y_VE] : 0.0;
+    dy[Y_VE] = m->train ? (train_force(m, y, s, v) + m->F_ex) / m->m_end : 0.0;
 }
 
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY])
 {
-    double omega_m = m->compliant ? y[Y_ROTOR] : y[1];
+    double omega_m = m->compliant ? y[Y_ROTOR] : y[1], d[4];
     dy[0] = y[1];
     dy[2] = m->has_current ? (u - m->R * y[2] - m->c_e * omega_m) / m->L : 0.0;
     dy[Y_TWIST] = m->compliant ? omega_m - y[1] : 0.0;
@@ -191,18 +212,26 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
     dy[Y_DIR] = 0.0;
     if (contact && y[Y_DIR] == 0.0) {   /* stuck: the cam and the follower on its flank at rest */
         dy[0] = dy[1] = dy[3] = dy[4] = 0.0;
+        if (m->train) {
+            cam_kind_eval(m, y[0], d);
+            end_mass_rates(m, y, d[0] - contact * cam_follower_clearance(m), 0.0, dy);
+        } else {
+            dy[Y_XE] = dy[Y_VE] = 0.0;
+        }
         return;
     }
     if (contact) {
-        double d[4], P, n_r;
+        double P, n_r;
         flank_terms(m, y, u, contact, d, &dy[1], &P, &n_r);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
+        end_mass_rates(m, y, d[0] - contact * cam_follower_clearance(m), dy[3], dy);
         return;
     }
     dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
     dy[3] = y[4];
     dy[4] = flight_acceleration(m, y);
+    end_mass_rates(m, y, y[3], y[4], dy);
 }
 
 /* The follower set on the flank `contact` at y's angle, moving with it. */
@@ -238,7 +267,8 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
 {
     double d[4];
     cam_kind_eval(m, y[0], d);
-    return fabs(cam_follower_closing(m, d[0]) / m->I_f) + cam_follower_friction0(m) / m->I_f + fabs(d[2]) * y[1] * y[1]
+    return fabs(closing_at(m, y, d[0], d[1] * y[1]) / m->I_f) + cam_follower_friction0(m) / m->I_f
+           + fabs(d[2]) * y[1] * y[1]
            + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
 }
 
@@ -259,6 +289,10 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
     if (m->compliant) {
         x[CAM_TWIST] = y[Y_TWIST];
         x[CAM_OMEGA_M] = y[Y_ROTOR];
+    }
+    if (m->train) {
+        x[CAM_X_END] = y[Y_XE];
+        x[CAM_V_END] = y[Y_VE];
     }
     mode->stuck = y[Y_DIR] == 0.0;
     if (y[Y_DIR] != 0.0)
@@ -290,6 +324,8 @@ static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM
     y[Y_ROTOR] = m->compliant ? x[CAM_OMEGA_M] : 0.0;
     y[Y_SIGMA] = mode->contact ? 0.0 : mode->sigma;
     y[Y_DIR] = mode->stuck ? 0.0 : mode->direction;
+    y[Y_XE] = m->train ? x[CAM_X_END] : 0.0;
+    y[Y_VE] = m->train ? x[CAM_V_END] : 0.0;
     y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; flank_terms) */
     if (!mode->contact) {
         cam_kind_eval(m, y[0], dd);
@@ -316,7 +352,8 @@ void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     dx[CAM_CURRENT] = dy[2];
     dx[CAM_TWIST] = dy[Y_TWIST];
     dx[CAM_OMEGA_M] = dy[Y_ROTOR];
-    dx[CAM_X_END] = dx[CAM_V_END] = 0.0;   /* no train on a follower of its own (physics/rules.py): held */
+    dx[CAM_X_END] = dy[Y_XE];   /* a train's end mass (held at 0 without one) */
+    dx[CAM_V_END] = dy[Y_VE];
     dx[CAM_GAP] = dx[CAM_RATE] = 0.0;
     if (mode->contact)
         return;
@@ -375,6 +412,7 @@ static double vf_step_limit(const CamDrive *d, double time)
     const CamMethod *method = cam_method(m->solver);
     double y[NY], dt = HUGE_VAL, u = d->form_u;
     double wn = m->k_spring > 0.0 ? sqrt(cam_follower_stiffness(m) / m->I_f) : 0.0;
+    double wt = m->train ? sqrt((cam_follower_stiffness(m) + m->k_train) / m->I_f) : 0.0;   /* on the train */
     double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
                   : 0.0;
     double ws = m->compliant ? cam_shaft_rate(m, m->J_0) : 0.0;
@@ -382,6 +420,8 @@ static double vf_step_limit(const CamDrive *d, double time)
         dt = fmin(dt, FLIGHT_ANGLE / fabs(d->x[CAM_OMEGA]));
     if (!mode->contact && wn > 0.0)
         dt = fmin(dt, STEP_PHASE / wn);
+    if (!mode->contact && wt > 0.0)   /* the follower rings on the train's spring: a gap's crossing and return unseen */
+        dt = fmin(dt, TRAIN_PHASE / wt);
     if (!mode->contact && mode->stuck && cam_follower_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
         double c = cam_follower_clearance(m), A;
         cam_vf_y(m, mode, d->x, y);
@@ -420,6 +460,18 @@ static void vf_transition(CamDrive *d, int code, double time)
     d->speed.rebound = rebound > 0.0 ? time + rebound : 0.0;
 }
 
+/* A train's end mass at rest relative to the follower on the flank `contact` at y (its weight on the train's spring:
+ * transitions.c cam_initial's rest, taken from the follower's flank, not the cam's s). */
+static void relax_train(const CamModel *m, double y[NY], int contact)
+{
+    double d[4];
+    if (!m->train)
+        return;
+    cam_kind_eval(m, y[0], d);
+    y[Y_XE] = d[0] - contact * cam_follower_clearance(m) + m->F_ex / m->k_train;
+    y[Y_VE] = d[1] * y[1];
+}
+
 static int vf_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
@@ -435,9 +487,11 @@ static int vf_init(CamDrive *d, CamError *err)
         double y[NY], other[NY];
         int contact, left = 1;
         cam_vf_y(&d->model, &d->mode, d->x, y);
+        relax_train(&d->model, y, 1);
         contact = cam_vf_settle(&d->model, y, d->u, 1);
         if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
             memcpy(other, y, sizeof other);
+            relax_train(&d->model, other, -1);
             if ((contact = cam_vf_settle(&d->model, other, d->u, -1)) != 0)
                 memcpy(y, other, sizeof other);
         }
@@ -528,6 +582,13 @@ static void vf_outputs(CamDrive *d, double out[])
         }
     } else {
         cam_record_outputs(&load, y[1], y[0], y[3], i, d->form_u, out);
+    }
+    if (m->train) {   /* the end mass on the follower's own s, v (docs/model.md 14.6) */
+        double F = train_force(m, y, y[3], y[4]);
+        out[CAM_O_S_END] = y[Y_XE];
+        out[CAM_O_V_END] = y[Y_VE];
+        out[CAM_O_A_END] = (F + m->F_ex) / m->m_end;
+        out[CAM_O_F_TRAIN] = F;
     }
     if (m->compliant) {   /* the rotor's side of the shaft; J counts the rotor too (outputs.c cam_outputs) */
         out[CAM_O_J] = load.J + m->J_m;
