@@ -366,11 +366,10 @@ int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENT
     int n = 0;
     codes[n++] = mode->stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
     if (mode->contact) {
-        if (!mode->stuck) {
+        if (!mode->stuck || m->train)   /* stuck, only a train's ringing changes the flank's force */
             codes[n++] = EV_LIFT_OFF;
-            if (mode->side != 0.0)
-                codes[n++] = EV_SIDE;   /* ends a step at the kink of |N_r| */
-        }
+        if (!mode->stuck && mode->side != 0.0)
+            codes[n++] = EV_SIDE;   /* ends a step at the kink of |N_r| */
         return n;
     }
     codes[n++] = EV_TOUCH_UP;

@@ -162,7 +162,7 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
     int n = 0, stuck = d->mode.stuck;
     codes[n++] = stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the input and the current may start it */
     if (d->mode.contact != 0) {
-        if (!stuck)
+        if (!stuck || d->model.train)   /* stuck, only a train's ringing changes the flank's force */
             codes[n++] = EV_LIFT_OFF;
         return n;
     }
