@@ -95,7 +95,8 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
     d->form->advice(d, advice, sizeof advice);
     if (verdict == CAM_PUBLISH_CLEARANCE)
         return cam_error(err, CAM_ERR_SIMULATION, "the follower is %.6g m from the cam at t = %g s, beyond the "
-                        "clearance c = %g m: a contact event was missed; %s", fabs(out[CAM_O_S] - out[CAM_O_S_CAM]),
+                        "clearance c = %g m: a contact event was missed; %s",
+                        fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) * d->model.q_scale * cam_follower_length(&d->model),
                         d->time, d->model.c, advice);
     {
         double excess, tolerance;

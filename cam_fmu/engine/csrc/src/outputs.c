@@ -171,14 +171,15 @@ int cam_energy_created(const CamEnergy *e, const double out[])
 
 int cam_publishable(const CamModel *m, const double out[], CamEnergy *budget, double u, double h)
 {
-    double total = 0.0;
+    double total = 0.0, gap;
     int k;
     for (k = 0; k < CAM_N_OUTPUTS; k++)
         total += out[k];
     if (!isfinite(total))
         return CAM_PUBLISH_NOT_FINITE;
-    if (m->closure == CAM_CHOICE_CLOSURE_SPRING ? out[CAM_O_S] - out[CAM_O_S_CAM] < -2e-12   /* on or off its flank */
-        : fabs(out[CAM_O_S] - out[CAM_O_S_CAM]) > m->c * (1.0 + 1e-9) + (m->free_follower ? 2e-12 : 1e-12))
+    gap = (out[CAM_O_S] - out[CAM_O_S_CAM]) * m->q_scale * cam_follower_length(m);   /* m along the follower's path */
+    if (m->closure == CAM_CHOICE_CLOSURE_SPRING ? gap < -2e-12   /* on or off its flank */
+        : fabs(gap) > m->c * (1.0 + 1e-9) + (m->free_follower ? 2e-12 : 1e-12))
         return CAM_PUBLISH_CLEARANCE;   /* a free follower touches down 1e-12 m inside a flank (follower.c) */
     if (budget != NULL) {
         cam_energy_step(budget, u, h, out[CAM_O_THETA_M], out[CAM_O_I]);
