@@ -205,10 +205,6 @@ RULES: tuple[Rule, ...] = (
          "parameter 'k_train' = {k_train} N/m: a train on a follower in a clearance needs the follower as a body of "
          "its own (closure 'form' with its mass m > 0, docs/model.md 14.6); allowed with closure {closure} and c = "
          "{c} m: k_train = 0"),
-    Rule(AllOf(TRAIN, OWN_FOLLOWER, Is("drive", ("speed",))),
-         "parameter 'k_train' = {k_train} N/m: the speed drive integrates a follower of its own's flight in closed "
-         "form (a spring and a constant force), which the train's end mass is not; allowed with closure {closure} "
-         "in the speed drive: k_train = 0 (or drive 'voltage', docs/model.md 14.6)"),
     *(Rule(AllOf(Not(OSCILLATING), Cmp(Num(name), "!=")),
            f"parameter {name!r} = {{{name}}} {unit} is not used by follower_type {{follower_type}} (only by the "
            f"oscillating types): leave it at its default 0") for name, unit in ARM_UNITS),
@@ -223,10 +219,6 @@ RULES: tuple[Rule, ...] = (
          "parameter 'c' = {c} m with follower_type {follower_type}: a clearance needs the follower as a body of its "
          "own (closure 'form' with the follower's mass m > 0, in the consistent formulation or the speed drive; "
          "docs/model.md 16.3); allowed with closure {closure}: c = 0"),
-    Rule(AllOf(OSCILLATING, OWN_FOLLOWER, Is("drive", ("speed",)), Cmp(Num("gravity"), "!=")),
-         "parameter 'gravity' = true with follower_type {follower_type} and closure {closure} in the speed "
-         "drive: its flight is integrated in closed form (a spring and a constant force), which an arm's weight "
-         "torque W cos(psi + psi_0) is not; allowed with it: gravity false (or drive 'voltage', docs/model.md 16.3)"),
     Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, TRAIN, AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
          "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train and a solver "
          "other than 'etdrk4' (which integrates the roller's electrical pole) so far; allowed with k_shaft = "

@@ -191,8 +191,6 @@ def refusal(params: dict) -> str:
     (dict(follower_type="oscillating_flat", lift_angle=0.1, pivot_distance=0.18), ("'arm_length'", "needs it")),
     (dict(KINDS["oscillating_roller"], beta=0.2), ("'beta'", "psi_0")),
     (dict(KINDS["translating_flat"], closure="kinematic", c=1e-4), ("'c' = 0.0001", "closure 'kinematic': c = 0")),
-    (dict(KINDS["oscillating_roller"], drive="speed", closure="spring", k_spring=1e3, gravity=True),
-     ("'gravity' = true", "closed form")),
     (dict(KINDS["translating_flat"], k_shaft=100.0), ("'follower_type'", "k_shaft = 100.0")),
     (dict(KINDS["oscillating_flat"], k_train=1e4, m_end=0.1), ("'follower_type'", "k_train = 10000.0")),
     (dict(KINDS["oscillating_flat"], formulation="paper"), ("'follower_type'", "paper")),

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from cam_fmu.engine.simulator import DriveSimulator
-from cam_fmu.physics.parameters import ParameterError, defaults
+from cam_fmu.physics.parameters import defaults
 
 G_N = 9.80665
 RISE = math.pi / 2
@@ -106,8 +106,3 @@ def test_the_train_pulls_the_follower_off_when_its_ringing_overcomes_the_spring(
     lift_offs = [event["time"] for event in sim.events() if event["name"] == "contact"]
     assert lift_offs and abs(lift_offs[0] - expected) < 1e-10
     assert sim.outputs()["N_contact"] == 0.0
-
-
-def test_the_speed_drive_refuses_a_train_on_a_follower_of_its_own_by_name():
-    with pytest.raises(ParameterError, match="'k_train' = 20000.0 N/m: the speed drive"):
-        DriveSimulator(dict(defaults(), **{**SCENE, "drive": "speed"}, **CLOSURES["spring"]))

@@ -63,6 +63,7 @@ extern const CamFormulation cam_consistent;   /* consistent.c */
 extern const CamFormulation cam_paper;        /* paper.c */
 extern const CamFormulation cam_speed;        /* speed.c */
 extern const CamFormulation cam_voltage_follower;   /* voltage_follower.c: consistent, closures 'form', 'spring' */
+extern const CamFormulation cam_speed_follower;   /* voltage_follower.c: the speed drive, closures 'form', 'spring' */
 
 /* The fixed-step paper scheme's state (paper.PaperScheme: FIELDS and M_l), in SI units. */
 typedef struct {
@@ -81,14 +82,6 @@ typedef struct {
     double fresh;               /* 1 until the first step: the start's contact follows the inputs set */
 } CamSpeedState;
 
-/* The follower as a body of its own in the speed drive (follower.c; docs/model.md section 13): its contact at the
- * start, a step of h [s] (st->theta not moved), the outputs (direction: the way the cam moves, sgn(omega), at a stop
- * at the step's end the way it moved into it: the left limit, docs/model.md 8.1). */
-void cam_follower_start(const CamModel *m, CamSpeedState *st, double omega, double omega_dot);
-int cam_follower_advance(const CamModel *m, CamSpeedState *st, double omega0, double omega_dot, double h,
-                         double time, char *events, size_t events_len, CamError *err);
-void cam_follower_outputs(const CamModel *m, const CamSpeedState *st, double omega_dot, double direction,
-                          double out[]);
 /* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
 typedef double (*CamEventValue)(void *ctx, int code, double x);
 /* The earliest of the n event functions codes[k] to cross, as `crossed(before, after)` says, from fa[k] at a to fb[k]

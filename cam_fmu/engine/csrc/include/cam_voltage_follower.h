@@ -58,6 +58,14 @@ void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int
 void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *contact, int *left, double *rebound,
                          double time, long *dropped);
 
+/* The formulation's parts the speed drive's follower (speed_follower.c) shares: the start on a flank under the input
+ * u, the outputs, the transition hook, the step bound, and the load torque [N m] on the flank `contact` at y. */
+void cam_vf_start(CamDrive *d, double u);
+void cam_vf_outputs(CamDrive *d, double out[]);
+void cam_vf_apply(CamDrive *d, int code, double time);
+double cam_vf_step_limit(const CamDrive *d, double time);
+double cam_vf_flank_torque(const CamModel *m, const double y[NY], double u, int contact);
+
 /* Model Exchange's view (the formulation's hooks cam_vf_exchange, cam_drive.h CamExchangeHooks). */
 int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS]);
 double cam_vf_me_event(const CamDrive *d, int code, const double x[CAM_ME_NX]);

@@ -28,7 +28,7 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt_
     const CamModel *m = &d->model;
     const CamMethod *method = it->method;
     int electrical = !method->exact_electrical_pole, finite, slot;
-    double stab = method->stability, res = method->resolution, u = d->u;
+    double stab = method->stability, res = method->resolution, u = d->form_u;
     double rate = cam_stiffness_rate(m, &d->mode, d->x, electrical), sweep = cam_profile_rate(m, d->x);
     double dt, rate_end, sweep_end, swept, fastest;
     long retries = 0;

@@ -13,7 +13,7 @@ const CamFormulation *cam_formulation(const CamModel *m)
     case CAM_FORM_PAPER:
         return &cam_paper;
     case CAM_FORM_SPEED:
-        return &cam_speed;
+        return m->free_follower ? &cam_speed_follower : &cam_speed;
     default:
         return NULL;
     }

@@ -87,7 +87,7 @@ int cam_step_adaptive(CamDrive *d, CamIntegrator *it, double remaining, double t
                       CamError *err)
 {
     const CamModel *m = &d->model;
-    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->u;
+    double dt = d->solver.h_next, floor_ = 1e-12 * span, u = d->form_u;
     if (remaining < dt)
         dt = remaining;
     if (m->h_max < dt)
@@ -200,8 +200,8 @@ static double trial_value(void *ctx, int code, double tau)
     Trial *t = ctx;
     double g;
     int k = 0;
-    trial(t->d, t->it, tau, t->d->u);
-    g = zero_value(t->d, code, t->target, t->it->work.x_new, t->d->u);
+    trial(t->d, t->it, tau, t->d->form_u);
+    g = zero_value(t->d, code, t->target, t->it->work.x_new, t->d->form_u);
     if (g <= 0.0) {
         while (t->codes[k] != code)
             k++;
@@ -243,7 +243,7 @@ static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], cons
 static double first_event(CamDrive *d, CamIntegrator *it, double dt)
 {
     int n = it->n_events, k;
-    double tau, u = d->u;
+    double tau, u = d->form_u;
     if (!it->have_before)
         cam_event_values(&d->model, &d->mode, n, it->codes, d->x, u, it->before);
     it->have_before = 0;
@@ -297,7 +297,7 @@ static int same_mode(const CamMode *a, const CamMode *b)
 static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *steps_out, CamError *err)
 {
     const CamModel *m = &d->model;
-    double t = 0.0, u = d->u, remaining, dt, target, cut, tau;
+    double t = 0.0, u = d->form_u, remaining, dt, target, cut, tau;
     long steps = 0, retries;
     int was_stuck = d->mode.stuck, next_valid, status, at_break;
     CamMode before = d->mode;

@@ -88,8 +88,6 @@ static int speed_init(CamDrive *d, CamError *err)
     d->speed.s = s_at(&d->model.profile, d->speed.theta);
     d->speed.v = d->speed.contact = d->speed.impacts = d->speed.rebound = 0.0;
     d->speed.fresh = 1.0;
-    if (d->model.free_follower)
-        cam_follower_start(&d->model, &d->speed, d->omega_ref, d->omega_dot_ref);
     if (d->model.train) {   /* the end mass at rest relative to the follower (its speed set with the inputs) */
         d->x[CAM_X_END] = x0[CAM_X_END];
         d->x[CAM_V_END] = 0.0;
@@ -100,16 +98,12 @@ static int speed_init(CamDrive *d, CamError *err)
 static void speed_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
 {
     (void)u;
+    (void)omega_dot_ref;
     d->speed.speed = omega_ref;
     if (d->model.train && d->speed.fresh != 0.0) {   /* before the first step: v_e = v, the cam at omega_ref */
         double p[4];
         cam_profile_eval(&d->model.profile, d->speed.theta, p);
         d->x[CAM_V_END] = p[1] * omega_ref;
-    }
-    if (d->model.free_follower) {   /* its own motion: the start's contact follows the inputs set before the first step */
-        if (d->speed.fresh != 0.0)
-            cam_follower_start(&d->model, &d->speed, omega_ref, omega_dot_ref);
-        return;
     }
     if (omega_ref == 0.0)   /* at rest from now: the follower lies where the force along the stroke pushes it (the
                                reference: after the output at a time where omega_ref is 0) */
@@ -122,19 +116,6 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
     double end = st->theta + (d->omega_ref + 0.5 * d->omega_dot_ref * h) * h;
     d->step_events[0] = '\0';
     (void)time;
-    if (d->model.free_follower) {
-        int status;
-        if (st->fresh != 0.0)
-            cam_follower_start(&d->model, st, d->omega_ref, d->omega_dot_ref);
-        st->fresh = 0.0;
-        if ((status = cam_follower_advance(&d->model, st, d->omega_ref, d->omega_dot_ref, h, time, d->step_events,
-                                           sizeof d->step_events, err)) != CAM_OK)
-            return status;
-        st->speed = d->omega_ref + d->omega_dot_ref * h;
-        st->theta = end;
-        *steps = 1;
-        return CAM_OK;
-    }
     if (d->model.train) {   /* the end mass under the step's motion (train.c), before the cam moves on */
         double h_next = d->solver.h_next > 0.0 ? d->solver.h_next : h;
         int status = cam_train_follow(&d->model, d->x, st->theta, d->omega_ref, d->omega_dot_ref, h, &h_next, steps,
@@ -176,10 +157,6 @@ static void speed_outputs(CamDrive *d, double out[])
     CamLoad load, ahead, behind;
     int on;
     direction = motion_sign(omega, d->omega_ref, omega_dot, fabs(d->time));
-    if (m->free_follower) {
-        cam_follower_outputs(m, st, omega_dot, direction, out);
-        return;
-    }
     double x_e = d->x[CAM_X_END], v_e = d->x[CAM_V_END], F = cam_train_force(m, theta, omega, x_e, v_e), a_e = 0.0;
     on = engaged(m, theta, st->s, direction, omega_dot);
     cam_load(m, theta, omega, omega_dot, direction, on, F, &load);

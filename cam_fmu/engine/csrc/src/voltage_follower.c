@@ -96,6 +96,21 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
     double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
     cam_kind_eval(m, y[0], d);
     F = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), d[1] * omega);
+    if (m->prescribed) {   /* the speed drive: omega_dot imposed (u), the flank's force follows */
+        double push = m->I_f * (d[2] * omega * omega + d[1] * u) + F;
+        *omega_dot = u;
+        *P = push;
+        *n_r = 0.0;
+        if (m->mu == 0.0 || m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)
+            return;   /* another type's friction loads the cam, not the follower */
+        sigma = sgn(d[1] * dir);   /* the guide's friction with the side force (J_0 = inf: kappa = tan(alpha)) */
+        tan_a = d[1] / (m->r_b + d[0]);
+        n0 = push * tan_a + m->G_y;
+        f = cam_guide_friction(n0, tan_a, sigma, m->mu, m->N_g, 0.0);
+        *P = push + sigma * f;
+        *n_r = n0 + sigma * tan_a * f;
+        return;
+    }
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c's equation, the flank's b = contact */
         CamKindBranch branch;
         *omega_dot = cam_kind_branch(m, d, omega, cam_vf_torque_toward(m, y, u, dir), dir, contact, F, &branch);
@@ -205,7 +220,7 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
 {
     double omega_m = m->compliant ? y[Y_ROTOR] : y[1], d[4];
     dy[0] = y[1];
-    dy[2] = m->has_current ? (u - m->R * y[2] - m->c_e * omega_m) / m->L : 0.0;
+    dy[2] = m->has_current && !m->prescribed ? (u - m->R * y[2] - m->c_e * omega_m) / m->L : 0.0;
     dy[Y_TWIST] = m->compliant ? omega_m - y[1] : 0.0;
     dy[Y_ROTOR] = m->compliant ? (m->c_m * current(m, y, u) - shaft_torque(m, y)) / m->J_m : 0.0;
     dy[Y_SIGMA] = 0.0;
@@ -228,7 +243,8 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
         end_mass_rates(m, y, d[0] - contact * cam_follower_clearance(m), dy[3], dy);
         return;
     }
-    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : torque(m, y, u) / m->J_0;   /* the cam stuck: the follower flies alone */
+    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : (m->prescribed ? u : torque(m, y, u) / m->J_0);   /* the cam stuck: the follower
+                                                                                      * flies alone */
     dy[3] = y[4];
     dy[4] = flight_acceleration(m, y);
     end_mass_rates(m, y, y[3], y[4], dy);
@@ -269,7 +285,7 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
     cam_kind_eval(m, y[0], d);
     return fabs(closing_at(m, y, d[0], d[1] * y[1]) / m->I_f) + cam_follower_friction0(m) / m->I_f
            + fabs(d[2]) * y[1] * y[1]
-           + fabs(d[1] * torque(m, y, u) / m->J_0) + 1e-300;
+           + fabs(d[1] * (m->prescribed ? u : torque(m, y, u) / m->J_0)) + 1e-300;
 }
 
 /* ------------------------------------------------------------------ the model contract's view (x, mode)
@@ -303,7 +319,7 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
     mode->sigma = 0.0;
     mode->side = 0.0;
     if (contact) {   /* the side force's sign: the kink of |N_r| ends a step (docs/model.md 10) */
-        if (y[Y_DIR] != 0.0 && m->mu > 0.0)
+        if (y[Y_DIR] != 0.0 && m->mu > 0.0 && !m->prescribed)   /* imposed motion: P's kink changes nothing */
             mode->side = sgn(side_force(m, y, u, contact));
         return;
     }
@@ -364,7 +380,10 @@ void cam_vf_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
 int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENTS])
 {
     int n = 0;
-    codes[n++] = mode->stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
+    if (!m->prescribed)
+        codes[n++] = mode->stuck ? EV_BREAK_AWAY : EV_STOP;   /* stuck: the torque on it may change */
+    else if (!mode->stuck)
+        codes[n++] = EV_STOP;   /* the imposed motion through omega = 0: its direction turns */
     if (mode->contact) {
         if (!mode->stuck || m->train)   /* stuck, only a train's ringing changes the flank's force */
             codes[n++] = EV_LIFT_OFF;
@@ -404,7 +423,7 @@ double cam_vf_value(const CamModel *m, const CamMode *mode, int code, const doub
 
 /* s: the longest step the follower's phases allow at the drive's state at `time` [s] (the flight's oscillation,
  * a gap's crossing, the electrical pole, the shaft, a rebound; the solver's own limits come on top). */
-static double vf_step_limit(const CamDrive *d, double time)
+double cam_vf_step_limit(const CamDrive *d, double time)
 {
     const CamModel *m = &d->model;
     const CamMode *mode = &d->mode;
@@ -412,7 +431,7 @@ static double vf_step_limit(const CamDrive *d, double time)
     double y[NY], dt = HUGE_VAL, u = d->form_u;
     double wn = m->k_spring > 0.0 ? sqrt(cam_follower_stiffness(m) / m->I_f) : 0.0;
     double wt = m->train ? sqrt((cam_follower_stiffness(m) + m->k_train) / m->I_f) : 0.0;   /* on the train */
-    double pole = m->has_current ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
+    double pole = m->has_current && !m->prescribed ? m->R / m->L + sqrt(m->c_e * m->c_m / ((m->compliant ? m->J_m : m->J_0) * m->L))
                   : 0.0;
     double ws = m->compliant ? cam_shaft_rate(m, m->J_0) : 0.0;
     if (!mode->contact && d->x[CAM_OMEGA] != 0.0)   /* in flight a step at most scans the gap's events */
@@ -440,7 +459,7 @@ static double vf_step_limit(const CamDrive *d, double time)
 
 /* The follower's transition `code` at the drive's state at `time` [s] (EV_NONE: the step's start, settled;
  * EV_BREAK: a profile breakpoint, the contact settled): cam_vf_event_update on y, the log line appended. */
-static void vf_transition(CamDrive *d, int code, double time)
+void cam_vf_apply(CamDrive *d, int code, double time)
 {
     const CamModel *m = &d->model;
     double y[NY], rebound = d->speed.rebound > time ? d->speed.rebound - time : 0.0;
@@ -471,13 +490,10 @@ static void relax_train(const CamModel *m, double y[NY], int contact)
     y[Y_VE] = d[1] * y[1];
 }
 
-static int vf_init(CamDrive *d, CamError *err)
+/* The follower's start at the drive's x (on its lower flank, or a groove's upper one where that holds; the shaft at
+ * rest decided by its rule) under the input u (the voltage, or the speed drive's imposed acceleration). */
+void cam_vf_start(CamDrive *d, double u)
 {
-    const double *v = d->model.params.v;
-    (void)err;
-    cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
-    d->form_u = d->u;
-    memset(&d->speed, 0, sizeof d->speed);
     d->mode.contact = CAM_ON_LOWER_FLANK;   /* or (a groove) on its upper flank where that one holds */
     d->mode.left = CAM_ON_LOWER_FLANK;
     d->mode.s_free = 0.0;
@@ -487,18 +503,28 @@ static int vf_init(CamDrive *d, CamError *err)
         int contact, left = 1;
         cam_vf_y(&d->model, &d->mode, d->x, y);
         relax_train(&d->model, y, 1);
-        contact = cam_vf_settle(&d->model, y, d->u, 1);
+        contact = cam_vf_settle(&d->model, y, u, 1);
         if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
             memcpy(other, y, sizeof other);
             relax_train(&d->model, other, -1);
-            if ((contact = cam_vf_settle(&d->model, other, d->u, -1)) != 0)
+            if ((contact = cam_vf_settle(&d->model, other, u, -1)) != 0)
                 memcpy(y, other, sizeof other);
         }
         if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-            cam_vf_at_rest(&d->model, y, d->u, &contact, &left, 0);
-        cam_vf_x(&d->model, y, d->u, contact, contact != 0 ? contact : left, d->x, &d->mode);
+            cam_vf_at_rest(&d->model, y, u, &contact, &left, 0);
+        cam_vf_x(&d->model, y, u, contact, contact != 0 ? contact : left, d->x, &d->mode);
     }
     d->solver.k1_valid = 0;
+}
+
+static int vf_init(CamDrive *d, CamError *err)
+{
+    const double *v = d->model.params.v;
+    (void)err;
+    cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
+    d->form_u = d->u;
+    memset(&d->speed, 0, sizeof d->speed);
+    cam_vf_start(d, d->u);
     return CAM_OK;
 }
 
@@ -523,7 +549,8 @@ static void kind_flank_load(const CamModel *m, const double y[NY], double u, int
     cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P);
     if (y[Y_DIR] == 0.0) {   /* stuck: static friction takes it all, the flank holds the follower at rest */
         cam_kind_contact_load(m, q, P, 0.0, load);
-        load->M = cam_vf_torque_toward(m, y, u, 0.0);
+        if (!m->prescribed)   /* (the speed drive's cam at rest: the flank's holding torque) */
+            load->M = cam_vf_torque_toward(m, y, u, 0.0);
     } else {
         cam_kind_contact_load(m, q, P, shaft_direction(y), load);
     }
@@ -532,7 +559,7 @@ static void kind_flank_load(const CamModel *m, const double y[NY], double u, int
 
 /* voltage_follower.outputs: the follower's own s, v, a (another type: its own q, q_dot, in the law's lift units, and
  * an arm's psi, psi_dot); in flight M = M_f sgn(omega) and J = J_0. */
-static void vf_outputs(CamDrive *d, double out[])
+void cam_vf_outputs(CamDrive *d, double out[])
 {
     const CamModel *m = &d->model;
     double y[NY], dd[4], omega_dot, P, i, a;
@@ -553,7 +580,7 @@ static void vf_outputs(CamDrive *d, double out[])
         double tan_a = dd[1] / (m->r_b + dd[0]);
         cam_vf_on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
         /* stuck: static friction takes it all */
-        load.M = y[Y_DIR] == 0.0 ? cam_vf_torque_toward(m, y, d->form_u, 0.0)
+        load.M = y[Y_DIR] == 0.0 && !m->prescribed ? cam_vf_torque_toward(m, y, d->form_u, 0.0)
                  : m->M_f * shaft_direction(y) + P * dd[1];
         load.N = cam_normal_force(P, tan_a);   /* signed as contact */
         load.J = m->J_0 + m->m * dd[1] * dd[1];
@@ -604,6 +631,19 @@ static void vf_advice(const CamDrive *d, char *buf, size_t len)
 }
 
 const CamFormulation cam_voltage_follower = {
-    "consistent", 1, vf_init, vf_set_inputs, vf_advance, vf_outputs, vf_advice, &cam_vf_exchange, vf_transition,
-    vf_step_limit,
+    "consistent", 1, vf_init, vf_set_inputs, vf_advance, cam_vf_outputs, vf_advice, &cam_vf_exchange, cam_vf_apply,
+    cam_vf_step_limit,
 };
+
+/* N m: the load torque with the follower on the flank `contact` at y (M_f d + P q' and another type's friction). */
+double cam_vf_flank_torque(const CamModel *m, const double y[NY], double u, int contact)
+{
+    double q[4], omega_dot, P, a;
+    CamLoad load;
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
+        kind_flank_load(m, y, u, contact, &a, &load);
+        return load.M;
+    }
+    cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P);
+    return m->M_f * shaft_direction(y) + P * q[1];
+}

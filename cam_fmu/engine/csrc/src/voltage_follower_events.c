@@ -12,6 +12,10 @@
 static void impact(const CamModel *m, double y[NY], double s1, double e)
 {
     double w = y[4] - s1 * y[1], m_eff = m->I_f * m->J_0 / (m->J_0 + m->I_f * s1 * s1);
+    if (m->prescribed) {   /* the speed drive's cam (J_0 = inf): its speed is kept */
+        y[4] -= (1.0 + e) * w;
+        return;
+    }
     double P = -(1.0 + e) * m_eff * w;
     y[4] += P / m->I_f;
     y[1] -= s1 * P / m->J_0;
@@ -110,6 +114,11 @@ void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int
     double dir, margin;
     y[1] = 0.0;
     y[Y_DIR] = 0.0;
+    if (m->prescribed) {   /* the speed drive: the imposed acceleration u turns it (0: at rest) */
+        y[Y_DIR] = u > 0.0 ? 1.0 : (u < 0.0 ? -1.0 : 0.0);
+        *contact = cam_vf_settle_from(m, y, u, *contact, left);
+        return;
+    }
     *contact = cam_vf_settle_from(m, y, u, *contact, left);
     margin = cam_vf_breakaway(m, y, u, *contact, &dir);
     if (margin > 0.0 || at_threshold) {
