@@ -75,8 +75,10 @@ def test_fmu_matches_reference_at_every_communication_point(fmu_runs, name, fact
         for out in ("s", "i", "M", "J"):
             assert np.all(np.isfinite(f[out])), f"{name}/{run.label}: {out} not finite"
         if run.params["drive"] == "speed" or run.params["formulation"] == "paper":
-            # the follower as a body of its own: the reference integrates its flight, the engine takes the closed form
-            free = {"s": 1e-10, "v": 1e-8, "a": 1e-7} if run.params["closure"] != "kinematic" else {}
+            # the follower as a body of its own: both integrate its flight (the reference DOP853 at rtol 1e-12, the
+            # engine rk45 at its rtol 1e-10); the current c_m i = J_0 omega_dot + M passes near 0 through its rows
+            # (measured 1.4e-11 A where i = -0.01 A on spring_bounce)
+            free = {"s": 1e-10, "v": 1e-8, "a": 1e-7, "i": 1e-10} if run.params["closure"] != "kinematic" else {}
             free["N_contact"] = 1e-10   # N: near its zeros the force is a difference of terms of tens of N (measured 1.4e-11)
             for out in ("s", "i", "M", "J", "v", "a", "alpha", "s_cam", "N_contact"):
                 assert np.allclose(f[out], r[out], rtol=1e-9, atol=free.get(out, 1e-12)), f"{name}/{run.label}: {out}"

@@ -82,6 +82,10 @@ typedef struct {
     double fresh;               /* 1 until the first step: the start's contact follows the inputs set */
 } CamSpeedState;
 
+/* The way the speed drive's cam moves at the end of a step (the left limit, docs/model.md 8.1): sgn(omega), and where
+ * omega ends at 0 (within the rounding of omega_ref + omega_dot_ref h and of the end time t [s]) the way the step
+ * started (speed.c). */
+double cam_motion_sign(double omega, double omega_ref, double omega_dot_ref, double t);
 /* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
 typedef double (*CamEventValue)(void *ctx, int code, double x);
 /* The earliest of the n event functions codes[k] to cross, as `crossed(before, after)` says, from fa[k] at a to fb[k]

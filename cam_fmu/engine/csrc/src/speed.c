@@ -140,7 +140,7 @@ static int speed_advance(CamDrive *d, double h, double time, long *steps, CamErr
  * and where omega ends at 0 the way the step started: a stop at the step's end still moves there. "At 0": within the
  * rounding of omega_ref + omega_dot_ref h and of the step's end time t [s] (a grid time k h is a few ulps off the
  * input's time stamp; the reference's Signal.left_value takes stamps within 1e-12 max(1, t) as t). */
-static double motion_sign(double omega, double omega_ref, double omega_dot_ref, double t)
+double cam_motion_sign(double omega, double omega_ref, double omega_dot_ref, double t)
 {
     double stop = 1e-12 * (t > 1.0 ? t : 1.0) * fabs(omega_dot_ref) + 4.0 * DBL_EPSILON * fabs(omega_ref);
     double x = fabs(omega) <= stop ? omega_ref : omega;
@@ -156,7 +156,7 @@ static void speed_outputs(CamDrive *d, double out[])
     double omega = st->speed, omega_dot = d->omega_dot_ref, theta = st->theta, direction, i, voltage;
     CamLoad load, ahead, behind;
     int on;
-    direction = motion_sign(omega, d->omega_ref, omega_dot, fabs(d->time));
+    direction = cam_motion_sign(omega, d->omega_ref, omega_dot, fabs(d->time));
     double x_e = d->x[CAM_X_END], v_e = d->x[CAM_V_END], F = cam_train_force(m, theta, omega, x_e, v_e), a_e = 0.0;
     on = engaged(m, theta, st->s, direction, omega_dot);
     cam_load(m, theta, omega, omega_dot, direction, on, F, &load);

@@ -93,6 +93,11 @@ static void sf_outputs(CamDrive *d, double out[])
 {
     const CamModel *m = &d->model;
     double y[NY], omega_dot = d->form_u, i, step = 1e-6;
+    double direction = cam_motion_sign(d->x[CAM_OMEGA], d->omega_ref, d->omega_dot_ref, fabs(d->time));
+    CamMode held = d->mode;
+    d->mode.stuck = direction == 0.0;   /* the outputs take the left limit's direction: a stop at the step's end */
+    if (direction != 0.0)               /* (its event turned the mode) still moves there */
+        d->mode.direction = direction;
     cam_vf_outputs(d, out);
     i = (m->J_0 * omega_dot + out[CAM_O_M]) / m->c_m;
     out[CAM_O_I] = i;
@@ -106,6 +111,7 @@ static void sf_outputs(CamDrive *d, double out[])
         behind = cam_vf_flank_torque(m, y, omega_dot, d->mode.contact);
         out[CAM_O_VOLTAGE] += m->L * out[CAM_O_OMEGA] * ((ahead - behind) / (2.0 * step)) / m->c_m;
     }
+    d->mode = held;
 }
 
 static void sf_advice(const CamDrive *d, char *buf, size_t len)
