@@ -22,10 +22,12 @@ static void impact(const CamModel *m, double y[NY], double s1, double e)
 }
 
 /* A stuck cam struck by the follower: its static friction, a finite force, gives no impulse; the cam moves off
- * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). */
+ * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). A turning cam the impact turns back
+ * (a light cam, a heavy follower) moves on the new way: its shaft's friction turns with it (held the old way,
+ * M_f sgn would feed the drive energy). */
 static void unstick(double y[NY])
 {
-    if (y[Y_DIR] == 0.0 && y[1] != 0.0)
+    if (y[1] != 0.0 && y[Y_DIR] != (y[1] > 0.0 ? 1.0 : -1.0))
         y[Y_DIR] = y[1] > 0.0 ? 1.0 : -1.0;
 }
 
