@@ -194,3 +194,22 @@ def test_a_spring_closed_follower_holds_at_098_of_its_jump_speed_and_leaves_at_1
         else:
             assert not off and np.max(np.abs(lift)) < 1e-15
             assert min(out["N_contact"] for out in rows) > 0.0
+
+
+def test_an_arm_whose_gap_in_lift_units_exceeds_the_clearance_runs_within_its_groove():
+    """lift_angle 0.1 rad on a 20 mm lift and a 150 mm arm: the arm's gap c / L = 3.3e-3 rad is 0.67 mm of the law's
+    lift, more than c = 0.5 mm. The clearance guard measures along the roller's path (L psi), so the run is not
+    refused, and the follower's distance from the cam along it never exceeds c."""
+    p = dict(defaults(), **SCENE, **{**KINDS["oscillating_roller"], "lift_angle": 0.1}, **CLOSURES["form"], **COAST,
+             restitution=0.5)
+    sim = DriveSimulator(p)
+    sim.set_inputs(0.0, 0.0, 0.0)
+    along, lift_units = [], []
+    for k in range(300):
+        sim.do_step(k * 1e-3, 1e-3, u=0.0, omega_ref=0.0, omega_dot_ref=0.0)
+        out = sim.outputs()
+        along.append(p["arm_length"] * (out["psi"] - p["lift_angle"] / LIFT * float(law(out["theta"])[0])))
+        lift_units.append(out["s"] - out["s_cam"])
+    assert max(abs(a) for a in along) > 0.9 * p["c"]   # it crosses the groove
+    assert max(abs(a) for a in along) <= p["c"] * (1 + 1e-9) + 1e-12
+    assert max(abs(g) for g in lift_units) > p["c"]   # where a guard in the law's units would have refused
