@@ -189,8 +189,10 @@ class VoltageFollower(FlankFollower):
 
     def unstick(self, omega: float) -> None:
         """A stuck cam struck by the follower moves off where the impact turned it (the shaft's static friction, a
-        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck."""
-        if self.heading == 0.0 and omega != 0.0:
+        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck. A turning cam that the
+        impact turns back (omega through 0 in the impulse) moves on the new way: the shaft's friction turns with it
+        (a light cam struck by a heavy follower; held the old way, M_f sgn would feed the drive energy)."""
+        if omega != 0.0 and self.heading != sgn(omega):
             self.heading = sgn(omega)
 
     def stored_energy(self, y) -> float:
