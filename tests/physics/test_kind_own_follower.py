@@ -250,3 +250,51 @@ def test_cli_runs_a_spring_closed_rocker_on_the_reference(tmp_path):
     header = (tmp_path / "packaging_rocker.csv").read_text().splitlines()[0]
     for column in ("psi [rad]", "psi_dot [rad/s]", "contact", "impacts"):
         assert column in header
+
+
+@pytest.mark.parametrize("name, closure", [("oscillating_flat", "spring"), ("translating_flat", "form"),
+                                           ("oscillating_roller", "form")])
+def test_speed_drive_rows_on_the_flank_are_the_closed_form(name, closure):
+    """At 20 rad/s (gravity in a vertical plane, friction off) on the +1 flank: q_f = q - c_q, P = I_f q'' omega^2 +
+    Q_close(q_f), M = P q', J = J_0 + I_f q'^2, N_contact 16's (P on a translating face, P (1 - psi') / (d cos(delta0 +
+    psi)) on an oscillating one), all written here from the cycloid's closed form; rows in flight M = 0, J = J_0,
+    N_contact = 0."""
+    kind, omega, k, F0, c = KINDS[name], 20.0, 300.0, 3.0, 3e-4
+    extra = dict(closure="spring", k_spring=k, F_spring0=F0) if closure == "spring" else \
+        dict(closure="form", backlash=True, c=c, restitution=0.3)
+    scene = dict(SCENE, **extra, gravity=True, gamma=math.pi / 2, beta=0.0 if kind.oscillating else math.pi,
+                 guide_friction=False, shaft_friction=False)
+    out = simulate_reference(scene, 2 * math.pi / omega, 2e-4, omega_ref=constant(omega), follower=kind)
+    p = resolve(scene)
+    J_0, I_f = p["J_m"] + p["J_cam"], inertia(kind)
+    q, q1, q2 = coordinate(kind, out["theta"])
+    if kind.oscillating:
+        L = kind.arm_length
+        c_q, l = (c / L if closure == "form" else 0.0), L
+        W = p["G"] * L + kind.m_arm * G_N * kind.r_cm_arm
+        gravity = lambda x: W * np.cos(x + kind.psi_0)  # noqa: E731
+    else:
+        c_q, l = (c if closure == "form" else 0.0), 1.0
+        gravity = lambda x: p["G"] + 0.0 * x  # noqa: E731  (F_gx = -G: the face lifted against gravity)
+    k_, F0_ = (k, F0) if closure == "spring" else (0.0, 0.0)
+    q_f = q - c_q
+    P = I_f * q2 * omega ** 2 + l * (F0_ + k_ * l * q_f) + gravity(q_f)
+    on = out["contact"] == 1.0
+    assert on.sum() > 100
+    if closure == "form":
+        assert np.any(out["contact"] != 1.0)  # it crosses the groove somewhere in the turn
+    own = out["psi"] if kind.oscillating else out["s"]
+    scale = np.max(np.abs(P * q1))
+    assert np.max(np.abs(own[on] - q_f[on])) < 1e-15
+    assert np.max(np.abs(out["M"][on] - (P * q1)[on])) < 1e-12 * scale
+    assert np.max(np.abs(out["J"][on] - (J_0 + I_f * q1 ** 2)[on])) < 1e-15
+    if name == "oscillating_flat":
+        delta0 = math.asin(p["r_b"] / kind.pivot_distance)
+        N = P * (1.0 - q1) / (kind.pivot_distance * np.cos(delta0 + q))
+    else:
+        N = P if not kind.oscillating else None
+    if N is not None:
+        assert np.max(np.abs(out["N_contact"][on] - N[on])) < 1e-12 * np.max(np.abs(N))
+    off = out["contact"] == 0.0
+    assert not np.any(out["M"][off]) and not np.any(out["N_contact"][off])
+    assert np.all(out["J"][off] == J_0)
