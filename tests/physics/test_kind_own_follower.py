@@ -268,17 +268,15 @@ def test_speed_drive_rows_on_the_flank_are_the_closed_form(name, closure):
     p = resolve(scene)
     J_0, I_f = p["J_m"] + p["J_cam"], inertia(kind)
     q, q1, q2 = coordinate(kind, out["theta"])
-    if kind.oscillating:
-        L = kind.arm_length
-        c_q, l = (c / L if closure == "form" else 0.0), L
-        W = p["G"] * L + kind.m_arm * G_N * kind.r_cm_arm
-        gravity = lambda x: W * np.cos(x + kind.psi_0)  # noqa: E731
-    else:
-        c_q, l = (c if closure == "form" else 0.0), 1.0
-        gravity = lambda x: p["G"] + 0.0 * x  # noqa: E731  (F_gx = -G: the face lifted against gravity)
-    k_, F0_ = (k, F0) if closure == "spring" else (0.0, 0.0)
+    l = kind.arm_length if kind.oscillating else 1.0
+    c_q = c / l if closure == "form" else 0.0
     q_f = q - c_q
-    P = I_f * q2 * omega ** 2 + l * (F0_ + k_ * l * q_f) + gravity(q_f)
+    if kind.oscillating:  # dV/dq: the arm's weight about its pivot
+        slope = (p["G"] * l + kind.m_arm * G_N * kind.r_cm_arm) * np.cos(q_f + kind.psi_0)
+    else:  # F_gx = -G: the face lifted against gravity
+        slope = p["G"]
+    k_, F0_ = (k, F0) if closure == "spring" else (0.0, 0.0)
+    P = I_f * q2 * omega ** 2 + l * (F0_ + k_ * l * q_f) + slope
     on = out["contact"] == 1.0
     assert on.sum() > 100
     if closure == "form":
