@@ -295,6 +295,13 @@ class FlankFollower:
         s_cam, s1, s2, _ = self.program.derivatives(theta)
         return s_cam - contact * self.c, s1, s2, s_cam
 
+    # m, the rebound's height below which an impact is plastic (the Zeno guard), in the follower's coordinate
+    zeno = ZENO_HEIGHT
+
+    def closing(self, s: float) -> float:
+        """N, the force pulling the follower at s [m] back toward the +1 flank: F_close(s) = F0 + k s - F_gx."""
+        return closing_force(s, self.k, self.F0, self.F_gx)
+
     def gaps(self, theta: float, s: float) -> tuple[float, float]:
         """(gap to the +1 flank, gap to the -1 flank) [m], both >= 0 in flight (inf: no such flank)."""
         s_cam = self.program.derivatives(theta)[0]
@@ -304,7 +311,7 @@ class FlankFollower:
         """m/s2, the flying follower's acceleration (-F_close(s) - sigma f0) / m with the friction's direction
         -sigma = -sgn(v); sigma = 0 at a halt, where the guide's static friction holds the follower while the net
         force is within f0 (then 0), else it starts the way that force pushes."""
-        net = -closing_force(s, self.k, self.F0, self.F_gx)
+        net = -self.closing(s)
         if sigma == 0.0:
             if abs(net) <= self.f0:
                 return 0.0
@@ -316,11 +323,10 @@ class FlankFollower:
         way the net force pushes it beyond the guide's static friction (0: held)."""
         if v != 0.0:
             return 1.0 if v > 0.0 else -1.0
-        net = -closing_force(s, self.k, self.F0, self.F_gx)
+        net = -self.closing(s)
         return (1.0 if net > 0.0 else -1.0) if abs(net) > self.f0 else 0.0
 
-    @staticmethod
-    def rebounds(w: float, scale: float) -> bool:
-        """Does the relative speed w [m/s] off a flank rise ZENO_HEIGHT or more at the acceleration ``scale``
-        [m/s2] (w^2 >= 2 A ZENO_HEIGHT)? Below it an impact is plastic (the Zeno guard)."""
-        return w * w >= 2.0 * scale * ZENO_HEIGHT
+    def rebounds(self, w: float, scale: float) -> bool:
+        """Does the relative speed w [m/s] off a flank rise ``zeno`` (ZENO_HEIGHT) or more at the acceleration
+        ``scale`` [m/s2] (w^2 >= 2 A ZENO_HEIGHT)? Below it an impact is plastic (the Zeno guard)."""
+        return w * w >= 2.0 * scale * self.zeno

@@ -93,14 +93,14 @@ class KindDriveModel(DriveModel):
 
     def _refuse(self, p: Mapping[str, Any]) -> None:
         kind = self.kind.follower_type
-        refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0),
+        refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0 and not self.free_follower),
                                          ("'k_shaft' (compliant shaft)", self.compliant),
-                                         ("'closure' (a follower of its own)", p["closure"] == "spring"),
                                          # the follower train as parameters (where the table has them)
                                          ("'k_train' (follower train)", p.get("k_train", 0.0) > 0.0)) if on]
         if refused:
-            raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam (closure 'kinematic' or "
-                                 f"'form' without clearance) and a rigid shaft so far: parameters "
+            raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam or as a body of its own "
+                                 f"(closure 'spring', or 'form' with a clearance and a mass m > 0; docs/model.md "
+                                 f"16.3) and a rigid shaft so far: parameters "
                                  f"{', '.join(refused)} must be off")
         if self.kind.oscillating and p["gravity"] and p["beta"] != 0.0:
             raise ParameterError(f"parameter 'beta' = {p['beta']!r} rad is not used by follower_type {kind!r} "

@@ -24,7 +24,7 @@ import math
 from typing import Any, Mapping
 
 from .follower import Jump, minimise_over_turn
-from .follower_kind import ARM_FIELDS, FollowerKind
+from .follower_kind import FollowerKind
 from .kind_drive import KindDriveModel
 from .parameters import resolve
 from .rules import check_rules
@@ -41,9 +41,7 @@ class KindSpring:
         kind = FollowerKind.from_parameters(p)
         if kind.default:
             raise ValueError("the translating roller's jump is physics/follower.py's")
-        # The spring's own rules (no clearance, a mass that carries the momentum) are the roller's, checked on its
-        # twin; the kind's rules with the follower held on the cam (the engines do not fly an arm yet) on its model.
-        check_rules(dict(p, follower_type="translating_roller", **{name: 0.0 for name in ARM_FIELDS}))
+        check_rules(p)   # the spring's and the kind's rules: both engines fly every type (docs/model.md 16.3)
         self.k, self.F0 = float(p["k_spring"]), float(p["F_spring0"])
         self.model = KindDriveModel(dict(p, closure="kinematic", k_spring=0.0, F_spring0=0.0, restitution=0.0),
                                     kind)

@@ -38,7 +38,7 @@ class SpeedFollower(FlankFollower):
         follower (a force of exactly 0 counts as held: the lift-off event, located from there, decides), else in
         flight at the flank's speed.
         """
-        s1 = self.program.derivatives(theta)[1]
+        s1 = self.flank(theta, contact)[1]
         hit = impact(math.inf, self.m, s1, omega, v, self.e)
         w = hit.v - s1 * omega
         if self.rebounds(w, self.acceleration_scale(theta, omega, omega_dot)):
@@ -57,7 +57,7 @@ class SpeedFollower(FlankFollower):
         guard's speed (w^2 < 2 A ZENO_HEIGHT, the rebound ``land`` would call plastic) nothing happens: the
         follower stays on the flank at its speed.
         """
-        s1 = self.program.derivatives(theta)[1]
+        s1 = self.flank(theta, contact)[1]
         w = v - s1 * omega
         if not self.rebounds(w, self.acceleration_scale(theta, omega, omega_dot)):
             return contact, s1 * omega, None

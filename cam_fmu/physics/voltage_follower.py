@@ -109,8 +109,7 @@ class VoltageFollower(FlankFollower):
     def static_force(self, theta: float, contact: float) -> float:
         """N, the force P along X of the flank ``contact`` on the follower at rest on it, the cam held: it balances
         the spring and gravity, F_close(s) (the guide's friction carries nothing at rest)."""
-        s_cam = self.program.derivatives(theta)[0]
-        return closing_force(s_cam - contact * self.c, self.k, self.F0, self.F_gx)
+        return self.closing(self.flank(theta, contact)[0])
 
     def start(self, y, u: float, contact: float) -> tuple[float, float]:
         """(margin [rad/s2], direction) of the shaft at rest: it starts toward ``direction`` where margin > 0 (the
@@ -136,7 +135,7 @@ class VoltageFollower(FlankFollower):
             dy = [0.0, 0.0, di, 0.0, 0.0] if contact else [0.0, 0.0, di, v, self.free_acceleration(s, sigma)]
         elif contact:
             omega_dot, _, _ = self.on_flank(theta, omega, drive, contact)
-            _, s1, s2, _ = self.program.derivatives(theta)
+            _, s1, s2, _ = self.flank(theta, contact)
             dy = [omega, omega_dot, di, s1 * omega, s2 * omega * omega + s1 * omega_dot]
         else:
             dy = [omega, drive / self.J_0, di, v, self.free_acceleration(s, sigma)]
@@ -168,8 +167,8 @@ class VoltageFollower(FlankFollower):
     def acceleration_scale(self, y, u: float) -> float:
         """m/s2, a bound of the follower's acceleration relative to the flank near y."""
         theta, omega = y[0], y[1]
-        s, s1, s2, _ = self.program.derivatives(theta)
-        return (abs(closing_force(s, self.k, self.F0, self.F_gx)) / self.m + self.f0 / self.m
+        s, s1, s2, _ = self.flank(theta, 0.0)
+        return (abs(self.closing(s)) / self.m + self.f0 / self.m
                 + abs(s2) * omega * omega + abs(s1 * self.torque(y, u) / self.J_0) + 1e-300)
 
     def land(self, y, u: float, contact: float = 1.0) -> tuple[float, list[float], Impact]:
@@ -190,8 +189,10 @@ class VoltageFollower(FlankFollower):
 
     def unstick(self, omega: float) -> None:
         """A stuck cam struck by the follower moves off where the impact turned it (the shaft's static friction, a
-        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck."""
-        if self.heading == 0.0 and omega != 0.0:
+        finite force, gives no impulse); on a dwell (s' = 0) omega stays 0 and it stays stuck. A turning cam that the
+        impact turns back (omega through 0 in the impulse) moves on the new way: the shaft's friction turns with it
+        (a light cam struck by a heavy follower; held the old way, M_f sgn would feed the drive energy)."""
+        if omega != 0.0 and self.heading != sgn(omega):
             self.heading = sgn(omega)
 
     def stored_energy(self, y) -> float:

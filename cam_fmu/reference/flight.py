@@ -42,9 +42,10 @@ class FollowerRun(HybridRun):
     """One run of the speed drive with the follower's own state y = (theta, s, v)."""
 
     label = "follower reference"
+    BODY = SpeedFollower  # the follower's equations (physics.kind_follower's for another kind)
 
     def __init__(self, model, omega_ref: Signal, rtol: float, atol: float) -> None:
-        self.body = SpeedFollower(model)
+        self.body = self.BODY(model)
         self.omega_ref = omega_ref
         self.rtol, self.atol = rtol, atol
         self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
@@ -56,11 +57,11 @@ class FollowerRun(HybridRun):
         """Rows on ``grid`` [s] from theta0 [rad]: on the +1 flank if it holds the follower, else on -1 (groove),
         else flying from the +1 flank."""
         body, t = self.body, float(grid[0])
-        s_cam, s1, _, _ = body.program.derivatives(theta0)
         omega, omega_dot = self._speed(t)
         flanks = (1.0, -1.0) if body.two_sided else (1.0,)
         contact = next((side for side in flanks if body.held(theta0, omega, omega_dot, side) >= 0.0), 0.0)
-        y = [theta0, s_cam - (contact or 1.0) * body.c, s1 * omega]
+        s, s1, _, _ = body.flank(theta0, contact or 1.0)
+        y = [theta0, s, s1 * omega]
         mode = Mode(Follower.flank(contact) if contact else flying(body, y))
         return self.pieces(grid, t, y, mode, sorted(b for b in self.omega_ref.breaks if t < b < float(grid[-1])))
 
@@ -72,7 +73,7 @@ class FollowerRun(HybridRun):
 
             def follow(t, y):  # (s, v) ride on the flank; only theta matters, s and v are reset from the cam
                 omega, omega_dot = speed(t)
-                _, s1, s2, _ = body.program.derivatives(y[0])
+                _, s1, s2, _ = body.flank(y[0], contact)
                 return [omega, s1 * omega, s2 * omega * omega + s1 * omega_dot]
             return [event(Event.LIFT_OFF, lambda t, y: body.held(y[0], *speed(t), contact))], follow, options
         omega = max(abs(w) for w in self.omega_ref.values)  # rad/s: the fastest the cam turns (a bound in any piece)

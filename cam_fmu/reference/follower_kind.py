@@ -26,6 +26,10 @@ KIND_OUTPUTS: tuple[tuple[str, str, str], ...] = (
 def _speed(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal,
            options: dict) -> dict[str, np.ndarray]:
     from .hybrid import collect
+
+    if model.free_follower:  # a follower of its own (docs/model.md 16.3)
+        from .kind_flight import kind_speed_flight
+        return kind_speed_flight(model, grid, omega_ref, options)
     from .integrate import _speed_rows
 
     return collect(_speed_rows(model, grid, omega_ref), grid)
@@ -35,6 +39,9 @@ def _consistent(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: S
                 options: dict) -> dict[str, np.ndarray]:
     from .integrate import _Consistent
 
+    if model.free_follower:  # a follower of its own (docs/model.md 16.3)
+        from .kind_flight import kind_voltage_flight
+        return kind_voltage_flight(model, grid, u, options)
     return _Consistent(model, u, options["rtol"], options["atol"], options["energy"], options["method"]).run(grid)
 
 
@@ -50,6 +57,8 @@ def kind_reference(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref
         raise ParameterError(f"follower_type {model.kind.follower_type!r} runs in the consistent formulation and "
                              f"the speed drive only (parameter 'formulation' = {model.formulation!r})")
     result = run(model, grid, u, omega_ref, options)
+    if model.free_follower:  # the follower's own psi, psi_dot are in its rows
+        return result
     if model.kind.oscillating:
         psi, psi1 = model.cam.arm.derivatives(np.asarray(result["theta"], dtype=float))[:2]
         result["psi"], result["psi_dot"] = psi, psi1 * result["omega"]

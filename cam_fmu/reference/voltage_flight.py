@@ -30,10 +30,11 @@ class VoltageFollowerRun(VoltageRun):
     equations read (the shaft's direction, stuck) and the transitions change in place."""
 
     label = "voltage follower reference"
+    BODY = VoltageFollower  # the follower's equations (physics.kind_follower's for another kind)
 
     def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None) -> None:
         super().__init__(model, u, rtol, atol, energy, method)
-        self.body = VoltageFollower(model)
+        self.body = self.BODY(model)
         self.impacts: list[tuple[float, float, float]] = []  # (t [s], w before, w after [m/s])
         self.loss = 0.0  # J, the impacts' losses so far
         self.lift_offs: list[tuple[float, float, float]] = []  # (t [s], s [m], v [m/s]) where the follower left the cam
@@ -49,7 +50,7 @@ class VoltageFollowerRun(VoltageRun):
         body, model = self.body, self.body.model
         p = model.params
         theta0, omega0 = p["theta0"], p["omega0"]
-        s_cam, s1, _, _ = body.program.derivatives(theta0)
+        s_cam, s1, _, _ = body.flank(theta0, 0.0)   # the cam's own lift (no clearance)
         y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0]
         y += [0.0, omega0] if body.compliant else []  # the shaft relaxed, the rotor at the cam's speed (model.md 12.1)
         y += [0.0] * len(ENERGY)
@@ -141,7 +142,7 @@ class VoltageFollowerRun(VoltageRun):
     def _touch(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
         body, u_t, n = self.body, self.u.value(t), self.body.size
         flank = 1.0 if kind is Event.TOUCH_LOWER else -1.0
-        s1 = body.program.derivatives(y[0])[1]
+        s1 = body.flank(y[0], flank)[1]
         w_before = y[4] - s1 * y[1]
         after, state, hit = body.land(y[:n], u_t, flank)
         self.loss += hit.loss

@@ -156,8 +156,9 @@ def test_bad_follower_kind_is_refused_by_name(fields, word):
 
 
 @pytest.mark.parametrize("scene, kind, word", [
-    (dict(SCENE, backlash=True, c=1e-4, closure="form"), "translating_flat", "'c'"),
-    (dict(SCENE, closure="spring"), "oscillating_roller", "closure"),
+    # a clearance needs a follower of its own (16.3): the kinematic rule, or 'form' without a mass, is refused
+    (dict(SCENE, backlash=True, c=1e-4, closure="kinematic"), "translating_flat", "'c'"),
+    (dict(SCENE, backlash=True, c=1e-4, closure="form", m=0.0, J_arm=0.0), "oscillating_roller", "'c'"),
     (dict(SCENE, drive="voltage", formulation="paper"), "oscillating_flat", "formulation"),
     (dict(SCENE, drive="voltage", k_shaft=100.0, J_cam=1e-4), "translating_flat", "k_shaft"),
     (dict(SCENE, gravity=True, gamma=math.pi / 2, beta=1.0), "oscillating_roller", "beta"),
