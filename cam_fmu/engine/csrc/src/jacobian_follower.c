@@ -76,6 +76,10 @@ static void kind_tangent(const CamDrive *d, const double x[CAM_ME_NX], const dou
         dout[CAM_O_PSI] = dq;
         dout[CAM_O_PSI_DOT] = dq_dot;
     }
+    {   /* the cam's pressure angle at theta (no contact force) */
+        double dN;
+        cam_kind_contact_tangent(m, q, 0.0, 0.0, dtheta, &dout[CAM_O_ALPHA], &dN);
+    }
 }
 
 void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const double seed[CAM_ME_NX], double du,

@@ -213,8 +213,7 @@ void cam_kind_init(CamModel *m)
     }
 }
 
-/* d(alpha) and d(N) [rad, N per the seed] of cam_kind_load's contact at q (q[4]) for P, dP, dtheta. */
-static void contact_tangent(const CamModel *m, const double q[4], double P, double dP, double dtheta, double *dalpha,
+void cam_kind_contact_tangent(const CamModel *m, const double q[4], double P, double dP, double dtheta, double *dalpha,
                             double *dN)
 {
     double delta = m->delta0 + q[0], d = m->pivot_distance, L = m->arm_length, c = cos(delta), sn = sin(delta);
@@ -290,7 +289,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
             Pc = P + m->mu * fabs(P) * st;
             dPc = dP + m->mu * sP * dP * st;
         }
-        contact_tangent(m, q, Pc, dPc, dtheta, &dalpha, &dN);
+        cam_kind_contact_tangent(m, q, Pc, dPc, dtheta, &dalpha, &dN);
         dout[CAM_O_J] = dJ;
         dout[CAM_O_V] = (q[2] * dtheta * w + q[1] * dw) / k;
         dout[CAM_O_A] = (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw + q[2] * dtheta * omega_dot

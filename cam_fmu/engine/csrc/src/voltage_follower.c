@@ -532,7 +532,11 @@ static void vf_set_inputs(CamDrive *d, double u, double omega_ref, double omega_
 {
     (void)omega_ref;
     (void)omega_dot_ref;
+    if (u == d->form_u)
+        return;   /* settled for this input already (each advance settles again at its start) */
     d->form_u = u;
+    d->step_events[0] = '\0';
+    cam_vf_apply(d, EV_NONE, d->time);   /* at rest: stuck, or starting now (consistent.c's rule) */
 }
 
 static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError *err)
@@ -597,8 +601,11 @@ void cam_vf_outputs(CamDrive *d, double out[])
         double s_cam[4];
         cam_profile_eval(&m->profile, y[0], s_cam);
         load.s_cam = s_cam[0];
-        if (d->mode.contact == 0)
-            load.alpha = 0.0;   /* no contact, no pressure angle (kind.c's disengaged load) */
+        if (d->mode.contact == 0) {   /* in flight the cam's pressure angle at theta, as the translating roller's */
+            CamLoad geometry;
+            cam_kind_contact_load(m, dd, 0.0, 0.0, &geometry);
+            load.alpha = geometry.alpha;
+        }
         load.v /= m->q_scale;
         load.a /= m->q_scale;
         cam_record_outputs(&load, y[1], y[0], y[3] / m->q_scale, i, d->form_u, out);
