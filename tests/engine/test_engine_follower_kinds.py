@@ -199,6 +199,12 @@ def refusal(params: dict) -> str:
     (dict(KINDS["oscillating_roller"], lift_angle=3.0), ("'lift_angle' = 3.0", "90 deg")),
     (dict(KINDS["oscillating_flat"], pivot_distance=0.07), ("'pivot_distance' = 0.07", "inside the base circle")),
     (dict(KINDS["oscillating_flat"], lift_angle=1.3), ("'lift_angle' = 1.3", "perpendicular")),
+    # the contour on a 0.1 deg grid (kinematics/follower_checks.py refuse_unbuildable's checks, in C)
+    (dict(KINDS["translating_flat"], r_b=0.005), ("'r_b' = 0.005", "r_b + s + s'' = -27.85", "r_b > 0.03285")),
+    (dict(KINDS["oscillating_flat"], lift_angle=0.6, pivot_distance=0.1), ("'r_b' = 0.08", "p + d2p/dphi2 = -1526")),
+    (dict(KINDS["oscillating_flat"], lift_angle=1.0, pivot_distance=0.5), ("'lift_angle' = 1.0", "psi' >= 1")),
+    (dict(KINDS["oscillating_roller"], pivot_distance=0.1, arm_length=0.1, lift_angle=1.0),
+     ("'pivot_distance' = 0.1", "158.087 mm", "sweep over the pivot")),
 ])
 def test_what_the_engine_does_not_run_is_refused_by_name(params, names):
     message = refusal(params)

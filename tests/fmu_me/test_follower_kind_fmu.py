@@ -141,3 +141,26 @@ def test_cam3_fmu_flies_every_kind_as_the_reference_does(cam3_fmu_path, own):
                                output_interval=STEP, output=NAMES)
     for output in NAMES:
         assert error(result, reference, output) < OWN_BOUNDS["CoSimulation"], (output, error(result, reference, output))
+
+
+@pytest.mark.parametrize("changes,words", [
+    ({**KINDS["translating_flat_friction"], "r_b": 0.005}, ("'r_b' = 0.005", "a cusp")),
+    ({**KINDS["oscillating_roller"], "pivot_distance": 0.1, "arm_length": 0.1, "lift_angle": 1.0},
+     ("'pivot_distance' = 0.1", "sweep over the pivot")),
+])
+def test_a_contour_that_cannot_be_built_is_an_fmi_error_as_the_reference_refuses_it(engine_fmu_path, changes, words):
+    """A flat face's cusp and a rocker's cam sweeping over its pivot (the contour on a 0.1 deg grid): fmi2Error at the
+    exit of initialisation naming the parameter, where the reference refuses the same geometry."""
+    from cam_fmu.physics.parameters import ParameterError
+
+    with pytest.raises(ParameterError):
+        simulate_reference(dict(defaults(), **changes), 0.1, 0.01, u=constant(U))
+    logged: list[str] = []
+
+    def logger(*args):
+        logged.append(args[-1].decode() if isinstance(args[-1], bytes) else str(args[-1]))
+
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(changes, u=U), stop_time=0.1, output_interval=0.01,
+                          logger=logger)
+    assert any(all(word in text for word in words) for text in logged), logged

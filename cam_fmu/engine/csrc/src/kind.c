@@ -158,10 +158,64 @@ static int wedge_check(const CamModel *m, CamError *err)
 /* The refusals of geometry that cannot be built whose limits are closed forms (kinematics/follower_checks.py and
  * the cam classes' constructors): the arm cannot reach the cam, the pivot inside the base circle, an arm turned to
  * the pressure angle's 90 deg or a face past the perpendicular. */
+/* Geometry that the contour on a 0.1 deg grid cannot build (kinematics/follower_checks.py refuse_unbuildable): a
+ * roller arm's cam sweeping over its pivot (the roller's centre sqrt(d^2 + L^2 - 2 d L cos(delta)) from the cam axis,
+ * the cam built on its pitch curve), an oscillating face turning faster than the cam (psi' >= 1: the contact runs off
+ * along the face), a flat face's cusp (its contour's radius of curvature rho = p + d2p/dphi2 <= 0, docs/model.md
+ * 15.2: r_b + s + s'' for a translating face). */
+static int contour_check(const CamModel *m, CamError *err)
+{
+    double q[4], theta, d = m->pivot_distance, L = m->arm_length, worst = -INFINITY, at = 0.0, need = -INFINITY, value;
+    char a[40];
+    int k, kind = m->kind;
+    if (kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)
+        return CAM_OK;
+    for (k = 0; k < WEDGE_GRID; k++) {
+        theta = 2.0 * PI * k / WEDGE_GRID;
+        cam_kind_eval(m, theta, q);
+        if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER)
+            value = sqrt(d * d + L * L - 2.0 * d * L * cos(m->delta0 + q[0]));   /* the roller's reach */
+        else if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT && q[1] >= 1.0)
+            value = INFINITY;
+        else if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT) {   /* -rho of the face's envelope */
+            double delta = m->delta0 + q[0], p = d * sin(delta), p1 = d * cos(delta) * q[1];
+            double p2 = d * (cos(delta) * q[2] - sin(delta) * q[1] * q[1]), f1 = q[1] - 1.0;
+            value = -(p + (p2 * f1 - p1 * q[2]) / (f1 * f1 * f1));
+        } else {
+            value = -(m->r_b + q[0] + q[2]);
+            need = fmax(need, -(q[0] + q[2]));
+        }
+        if (value > worst) {
+            worst = value;
+            at = theta;
+        }
+    }
+    if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER && worst >= d)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'pivot_distance' = %s m: the cam's contour reaches %.6g mm "
+                         "from its axis (at theta = %.6g deg) and would sweep over the pivot; allowed > %.6g m",
+                         cam_num(d, a), worst * 1e3, at * (180.0 / PI), worst);
+    if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT && worst == INFINITY)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'lift_angle' = %s rad: the arm turns faster than the cam "
+                         "(psi' >= 1 at theta = %.6g deg) and the contact runs off along the face; allowed a lift_angle "
+                         "where psi' < 1", cam_num(m->params.v[CAM_P_LIFT_ANGLE], a), at * (180.0 / PI));
+    if (kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_FLAT && worst >= 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'r_b' = %s m: the flat face's contour has radius of "
+                         "curvature r_b + s + s'' = %.6g mm <= 0 at theta = %.6g deg (a cusp, it cannot be made); "
+                         "allowed r_b > %.6g m (max of -(s + s'') on a 0.1 deg grid)", cam_num(m->r_b, a), -worst * 1e3,
+                         at * (180.0 / PI), need);
+    if (kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT && worst >= 0.0)
+        return cam_error(err, CAM_ERR_PARAMETER, "parameter 'r_b' = %s m: the flat face's contour has radius of "
+                         "curvature p + d2p/dphi2 = %.6g mm <= 0 at theta = %.6g deg (a cusp, it cannot be made); "
+                         "allowed a larger r_b (or a smaller lift_angle)", cam_num(m->r_b, a), -worst * 1e3,
+                         at * (180.0 / PI));
+    return CAM_OK;
+}
+
 int cam_kind_check(const CamModel *m, CamError *err)
 {
     double L = m->arm_length, d = m->pivot_distance, r_b = m->r_b, lift_angle = m->params.v[CAM_P_LIFT_ANGLE], top;
     char a[40], b[40], c[40];
+    int status;
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {
         if (!(fabs(d - L) < r_b && r_b < d + L))
             return cam_error(err, CAM_ERR_PARAMETER, "parameters 'arm_length' = %s m, 'pivot_distance' = %s m: the arm "
@@ -182,6 +236,8 @@ int cam_kind_check(const CamModel *m, CamError *err)
                              "perpendicular to the cam axis; allowed < pi/2 - delta0 = %.6g rad (sin delta0 = r_b / d)",
                              cam_num(lift_angle, a), top);
     }
+    if ((status = contour_check(m, err)) != CAM_OK)
+        return status;
     return wedge_check(m, err);
 }
 
