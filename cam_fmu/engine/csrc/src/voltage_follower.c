@@ -436,8 +436,8 @@ double cam_vf_step_limit(const CamDrive *d, double time)
     double ws = m->compliant ? cam_shaft_rate(m, m->J_0) : 0.0;
     if (!mode->contact && d->x[CAM_OMEGA] != 0.0)   /* in flight a step at most scans the gap's events */
         dt = fmin(dt, FLIGHT_ANGLE / fabs(d->x[CAM_OMEGA]));
-    if (!mode->contact && wn > 0.0)
-        dt = fmin(dt, STEP_PHASE / wn);
+    if (!mode->contact && wn > 0.0)   /* (the speed drive's rk45: its error control holds the flight) */
+        dt = fmin(dt, (m->prescribed ? TRAIN_PHASE : STEP_PHASE) / wn);
     if (!mode->contact && wt > 0.0)   /* the follower rings on the train's spring: a gap's crossing and return unseen */
         dt = fmin(dt, TRAIN_PHASE / wt);
     if (!mode->contact && mode->stuck && cam_follower_clearance(m) > 0.0) {   /* flying at a stuck cam: a tenth of the gap */
