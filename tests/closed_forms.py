@@ -45,3 +45,23 @@ def to_cam_frame(theta, x, y):
     """Rot(-theta) (x, y): a point of the fixed frame in the cam frame at cam angle theta (-theta: back)."""
     c, s = np.cos(theta), np.sin(theta)
     return x * c + y * s, -x * s + y * c
+
+
+def cycloid_program(theta, rise: float, lift: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(s, s', s'') [m, m/rad, m/rad2] of a cycloidal rise over [0, b), a dwell, the mirrored return over [2 b, 3 b) and
+    a dwell (b = rise [rad], each piece b; lift [m]): rise lift (x - sin(2 pi x) / (2 pi)), x the fraction of the
+    piece, written from the closed form."""
+    theta = np.mod(np.asarray(theta, dtype=float), 2.0 * math.pi)
+    b, h = rise, lift
+    s, s1, s2 = np.zeros_like(theta), np.zeros_like(theta), np.zeros_like(theta)
+    up, top, ret = theta < b, (theta >= b) & (theta < 2 * b), (theta >= 2 * b) & (theta < 3 * b)
+    x = theta[up] / b
+    s[up] = h * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
+    s1[up] = h / b * (1.0 - np.cos(2 * math.pi * x))
+    s2[up] = 2 * math.pi * h / b ** 2 * np.sin(2 * math.pi * x)
+    s[top] = h
+    x = (theta[ret] - 2 * b) / b
+    s[ret] = h - h * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
+    s1[ret] = -h / b * (1.0 - np.cos(2 * math.pi * x))
+    s2[ret] = -2 * math.pi * h / b ** 2 * np.sin(2 * math.pi * x)
+    return s, s1, s2

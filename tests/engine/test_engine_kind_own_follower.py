@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from closed_forms import cycloid_program
 
 from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import defaults
@@ -30,20 +31,9 @@ COAST = dict(R=1e4, c_e=1e-6, c_m=1e-6, omega0=60.0, drive="voltage", formulatio
 
 
 def law(theta: np.ndarray | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The program's lift s [m] and its theta-derivatives s', s'' at theta [rad] (the cycloid, written here)."""
-    phase = np.mod(theta, 2 * math.pi)
-    x = np.clip(phase / RISE, 0.0, 1.0)
-    back = np.clip((phase - 2 * RISE) / RISE, 0.0, 1.0)
-    rise = (x - np.sin(2 * math.pi * x) / (2 * math.pi),
-            (1 - np.cos(2 * math.pi * x)) / RISE, 2 * math.pi * np.sin(2 * math.pi * x) / RISE ** 2)
-    fall = (back - np.sin(2 * math.pi * back) / (2 * math.pi),
-            (1 - np.cos(2 * math.pi * back)) / RISE, 2 * math.pi * np.sin(2 * math.pi * back) / RISE ** 2)
-    in_rise = phase < RISE
-    in_fall = (phase >= 2 * RISE) & (phase < 3 * RISE)
-    s = np.where(in_rise, rise[0], np.where(phase < 2 * RISE, 1.0, np.where(in_fall, 1.0 - fall[0], 0.0)))
-    s1 = np.where(in_rise, rise[1], np.where(in_fall, -fall[1], 0.0))
-    s2 = np.where(in_rise, rise[2], np.where(in_fall, -fall[2], 0.0))
-    return LIFT * s, LIFT * s1, LIFT * s2
+    """The program's lift s [m] and its theta-derivatives s', s'' at theta [rad] (tests/closed_forms.py: the cycloid's
+    closed form)."""
+    return cycloid_program(theta, RISE, LIFT)
 
 
 def inertia(p: dict) -> float:

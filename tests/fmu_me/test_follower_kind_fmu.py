@@ -42,6 +42,19 @@ def error(result, reference: dict, name: str) -> float:
     return float(np.max(np.abs(result[name][rows] - reference[name])) / (scale if scale > 0.0 else 1.0))
 
 
+def fmu_against_reference(fmu, fmi_type: str | None, start: dict, reference: dict, bound: float):
+    """cam.fmu (or cam3.fmu: fmi_type None) run from `start` at U against `reference`: every NAMES output within
+    `bound` of its largest (error); the result."""
+    options = {"relative_tolerance": 1e-10} if fmi_type == "ModelExchange" else {}
+    if fmi_type is not None:
+        options["fmi_type"] = fmi_type
+    result = fmpy.simulate_fmu(str(fmu), start_values=dict(start, u=U), stop_time=STOP, output_interval=STEP,
+                               output=NAMES, **options)
+    for output in NAMES:
+        assert error(result, reference, output) < bound, (fmi_type, output, error(result, reference, output))
+    return result
+
+
 @pytest.fixture(scope="module", params=list(KINDS))
 def kind(request) -> tuple[str, dict]:
     params = KINDS[request.param]
@@ -52,11 +65,7 @@ def kind(request) -> tuple[str, dict]:
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 def test_cam_fmu_runs_the_kind_as_the_reference_does(engine_fmu_path, kind, fmi_type):
     name, reference = kind
-    options = {"relative_tolerance": 1e-10} if fmi_type == "ModelExchange" else {}
-    result = fmpy.simulate_fmu(str(engine_fmu_path), fmi_type=fmi_type, start_values=dict(KINDS[name], u=U),
-                               stop_time=STOP, output_interval=STEP, output=NAMES, **options)
-    for output in NAMES:
-        assert error(result, reference, output) < BOUNDS[fmi_type], (fmi_type, output, error(result, reference, output))
+    result = fmu_against_reference(engine_fmu_path, fmi_type, KINDS[name], reference, BOUNDS[fmi_type])
     if name.startswith("oscillating"):
         assert np.max(result["psi"]) > 0.9 * KINDS[name]["lift_angle"]   # the arm swings through its law
     else:
@@ -65,21 +74,23 @@ def test_cam_fmu_runs_the_kind_as_the_reference_does(engine_fmu_path, kind, fmi_
 
 def test_cam3_fmu_runs_the_kind_as_the_reference_does(cam3_fmu_path, kind):
     name, reference = kind
-    result = fmpy.simulate_fmu(str(cam3_fmu_path), start_values=dict(KINDS[name], u=U), stop_time=STOP,
-                               output_interval=STEP, output=NAMES)
-    for output in NAMES:
-        assert error(result, reference, output) < BOUNDS["CoSimulation"], (output, error(result, reference, output))
+    fmu_against_reference(cam3_fmu_path, None, KINDS[name], reference, BOUNDS["CoSimulation"])
 
 
-def test_a_kind_the_engine_cannot_run_is_an_fmi_error_with_its_reason(engine_fmu_path):
+def refused_at_initialisation(fmu, start: dict) -> list[str]:
+    """The FMU's log lines when it refuses `start` at the exit of initialisation (fmi2Error there, asserted)."""
     logged: list[str] = []
 
     def logger(*args):
         logged.append(args[-1].decode() if isinstance(args[-1], bytes) else str(args[-1]))
 
-    with pytest.raises(Exception):
-        fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(KINDS["oscillating_roller"], arm_length=0.05),
-                          stop_time=0.1, output_interval=0.01, logger=logger)
+    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
+        fmpy.simulate_fmu(str(fmu), start_values=start, stop_time=0.1, output_interval=0.01, logger=logger)
+    return logged
+
+
+def test_a_kind_the_engine_cannot_run_is_an_fmi_error_with_its_reason(engine_fmu_path):
+    logged = refused_at_initialisation(engine_fmu_path, dict(KINDS["oscillating_roller"], arm_length=0.05))
     assert any("'arm_length' = 0.05" in text and "cannot reach" in text for text in logged), logged
 
 
@@ -91,14 +102,7 @@ def test_a_follower_its_friction_would_wedge_is_an_fmi_error_with_the_reference_
     params = {**KINDS["oscillating_flat"], "mu": 0.5, "J_cam": 0.0}
     with pytest.raises(ParameterError) as reference_error:
         simulate_reference(dict(defaults(), **params), 0.1, 0.01, u=constant(U))
-    logged: list[str] = []
-
-    def logger(*args):
-        logged.append(args[-1].decode() if isinstance(args[-1], bytes) else str(args[-1]))
-
-    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
-        fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(params, u=U), stop_time=0.1, output_interval=0.01,
-                          logger=logger)
+    logged = refused_at_initialisation(engine_fmu_path, dict(params, u=U))
     assert "wedge" in str(reference_error.value)
     assert any(str(reference_error.value) in text for text in logged), (str(reference_error.value), logged)
 
@@ -126,21 +130,13 @@ def own(request) -> tuple[str, dict]:
 @pytest.mark.parametrize("fmi_type", ["CoSimulation", "ModelExchange"])
 def test_cam_fmu_flies_every_kind_as_the_reference_does(engine_fmu_path, own, fmi_type):
     name, reference = own
-    options = {"relative_tolerance": 1e-10} if fmi_type == "ModelExchange" else {}
-    result = fmpy.simulate_fmu(str(engine_fmu_path), fmi_type=fmi_type, start_values=dict(OWN[name], u=U),
-                               stop_time=STOP, output_interval=STEP, output=NAMES, **options)
-    for output in NAMES:
-        assert error(result, reference, output) < OWN_BOUNDS[fmi_type], (fmi_type, output,
-                                                                           error(result, reference, output))
+    fmu_against_reference(engine_fmu_path, fmi_type, OWN[name], reference, OWN_BOUNDS[fmi_type])
     assert np.sum(reference["contact"] == 0.0) >= 5 and reference["impacts"][-1] >= 3
 
 
 def test_cam3_fmu_flies_every_kind_as_the_reference_does(cam3_fmu_path, own):
     name, reference = own
-    result = fmpy.simulate_fmu(str(cam3_fmu_path), start_values=dict(OWN[name], u=U), stop_time=STOP,
-                               output_interval=STEP, output=NAMES)
-    for output in NAMES:
-        assert error(result, reference, output) < OWN_BOUNDS["CoSimulation"], (output, error(result, reference, output))
+    fmu_against_reference(cam3_fmu_path, None, OWN[name], reference, OWN_BOUNDS["CoSimulation"])
 
 
 @pytest.mark.parametrize("changes,words", [
@@ -155,12 +151,5 @@ def test_a_contour_that_cannot_be_built_is_an_fmi_error_as_the_reference_refuses
 
     with pytest.raises(ParameterError):
         simulate_reference(dict(defaults(), **changes), 0.1, 0.01, u=constant(U))
-    logged: list[str] = []
-
-    def logger(*args):
-        logged.append(args[-1].decode() if isinstance(args[-1], bytes) else str(args[-1]))
-
-    with pytest.raises(Exception, match="fmi2ExitInitializationMode"):
-        fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(changes, u=U), stop_time=0.1, output_interval=0.01,
-                          logger=logger)
+    logged = refused_at_initialisation(engine_fmu_path, dict(changes, u=U))
     assert any(all(word in text for word in words) for text in logged), logged

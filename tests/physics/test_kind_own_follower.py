@@ -10,6 +10,7 @@ import sys
 
 import numpy as np
 import pytest
+from closed_forms import cycloid_program
 
 from cam_fmu.physics.follower_kind import FollowerKind
 from cam_fmu.physics.kind_drive import KindDriveModel
@@ -31,21 +32,9 @@ QUIET = dict(gravity=False, guide_friction=False, shaft_friction=False)
 
 
 def cycloidal(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(s, s', s'') of the scene's program (the cycloid's closed form, rise and mirrored return, dwells)."""
-    theta = np.mod(np.asarray(theta, dtype=float), 2.0 * math.pi)
-    b = RISE
-    s, s1, s2 = np.zeros_like(theta), np.zeros_like(theta), np.zeros_like(theta)
-    rise, top, ret = theta < b, (theta >= b) & (theta < 2 * b), (theta >= 2 * b) & (theta < 3 * b)
-    x = theta[rise] / b
-    s[rise] = H * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
-    s1[rise] = H / b * (1.0 - np.cos(2 * math.pi * x))
-    s2[rise] = 2 * math.pi * H / b ** 2 * np.sin(2 * math.pi * x)
-    s[top] = H
-    x = (theta[ret] - 2 * b) / b
-    s[ret] = H - H * (x - np.sin(2 * math.pi * x) / (2 * math.pi))
-    s1[ret] = -H / b * (1.0 - np.cos(2 * math.pi * x))
-    s2[ret] = -2 * math.pi * H / b ** 2 * np.sin(2 * math.pi * x)
-    return s, s1, s2
+    """(s, s', s'') of the scene's program (tests/closed_forms.py: the cycloid's closed form, rise and mirrored return,
+    dwells)."""
+    return cycloid_program(theta, RISE, H)
 
 
 def inertia(kind: FollowerKind, m: float = 0.4) -> float:
