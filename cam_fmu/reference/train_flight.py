@@ -44,6 +44,7 @@ class TrainFollowerRun(VoltageFollowerRun):
         if train is not None:   # a train given apart from the parameters' (simulate_reference's ``train``)
             self.body = TrainVoltageFollower(model, train)
         self.end_offset = end_offset
+        self.releases: list[float] = []   # s, where a follower halted in flight was started again by the train
 
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
         body, p = self.body, self.body.model.params
@@ -96,6 +97,13 @@ class TrainFollowerRun(VoltageFollowerRun):
                     return body.f0 + SIDE_HYSTERESIS - abs(body.net_at_rest(y[3]))
                 events.append(event(Event.HALT, release))
         return events, rhs, options
+
+    def _halt(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        if mode.follower is Follower.HALTED:   # the release: the train's pull beat the guide's static friction
+            self.releases.append(t)
+        return super()._halt(t, y, mode, kind)
+
+    TRANSITIONS = {**VoltageFollowerRun.TRANSITIONS, Event.HALT: _halt}
 
     def _rhs(self, contact: float, sigma: float):
         body, n = self.body, self.body.size
