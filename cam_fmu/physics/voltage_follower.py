@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 
 from .drive import sign as sgn
-from .follower import FlankFollower, Impact, closing_force, impact
+from .follower import FlankFollower, Impact, impact
 from .modes import Mode, Shaft
 from .variables import output_record
 
@@ -87,7 +87,7 @@ class VoltageFollower(FlankFollower):
         """(omega_dot [rad/s2], P [N], f [N]) with the follower on the flank ``contact``: the module's equations
         (the guide's friction against s' times ``heading``, the shaft's direction, sgn(omega) unless given)."""
         s_cam, s1, s2, _ = self.program.derivatives(theta)
-        F = closing_force(s_cam - contact * self.c, self.k, self.F0, self.F_gx)
+        F = self.flank_closing(s_cam - contact * self.c, s1 * omega)
         m, J_0 = self.m, self.J_0
         if self.mu == 0.0:
             omega_dot = (drive - (m * s2 * omega * omega + F) * s1) / (J_0 + m * s1 * s1)
@@ -106,10 +106,15 @@ class VoltageFollower(FlankFollower):
         f = self.mu * (abs(P * tan_a + self.G_y) + self.N_g)
         return omega_dot, P, f
 
+    def flank_closing(self, s: float, v: float) -> float:
+        """N, what closes the follower at s [m], moving at v [m/s], onto its +1 flank: F_close(s) (a train adds its
+        force, physics/train_follower.py)."""
+        return self.closing(s)
+
     def static_force(self, theta: float, contact: float) -> float:
         """N, the force P along X of the flank ``contact`` on the follower at rest on it, the cam held: it balances
         the spring and gravity, F_close(s) (the guide's friction carries nothing at rest)."""
-        return self.closing(self.flank(theta, contact)[0])
+        return self.flank_closing(self.flank(theta, contact)[0], 0.0)
 
     def start(self, y, u: float, contact: float) -> tuple[float, float]:
         """(margin [rad/s2], direction) of the shaft at rest: it starts toward ``direction`` where margin > 0 (the
@@ -168,7 +173,7 @@ class VoltageFollower(FlankFollower):
         """m/s2, a bound of the follower's acceleration relative to the flank near y."""
         theta, omega = y[0], y[1]
         s, s1, s2, _ = self.flank(theta, 0.0)
-        return (abs(self.closing(s)) / self.m + self.f0 / self.m
+        return (abs(self.flank_closing(s, s1 * omega)) / self.m + self.f0 / self.m
                 + abs(s2) * omega * omega + abs(s1 * self.torque(y, u) / self.J_0) + 1e-300)
 
     def land(self, y, u: float, contact: float = 1.0) -> tuple[float, list[float], Impact]:

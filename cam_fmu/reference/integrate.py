@@ -36,6 +36,7 @@ from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
 from .follower_kind import kind_reference
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
+from .train_flight import train_follower_reference
 from .train_speed import speed_train_reference
 from .train_voltage import voltage_train_reference
 from .voltage_flight import follower_voltage_reference
@@ -59,7 +60,8 @@ def simulate_reference(
 
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
     m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_INTEGRALS
-    (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py).
+    (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py; with a
+    follower of its own, reference/train_flight.py).
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
     'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the
@@ -281,6 +283,8 @@ def _speed_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Sign
 
 def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
                    options: dict) -> dict[str, np.ndarray]:
+    if model.free_follower:  # the train on the follower's own state (docs/model.md 14.6)
+        return train_follower_reference(model, grid, u, options, train)
     return voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
 
 

@@ -19,7 +19,8 @@ rotor's omega_m [rad/s] after the end mass's (TWIST, OMEGA_M) and E_damp = int d
 after the integrals: the cam side (J_cam + m s'^2) takes the shaft's torque M_shaft = k_shaft twist + d_shaft
 (omega_m - omega) in place of the motor's, the rotor J_m omega_m' = c_m i - M_shaft, the current sees omega_m; the
 held cam's break-away margin uses M_shaft (omega = 0), as reference/integrate.py's compliant drive. A clearance and
-a follower of its own are refused with that reason (their events do not carry the train yet).
+a follower of its own are refused here with that reason (a follower of its own carries the train in
+reference/train_flight.py, where simulate_reference routes it).
 """
 from __future__ import annotations
 

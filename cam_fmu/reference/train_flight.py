@@ -1,0 +1,128 @@
+"""The reference of a follower train on the follower of its own in the voltage drive (docs/model.md 14.6).
+
+``voltage_flight.VoltageFollowerRun`` with ``physics.train_follower.TrainVoltageFollower``: y = (theta, omega, i, s,
+v, [phi, omega_m,] x_e, v_e) and the energy integrals (hybrid.ENERGY; E_damp adds the train damper's d_train (v -
+v_e)^2), through the one hybrid loop. The events are the follower of its own's, with two more: on a stuck cam the
+flank's force changes through the train alone, so the lift-off is an event there too; a follower halted in flight by
+the guide's static friction starts again where the ringing train's pull overcomes it (|net| > f0 + SIDE_HYSTERESIS).
+In flight a step turns at most TRAIN_PHASE of the follower's ringing on the train's and the return spring's
+stiffness. The end mass starts at rest on the train's spring where its weight holds it, relative to the follower on
+its starting flank (x_e = s - contact c + F_ex / k_train, v_e = s' omega0), moved by ``end_offset`` [m] (a test's
+let-go). Rows add s_end, v_end, a_end and F_train.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..physics.drive import sign as sgn
+from ..physics.formulations.consistent import SIDE_HYSTERESIS
+from ..physics.modes import Event, Follower, Mode, Shaft
+from ..physics.signals import Signal
+from ..physics.train import Train
+from ..physics.train_follower import TrainVoltageFollower
+from .hybrid import ENERGY, event, piece_input
+from .voltage_flight import VoltageFollowerRun
+
+__all__ = ["TrainFollowerRun", "train_follower_reference"]
+
+# rad: the flying follower's phase on sqrt((k_spring + k_train) / m) in one step at most (the engine's bound): a
+# gap's crossing and return within one step would go unseen.
+TRAIN_PHASE = 0.05
+
+
+class TrainFollowerRun(VoltageFollowerRun):
+    """One run of the voltage drive with a follower of its own carrying the train."""
+
+    label = "train follower reference"
+    BODY = TrainVoltageFollower
+
+    def __init__(self, model, u: Signal, rtol: float, atol: float, energy: bool, method: str | None,
+                 train: Train | None = None, end_offset: float = 0.0) -> None:
+        super().__init__(model, u, rtol, atol, energy, method)
+        if train is not None:   # a train given apart from the parameters' (simulate_reference's ``train``)
+            self.body = TrainVoltageFollower(model, train)
+        self.end_offset = end_offset
+        self.releases: list[float] = []   # s, where a follower halted in flight was started again by the train
+
+    def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
+        body, p = self.body, self.body.model.params
+        theta0, omega0 = p["theta0"], p["omega0"]
+        s_cam, s1, _, _ = body.flank(theta0, 0.0)
+        y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0]
+        y += [0.0, omega0] if body.compliant else []
+        y += [0.0, 0.0] + [0.0] * len(ENERGY)
+        t = float(grid[0])
+        body.heading = sgn(omega0)
+        contact, y = self._hold(t, self._relax(y, 1.0), 1.0)
+        if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
+            other, y_other = self._hold(t, self._relax(y, -1.0), -1.0)
+            if other != 0.0:
+                self.lift_offs.pop()
+                contact, y = other, y_other
+        if body.heading == 0.0:
+            contact, y = self._rest(t, y, contact)
+        return self.pieces(grid, t, y, self._mode(contact, y),
+                           sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
+
+    def _relax(self, y: list, contact: float) -> list:
+        """y with the end mass at rest relative to the follower on the flank ``contact`` (and ``end_offset``)."""
+        body = self.body
+        s, s1, _, _ = body.flank(y[0], contact)
+        x_e, v_e = body.rest(s, s1 * y[1])
+        y = list(y)
+        y[body.X_E:body.X_E + 2] = [x_e + self.end_offset, v_e]
+        return y
+
+    def _mode(self, contact: float, y: list) -> Mode:
+        self.body.bind(y)
+        return super()._mode(contact, y)
+
+    def _piece(self, t: float, y: list, mode: Mode) -> tuple[list, object, dict]:
+        body, n, contact = self.body, self.body.size, mode.contact
+        body.bind(y)
+        events, rhs, options = super()._piece(t, y, mode)
+        u_at = piece_input(self.u, self.piece_end)
+        if contact and mode.shaft is Shaft.STUCK:  # the train alone changes the flank's force on a stuck cam
+            events.append(event(Event.LIFT_OFF, lambda t, y: body.contact_force(y[:n], u_at(t)[0], contact)))
+        if not contact:
+            rate = math.sqrt((max(body.k, 0.0) + body.train.k_train) / body.m)
+            options["max_step"] = min(options.get("max_step", math.inf), TRAIN_PHASE / rate)
+            body.bind(y)
+            if mode.follower is Follower.HALTED and body.f0 > 0.0:  # held by the guide until the train's pull beats it
+
+                def release(t, y):
+                    body.bind(y)
+                    return body.f0 + SIDE_HYSTERESIS - abs(body.net_at_rest(y[3]))
+                events.append(event(Event.HALT, release))
+        return events, rhs, options
+
+    def _halt(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
+        if mode.follower is Follower.HALTED:   # the release: the train's pull beat the guide's static friction
+            self.releases.append(t)
+        return super()._halt(t, y, mode, kind)
+
+    TRANSITIONS = {**VoltageFollowerRun.TRANSITIONS, Event.HALT: _halt}
+
+    def _rhs(self, contact: float, sigma: float):
+        body, n = self.body, self.body.size
+        rhs = super()._rhs(contact, sigma)
+        if not self.energy or body.train.d_train == 0.0:
+            return rhs
+
+        def with_damper(t, y):
+            dy = rhs(t, y)
+            dy[-1] += body.train_damping(y[:n], contact)
+            return dy
+        return with_damper
+
+
+def train_follower_reference(model, grid: np.ndarray, u: Signal, options: dict, train: Train | None = None,
+                             end_offset: float = 0.0) -> dict[str, np.ndarray]:
+    """The consistent voltage drive with a follower of its own (closures 'spring', 'form' with c > 0) carrying
+    ``train`` (None: the parameters' k_train, d_train, m_end), on the output grid; ``end_offset`` [m] moves the end
+    mass from its rest at the start."""
+    run = TrainFollowerRun(model, u, options["rtol"], options["atol"], options["energy"], options["method"], train,
+                           end_offset)
+    return run.run(grid)
