@@ -32,6 +32,7 @@
                                  * term 1.8e-8 of M_shaft off the reference (0.1: 2.2e-9; 0.03 and below: 2.1e-10, the
                                  * reference's own floor); STEP_PHASE there took 56x the steps for no gain (measured) */
 #define TRAIN_PHASE 0.05        /* rad: the flying follower's phase on the train's spring in one step */
+#define RELEASE_MARGIN 1e-9    /* N: a held follower leaves where the net force exceeds the guide's f0 by this */
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
 
@@ -271,6 +272,8 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
         cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P);
         return contact * P;
     }
+    if (code == EV_HALT && y[Y_SIGMA] == 0.0)   /* held by the guide: released where a train's pull beats f0 */
+        return cam_follower_friction0(m) + RELEASE_MARGIN - fabs(closing_at(m, y, y[3], 0.0));
     if (code == EV_HALT)
         return y[Y_SIGMA] * y[4];
     cam_kind_eval(m, y[0], d);
@@ -394,8 +397,8 @@ int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENT
     codes[n++] = EV_TOUCH_UP;
     if (m->closure == CAM_CHOICE_CLOSURE_FORM)
         codes[n++] = EV_TOUCH_DOWN;
-    if (mode->sigma != 0.0 && cam_follower_friction0(m) > 0.0)
-        codes[n++] = EV_HALT;
+    if ((mode->sigma != 0.0 || m->train) && cam_follower_friction0(m) > 0.0)
+        codes[n++] = EV_HALT;   /* held (sigma 0): only a train's ringing changes the force the guide holds */
     return n;
 }
 

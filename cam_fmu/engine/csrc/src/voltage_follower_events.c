@@ -178,8 +178,8 @@ int cam_vf_me_codes(const CamDrive *d, int codes[CAM_VF_ME_EVENTS])
         return n;
     }
     codes[n++] = EV_TOUCH;
-    if (d->mode.sigma != 0.0 && cam_follower_friction0(&d->model) > 0.0)
-        codes[n++] = EV_HALT;
+    if ((d->mode.sigma != 0.0 || d->model.train) && cam_follower_friction0(&d->model) > 0.0)
+        codes[n++] = EV_HALT;   /* held (sigma 0): released where a train's pull beats f0 */
     return n;
 }
 
