@@ -159,6 +159,11 @@ PLATFORM_SCENES = {
     "spring": [("sets", "closure", "spring"), ("setr", "k_spring", "800"), ("setr", "F_spring0", "20"),
                ("setr", "restitution", "0.5"), ("setr", "omega0", "60"), ("setr", "J_cam", "0.05"),
                ("setr", "gamma", "3.141592653589793"), ("setr", "u", "11")],
+    # an oscillating roller in a groove with its pivot's friction: its own flight, impacts about the pivot
+    "rocker": [("sets", "follower_type", "oscillating_roller"), ("setr", "arm_length", "0.15"),
+               ("setr", "pivot_distance", "0.18"), ("setr", "lift_angle", "0.3"), ("setr", "J_arm", "0.002"),
+               ("sets", "closure", "form"), ("setr", "c", "0.0003"), ("setr", "restitution", "0.5"),
+               ("setr", "mu", "0.05"), ("setr", "u", "6")],
 }
 
 

@@ -78,7 +78,7 @@ def test_win64_binary_agrees_with_linux64(hosts, fmu_dir, scene):
     assert len(linux) == len(windows) == 2
     for row_l, row_w in zip(linux, windows):
         for a, b in zip(row_l, row_w):
-            assert b == pytest.approx(a, rel=1e-10 if scene == "spring" else 1e-12, abs=1e-15)
+            assert b == pytest.approx(a, rel=1e-10 if scene in ("spring", "rocker") else 1e-12, abs=1e-15)
     assert linux[-1][1] > 5.0  # theta(2 s) [rad]: the cam turned
 
 
