@@ -54,3 +54,32 @@ def test_reflect_refuses_a_spring_closed_arm_and_its_advice_runs(tmp_path):
     assert len(advised) == 1 and shlex.split(advised[0])[1:3] == ["jump", "packaging_rocker"]
     ran = cli(*shlex.split(advised[0])[1:], "--no-plot", "--out", str(tmp_path), cwd=tmp_path)
     assert ran.returncode == 0 and "omega_jump:" in ran.stdout, ran.stderr
+
+
+def test_a_sweep_takes_the_follower_type_as_a_categorical_parameter(tmp_path):
+    """`cam-fmu sweep packaging_rocker --vary follower_type=oscillating_roller,oscillating_flat --vary mu=0.05` runs
+    both arms (the scene's arm fields fit either) as two cases; each case's peak load torque is that of the scene run
+    with its type in the engine directly (the type reaches the run), and they differ: with friction a roller arm
+    (the pivot's) and a flat face (sliding on the cam) load it differently (without it, on the same psi law, alike)."""
+
+    from cli_run import cli, csv_rows
+    from cam_fmu.engine.simulator import DriveSimulator
+    from cam_fmu.experiments.scenes import find_scene
+
+    cli("sweep", "packaging_rocker", "--vary", "follower_type=oscillating_roller,oscillating_flat", "--vary",
+        "mu=0.05", "--stop-time", "1.0", "--serial", "--no-plot", "--out", str(tmp_path), cwd=tmp_path)
+    header, *rows = csv_rows(tmp_path / "packaging_rocker_sweep.csv")
+    got = {row[header.index("follower_type")]: float(row[header.index("peak_M [N.m]")]) for row in rows}
+    assert sorted(got) == ["oscillating_flat", "oscillating_roller"]
+    assert all(row[header.index("status")] == "ok" for row in rows)
+    scene = find_scene("packaging_rocker")
+    for kind, peak in got.items():
+        sim = DriveSimulator(dict(scene.primary.params, follower_type=kind, mu=0.05))
+        sim.set_inputs(scene.u.value(0.0), 0.0, 0.0)
+        torques = []
+        for k in range(int(round(1.0 / scene.output_interval))):
+            t = k * scene.output_interval
+            sim.do_step(t, scene.output_interval, u=scene.u.value(t), omega_ref=0.0, omega_dot_ref=0.0)
+            torques.append(abs(sim.outputs()["M"]))
+        assert abs(peak - max(torques)) <= 1e-9 * peak
+    assert abs(got["oscillating_roller"] - got["oscillating_flat"]) > 1e-3 * max(got.values())
