@@ -16,13 +16,12 @@ import math
 
 import numpy as np
 
-from ..physics.drive import sign as sgn
 from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.modes import Event, Follower, Mode, Shaft
 from ..physics.signals import Signal
 from ..physics.train import Train
 from ..physics.train_follower import TrainVoltageFollower
-from .hybrid import ENERGY, event, piece_input
+from .hybrid import event, piece_input
 from .voltage_flight import VoltageFollowerRun
 
 __all__ = ["TrainFollowerRun", "train_follower_reference"]
@@ -46,25 +45,9 @@ class TrainFollowerRun(VoltageFollowerRun):
         self.end_offset = end_offset
         self.releases: list[float] = []   # s, where a follower halted in flight was started again by the train
 
-    def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
-        body, p = self.body, self.body.model.params
-        theta0, omega0 = p["theta0"], p["omega0"]
-        s_cam, s1, _, _ = body.flank(theta0, 0.0)
-        y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0]
-        y += [0.0, omega0] if body.compliant else []
-        y += [0.0, 0.0] + [0.0] * len(ENERGY)
-        t = float(grid[0])
-        body.heading = sgn(omega0)
-        contact, y = self._hold(t, self._relax(y, 1.0), 1.0)
-        if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
-            other, y_other = self._hold(t, self._relax(y, -1.0), -1.0)
-            if other != 0.0:
-                self.lift_offs.pop()
-                contact, y = other, y_other
-        if body.heading == 0.0:
-            contact, y = self._rest(t, y, contact)
-        return self.pieces(grid, t, y, self._mode(contact, y),
-                           sorted(b for b in self.u.breaks if t < b < float(grid[-1])))
+    def _extra(self) -> list:
+        """The end mass's position and velocity, set on the starting flank by _relax."""
+        return [0.0, 0.0]
 
     def _relax(self, y: list, contact: float) -> list:
         """y with the end mass at rest relative to the follower on the flank ``contact`` (and ``end_offset``)."""

@@ -46,6 +46,14 @@ class VoltageFollowerRun(VoltageRun):
         mode.follower = Follower.flank(contact) if contact else flying(self.body, y, 4)
         return mode
 
+    def _extra(self) -> list:
+        """The body's states after the shaft's at the start (a train's end mass: TrainFollowerRun); none here."""
+        return []
+
+    def _relax(self, y: list, contact: float) -> list:
+        """y as the start on the flank ``contact`` (a train's end mass relaxed on it: TrainFollowerRun); y here."""
+        return y
+
     def run(self, grid: np.ndarray) -> dict[str, np.ndarray]:
         body, model = self.body, self.body.model
         p = model.params
@@ -53,12 +61,12 @@ class VoltageFollowerRun(VoltageRun):
         s_cam, s1, _, _ = body.flank(theta0, 0.0)   # the cam's own lift (no clearance)
         y = [theta0, omega0, p["i0"] if body.has_current else 0.0, s_cam, s1 * omega0]
         y += [0.0, omega0] if body.compliant else []  # the shaft relaxed, the rotor at the cam's speed (model.md 12.1)
-        y += [0.0] * len(ENERGY)
+        y += self._extra() + [0.0] * len(ENERGY)
         t = float(grid[0])
         body.heading = sgn(omega0)  # from rest: stuck (0) until the break-away rule starts it
-        contact, y = self._hold(t, y, 1.0)
+        contact, y = self._hold(t, self._relax(y, 1.0), 1.0)
         if contact == 0.0 and body.two_sided:  # a groove: on its other flank if that one holds the follower
-            other, y_other = self._hold(t, y, -1.0)
+            other, y_other = self._hold(t, self._relax(y, -1.0), -1.0)
             if other != 0.0:
                 self.lift_offs.pop()
                 contact, y = other, y_other
