@@ -86,15 +86,6 @@ typedef struct {
  * omega ends at 0 (within the rounding of omega_ref + omega_dot_ref h and of the end time t [s]) the way the step
  * started (speed.c). */
 double cam_motion_sign(double omega, double omega_ref, double omega_dot_ref, double t);
-/* An event function `code` of a hybrid run at x (a time or a step's length) [s]; > 0 while nothing happens. */
-typedef double (*CamEventValue)(void *ctx, int code, double x);
-/* The earliest of the n event functions codes[k] to cross, as `crossed(before, after)` says, from fa[k] at a to fb[k]
- * at b, each located by Illinois false position (the first x where crossed(fa[k], value) holds) to a bracket of tol
- * [s], or with tol = 0 to the last bit: its index, or -1 for none, and *at. Every hybrid run's one locator
- * (integrate.c). */
-int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
-                           double *at);
 /* The follower's names for the one table of event codes (CAM_EV_*, generated; docs/model.md 10 and 13.7), for the
  * speed drive's follower (follower.c) and the voltage drive's (voltage_follower.c, Model Exchange's indicators):
  * lift-off is the contact's loss, touch-down on flank +1 (TOUCH_UP) and -1 (TOUCH_DOWN) its engagements; EV_BREAK (a

@@ -6,7 +6,7 @@
  * plain tableau (etdrk4: exponential, exact on the electrical pole) provides its
  * own step function with the same signature. One communication-step driver
  * (cam_integrate) serves every method: profile breakpoints, event location
- * (Illinois false position on re-stepped trial states), transitions, the work
+ * (seeded on the step's dense output, polished on re-stepped trial states), transitions, the work
  * bound max_steps and its message, and rollback to the state before the step
  * when the step is refused.
  *

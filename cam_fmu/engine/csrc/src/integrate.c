@@ -1,7 +1,7 @@
 /* One communication step of the consistent formulation with any method: adaptive steps with error
- * control (or fixed steps inside the method's limits), profile breakpoints, events located by Illinois
- * false position on re-stepped trial states (cam_locate_first_event, every hybrid run's one locator),
- * transitions, the work bound max_steps, rollback.
+ * control (or fixed steps inside the method's limits), profile breakpoints, events located on the step's dense
+ * output and polished on re-stepped trial states by Illinois false position (locate: every hybrid run's one
+ * locator), transitions, the work bound max_steps, rollback.
  *
  * Ported from the former Python engine (its step attempt, trial, locate, first_event,
  * advance) with the order of floating-point operations kept: rk45 agrees with it to the last bit. */
@@ -146,95 +146,151 @@ static int open_bracket(double lo, double hi, double tol, int j)
     return tol > 0.0 ? j < EVENT_ITERATIONS && hi - lo > tol : j < EXACT_ITERATIONS && lo < mid && mid < hi;
 }
 
-int cam_locate_first_event(int n, const int codes[], double a, double b, const double fa[], const double fb[],
-                           int (*crossed)(double before, double after), CamEventValue value, void *ctx, double tol,
-                           double *at)
-{
-    int k, j, side, first = -1;
-    double best = b;
-    for (k = 0; k < n; k++) {
-        double lo = a, hi = b, g_lo = fa[k], g_hi = fb[k], tau, g;
-        if (!crossed(fa[k], fb[k]))
-            continue;
-        for (side = 0, j = 0; open_bracket(lo, hi, tol, j); j++) {
-            tau = g_hi != g_lo ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
-            if (!(lo < tau && tau < hi))
-                tau = 0.5 * (lo + hi);
-            g = value(ctx, codes[k], tau);
-            if (crossed(fa[k], g)) {
-                hi = tau;
-                g_hi = g;
-                if (side == -1)
-                    g_lo *= 0.5;
-                side = -1;
-            } else {
-                lo = tau;
-                g_lo = g;
-                if (side == 1)
-                    g_hi *= 0.5;
-                side = 1;
-            }
-        }
-        if (first < 0 || hi < best) {
-            best = hi;
-            first = k;
-        }
-    }
-    if (first >= 0)
-        *at = best;
-    return first;
-}
-
-typedef struct {                /* trial_value's arguments but the code and the time */
+typedef struct {                /* the values' arguments but the code and the time */
     CamDrive *d;
     CamIntegrator *it;
     const int *codes;           /* the functions located */
     double target;              /* rad: the breakpoint of code -1 */
+    double dt;                  /* s: the step's length */
+    double f_end[CAM_NX];       /* f at the step's end (the interpolant's last rate) */
     double x[CAM_MAX_EVENTS][CAM_NX];   /* each function's latest trial state on its event side (<= 0) */
 } Trial;
 
-/* The event function `code` (-1: the gap direction (target - theta)) at the trial state tau [s] into the step; the
- * state kept where it is <= 0 (the located time is the latest such trial: no step taken again). */
-static double trial_value(void *ctx, int code, double tau)
+typedef double (*Value)(Trial *t, int k, double tau);
+
+/* Illinois false position on function k from g_lo > 0 at lo to g_hi <= 0 at hi, to a bracket of tol [s]: the
+ * bracket's end past the zero; the secant slope of the last bracket's values into *slope. */
+static double illinois(Value value, Trial *t, int k, double lo, double hi, double g_lo, double g_hi, double tol,
+                       double *slope)
 {
-    Trial *t = ctx;
-    double g;
-    int k = 0;
-    trial(t->d, t->it, tau, t->d->form_u);
-    g = zero_value(t->d, code, t->target, t->it->work.x_new, t->d->form_u);
-    if (g <= 0.0) {
-        while (t->codes[k] != code)
-            k++;
-        memcpy(t->x[k], t->it->work.x_new, sizeof t->x[k]);
+    int side = 0, j;
+    double tau, g, raw_lo = g_lo, raw_hi = g_hi;
+    for (j = 0; open_bracket(lo, hi, tol, j); j++) {
+        tau = g_hi != g_lo ? hi - g_hi * (hi - lo) / (g_hi - g_lo) : 0.5 * (lo + hi);
+        if (g_hi == 0.0 && side != 2) {   /* the secant stays at an exact zero: first a try just before it */
+            tau = hi - 0.9 * tol;
+            side = 2;
+        }
+        if (!(lo < tau && tau < hi))
+            tau = 0.5 * (lo + hi);
+        g = value(t, k, tau);
+        if (g <= 0.0) {
+            hi = tau;
+            g_hi = raw_hi = g;
+            g_lo *= side == -1 ? 0.5 : 1.0;
+            side = -1;
+        } else {
+            lo = tau;
+            g_lo = raw_lo = g;
+            g_hi *= side == 1 ? 0.5 : 1.0;
+            side = 1;
+        }
     }
+    *slope = (raw_hi - raw_lo) / (hi - lo);
+    return hi;
+}
+
+/* Function k at the trial state tau [s] into the step (moving: a step taken again; stuck: exact), the state kept
+ * where it is <= 0 (the located time is the latest such trial: no step taken again). */
+static double trial_value(Trial *t, int k, double tau)
+{
+    double g;
+    trial(t->d, t->it, tau, t->d->form_u); 
+    g = zero_value(t->d, t->codes[k], t->target, t->it->work.x_new, t->d->form_u);
+    if (g <= 0.0)
+        memcpy(t->x[k], t->it->work.x_new, sizeof t->x[k]);
     return g;
 }
 
-static int downward(double before, double after)
+/* Function k on the step's dense output at tau [s]: the cubic Hermite interpolant of its ends' states and rates,
+ * every method's (no stage computed; docs/model.md 10). */
+static double dense_value(Trial *t, int k, double tau)
 {
-    return before > 0.0 && after <= 0.0;
+    const double *x0 = t->d->x, *f0 = t->d->solver.k1, *x1 = t->it->x_end, *f1 = t->f_end;
+    double s = tau / t->dt, r = 1.0 - s, x[CAM_NX];
+    int slot;
+    memcpy(x, x1, sizeof x);
+    for (slot = 0; slot < t->d->model.slots; slot++)
+        x[slot] = (1.0 + 2.0 * s) * r * r * x0[slot] + s * r * r * t->dt * f0[slot] + s * s * (3.0 - 2.0 * s) * x1[slot]
+                  - s * s * r * t->dt * f1[slot];
+    return zero_value(t->d, t->codes[k], t->target, x, t->d->form_u);
+}
+
+/* Function k's zero in (0, end], from g0 > 0 at the step's start to g_end <= 0 at end: seeded on the dense output,
+ * then polished on trial states: two secant steps (the first on the interpolant's slope), then two trials a bracket
+ * of tol [s] apart about the result, and Illinois from what they leave (each trial inside the bracket narrows it). */
+static double zero_of(Trial *t, int k, double g0, double end, double g_end, double tol)
+{
+    double slope, lo = 0.0, hi = end, g_lo = g0, g_hi = g_end, tau, g, root, last = 0.0, g_last = 0.0;
+    int j;
+    root = illinois(dense_value, t, k, lo, hi, g_lo, g_hi, tol, &slope);
+    slope = (dense_value(t, k, root + 1e-4 * t->dt) - dense_value(t, k, root - 1e-4 * t->dt)) / (2e-4 * t->dt);
+    for (j = 0; j < 4; j++) {
+        tau = j < 2 ? root : root + (j == 2 ? 0.45 : -0.45) * tol;
+        if (!(lo < tau && tau <= hi))
+            continue;
+        g = trial_value(t, k, tau);
+        if (j == 1)   /* the secant through the two trials */
+            slope = (g - g_last) / (tau - last);
+        if (j < 2) {
+            last = tau;
+            g_last = g;
+            root = tau - g / slope;
+        }
+        if (g <= 0.0) {
+            hi = tau;
+            g_hi = g;
+        } else {
+            lo = tau;
+            g_lo = g;
+        }
+    }
+    return illinois(trial_value, t, k, lo, hi, g_lo, g_hi, tol, &slope);
 }
 
 /* The first of n functions codes[k] to go from before[k] > 0 to after[k] <= 0 over the step of dt from d->x to
- * it->x_end: its index (-1: none), its time *tau from the step start [s] and the state there in it->x_hit. */
+ * it->x_end: its index (-1: none), its time *tau from the step start [s] and the state there in it->x_hit. Each
+ * crossing function's zero is found on the dense output and polished on trial steps; one that is already <= 0 at
+ * the first polished zero went first and is located before it in turn. */
 static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], const double before[],
                   const double after[], double target, double dt, double *tau)
 {
     Trial t;
-    int k;
-    for (k = 0; k < n && !downward(before[k], after[k]); k++)
-        ;
-    if (k == n)   /* the common case: nothing crossed, no call */
-        return -1;
+    int k, first = -1, exact = d->mode.stuck && d->model.slots == CAM_NX_RIGID, open[CAM_MAX_EVENTS];
+    double tol = 1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, end = dt, slope, g, g_end[CAM_MAX_EVENTS];
     t.d = d;
     t.it = it;
     t.codes = codes;
     t.target = target;
-    k = cam_locate_first_event(n, codes, 0.0, dt, before, after, downward, trial_value, &t,
-                               1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, tau);
-    if (k >= 0)   /* at dt no trial fell on the event's side: the step's end */
-        memcpy(it->x_hit, *tau < dt ? t.x[k] : it->x_end, sizeof it->x_hit);
-    return k;
+    t.dt = dt;
+    for (k = 0; k < n; k++) {   /* the earliest seed; the common case: nothing crossed, no call */
+        g_end[k] = after[k];
+        open[k] = before[k] > 0.0 && after[k] <= 0.0;
+        if (!open[k])
+            continue;
+        if (first < 0 && !exact)
+            cam_rhs(&d->model, &d->mode, it->x_end, d->form_u, t.f_end);
+        g = exact ? dt : illinois(dense_value, &t, k, 0.0, dt, before[k], after[k], tol, &slope);
+        if (first < 0 || g < *tau) {
+            first = k;
+            *tau = g;
+        }
+    }
+    while (first >= 0) {   /* polish the first; another function at or below 0 at its zero went before it */
+        memcpy(t.x[first], end < dt ? it->x_hit : it->x_end, sizeof t.x[first]);   /* the state at end */
+        end = exact ? illinois(trial_value, &t, first, 0.0, end, before[first], g_end[first], tol, &slope)
+                    : zero_of(&t, first, before[first], end, g_end[first], tol);
+        memcpy(it->x_hit, t.x[first], sizeof it->x_hit);
+        *tau = end;
+        open[first] = 0;
+        for (k = 0; k < n; k++)
+            if (open[k] && (g_end[k] = zero_value(d, codes[k], target, it->x_hit, d->form_u)) <= 0.0)
+                break;
+        if (k == n)
+            return first;
+        first = k;
+    }
+    return -1;
 }
 
 /* The earliest event in (0, dt] of the step from d->x to it->x_end: its time from the step start [s],
