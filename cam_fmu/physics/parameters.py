@@ -161,11 +161,12 @@ _MODE = (
 )
 
 _SOLVER = (
-    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole), 'rk23' (adaptive Bogacki-Shampine 3(2): half rk45's stages a step, for loose tolerances); not used by the speed drive; each runs a follower of its own in the voltage drive too (docs/model.md 13.6)", kind="string", choices=SOLVERS),
-    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; not used by the speed drive, "
-       "which takes its own steps, docs/model.md 13.4)",
+    _P("solver", "", "rk45", "integrator: 'euler', 'rk4' (fixed step), 'rk45' (adaptive Dormand-Prince), 'etdrk4' (exponential RK4, exact on the electrical pole), 'rk23' (adaptive Bogacki-Shampine 3(2): half rk45's stages a step, for loose tolerances); each runs a follower of its own in either drive (docs/model.md 13.6; the speed drive's rigid follower is a closed form and takes none)", kind="string", choices=SOLVERS),
+    _P("h_max", "s", 1e-3, "largest internal step (fixed-step solvers: the internal step; the speed drive's only with a "
+       "follower of its own, docs/model.md 13.4)",
        low=1e-9, high=10.0),
-    _P("rtol", "1", 1e-10, "relative tolerance of 'rk45' (not used by the speed drive, as h_max)", low=1e-14, high=0.1),
+    _P("rtol", "1", 1e-10, "relative tolerance of 'rk45' and 'rk23' (the speed drive's only with a follower of its own or a "
+       "train)", low=1e-14, high=0.1),
     _P("atol", "1", 1e-12, "absolute tolerance of 'rk45' (on rad, rad/s, A; not used where rtol is not)",
        low=1e-16, high=1.0),
     _P("max_steps", "1", 10000.0, "most internal steps in one communication step before an error is reported (a stiff pole or a huge step: see etdrk4); bounds the work of one step", low=1.0, high=1e6),

@@ -71,6 +71,65 @@ def test_the_engine_is_the_reference_over_many_crossings_of_a_vertical_groove():
     assert np.max(np.abs(got["v"] - ref["v"])) < 1e-7
 
 
+VERTICAL = dict(drive="speed", closure="form", c=1e-3, restitution=0.9, gamma=math.pi / 2, mu=0.0, M_f=0.0)
+W0, W1, RAMP = 40.0, 100.0, 0.12   # rad/s, rad/s, s: omega_ref ramps from W0 to W1 over RAMP
+
+
+@pytest.fixture(scope="module")
+def ramp_reference():
+    """The reference over the ramp in the vertical groove (20 impacts on both flanks): times, rows, impacts."""
+    from cam_fmu.physics.drive import DriveModel
+    from cam_fmu.physics.signals import Signal
+    from cam_fmu.reference.flight import FollowerRun
+
+    run = FollowerRun(DriveModel(VERTICAL), Signal((0.0, RAMP), (W0, W1)), 1e-12, 1e-13)
+    times = np.linspace(0.0, RAMP, 241)
+    return times, run.run(times, 0.0), run.impacts
+
+
+def ramp_run(settings: dict, times: np.ndarray) -> dict[str, np.ndarray]:
+    """The engine in the vertical groove with ``settings``, omega_ref and omega_dot_ref set at each point."""
+    alpha = (W1 - W0) / RAMP
+    sim = DriveSimulator(dict(VERTICAL, **settings))
+    sim.set_inputs(u=0.0, omega_ref=W0, omega_dot_ref=alpha)
+    rows = [sim.outputs()]
+    for t0, t1 in zip(times[:-1], times[1:]):
+        sim.do_step(float(t0), float(t1 - t0), omega_ref=W0 + alpha * float(t0), omega_dot_ref=alpha)
+        rows.append(sim.outputs())
+    return {name: np.array([row[name] for row in rows]) for name in rows[0]}
+
+
+@pytest.mark.parametrize("settings, s_tol, v_tol", [
+    (dict(solver="rk23", rtol=1e-9, atol=1e-12), 3e-8, 2e-5),   # measured 6.4e-9 m, 4.1e-6 m/s
+    (dict(solver="rk4", h_max=1e-4), 1e-8, 4e-6),               # measured 1.2e-9 m, 7.8e-7 m/s
+    (dict(solver="etdrk4", h_max=1e-4), 1e-8, 4e-6),            # (no pole here: rk4's steps)
+])
+def test_every_solver_runs_the_speed_drives_follower(settings, s_tol, v_tol, ramp_reference):
+    """Issue 38: the speed drive's follower of its own takes any solver with its settings. Under a ramp of omega_ref
+    the cam's angle stays the closed form theta = W0 t + alpha t^2 / 2 whatever the method (set exactly after each
+    step); the follower's 20 impacts agree with the reference to the method's accuracy."""
+    times, ref, impacts = ramp_reference
+    got = ramp_run(settings, times)
+    alpha = (W1 - W0) / RAMP
+    assert len(impacts) >= 15
+    assert np.max(np.abs(got["theta"] - (W0 * times + 0.5 * alpha * times ** 2))) < 1e-12
+    assert np.max(np.abs(got["s"] - ref["s"])) < s_tol
+    assert np.max(np.abs(got["v"] - ref["v"])) < v_tol
+
+
+def test_euler_runs_the_speed_drives_follower_at_first_order(ramp_reference):
+    """Explicit Euler on the same ramp up to the second impact: the error halves with h_max (measured 8.0e-6, 4.0e-6,
+    2.0e-6 m at 4, 2, 1 us) while theta stays exact (euler alone would be off by alpha h^2 / 2 per step)."""
+    times, ref, impacts = ramp_reference
+    before = times < impacts[1][0]
+    errors = []
+    for h_max in (4e-6, 2e-6, 1e-6):
+        got = ramp_run(dict(solver="euler", h_max=h_max), times)
+        assert np.max(np.abs(got["theta"] - ref["theta"])) < 1e-12
+        errors.append(np.max(np.abs(got["s"] - ref["s"])[before]))
+    assert errors[0] < 2e-5 and all(1.7 < a / b < 2.3 for a, b in zip(errors, errors[1:])), errors
+
+
 @pytest.mark.parametrize("ratio, leaves", [(0.98, False), (1.02, True)])
 def test_jump_speed_in_the_speed_drive(ratio, leaves):
     omega_jump = math.sqrt((F0 + K * H) / (MASS * H / 2 * (math.pi / B) ** 2))

@@ -134,6 +134,10 @@ int cam_step_control(double norm, double exponent, double bound, double *dt, dou
 int cam_train_follow(const CamModel *m, double x[CAM_NX], double theta0, double omega0, double alpha, double h,
                      double *h_next, long *steps, CamError *err);
 
+/* The speed drive's imposed motion over a step of h [s] from x at the acceleration u [rad/s2] into x_new's theta and
+ * omega, exact whatever the method (m->prescribed only; speed_follower.c). */
+void cam_impose_motion(const CamModel *m, const double x[CAM_NX], double u, double h, double x_new[CAM_NX]);
+
 /* One accepted adaptive step no longer than remaining, h_max and d->solver.h_next: its length [s],
  * the end state in it->x_end, f there in it->f_end. span is the communication step (the step floor is
  * 1e-12 of it); below the floor: CAM_ERR_REJECTED with the former engine's message. */

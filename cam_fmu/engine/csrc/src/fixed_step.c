@@ -38,6 +38,7 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt_
         dt = smaller(dt, sweep > 0.0 ? res / sweep : HUGE_VAL);
         memcpy(it->work.k[0], d->solver.k1, sizeof d->solver.k1);
         method->step(method, m, &d->mode, d->x, u, dt, &it->work);
+        cam_impose_motion(m, d->x, u, dt, it->work.x_new);
         finite = 1;
         for (slot = 0; slot < m->slots; slot++)
             finite = finite && isfinite(it->work.x_new[slot]);

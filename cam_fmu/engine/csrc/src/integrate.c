@@ -35,6 +35,7 @@ static void method_step(CamDrive *d, CamIntegrator *it, double h, double u)
     }
     memcpy(it->work.k[0], d->solver.k1, sizeof d->solver.k1);
     it->method->step(it->method, &d->model, &d->mode, d->x, u, h, &it->work);
+    cam_impose_motion(&d->model, d->x, u, h, it->work.x_new);
 }
 
 /* A likely cause of many small steps, into buf ("" for none): a follower train ringing faster than h_max resolves, or

@@ -425,8 +425,6 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->free_follower = cam_own_follower(v);   /* physics/rules.py OWN_FOLLOWER (docs/model.md 13) */
     model->prescribed = model->formulation == CAM_FORM_SPEED;
     model->follower_states = model->free_follower && (model->formulation == CAM_FORM_CONSISTENT || model->prescribed);
-    if (model->follower_states && model->prescribed)   /* the speed drive has no solver of its own: its follower's */
-        model->solver = CAM_CHOICE_SOLVER_RK45;
     model->slots = model->follower_states ? CAM_NX : (model->compliant || model->train ? CAM_NX_SHAFT : CAM_NX_RIGID);
     if (model->follower_states)
         model->nx += 2;   /* its gap and rate (0 on a flank) */

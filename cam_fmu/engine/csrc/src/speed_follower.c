@@ -1,7 +1,7 @@
 /* The speed drive's follower of its own (docs/model.md 13, 16.3): the voltage drive's follower (voltage_follower.c,
  * its equations, events and transitions) under the imposed motion omega(t) = omega_ref + omega_dot_ref (t - t_k)
  * (m->prescribed: the cam's J_0 is infinite, an impact keeps its speed; the rates' input u is omega_dot_ref), in the
- * one hybrid driver (integrate.c) with rk45 at the drive's rtol, atol and h_max. A step of omega_ref at a
+ * one hybrid driver (integrate.c) with any solver and its settings, the cam's motion set exactly after each step. A step of omega_ref at a
  * communication point moves the flank, not the follower (speed_step); the outputs add the current and the voltage
  * that impose the motion. Its check is the reference's physics/speed_follower.py and reference/flight.py. */
 #include <math.h>
@@ -48,6 +48,14 @@ static void speed_step(CamDrive *d, double time)
         }
     }
     cam_vf_x(m, y, u, contact, contact != 0 ? contact : left, d->x, &d->mode);
+}
+
+void cam_impose_motion(const CamModel *m, const double x[CAM_NX], double u, double h, double x_new[CAM_NX])
+{
+    if (m->prescribed) {   /* theta, omega exact under every method (euler's theta would be off by u h^2 / 2) */
+        x_new[CAM_THETA] = x[CAM_THETA] + (x[CAM_OMEGA] + 0.5 * u * h) * h;
+        x_new[CAM_OMEGA] = x[CAM_OMEGA] + u * h;
+    }
 }
 
 static int sf_init(CamDrive *d, CamError *err)
