@@ -62,7 +62,7 @@ const CamFormulation *cam_formulation(const CamModel *m);
 extern const CamFormulation cam_consistent;   /* consistent.c */
 extern const CamFormulation cam_paper;        /* paper.c */
 extern const CamFormulation cam_speed;        /* speed.c */
-extern const CamFormulation cam_voltage_follower;   /* voltage_follower.c: consistent, closures 'form', 'spring' */
+extern const CamFormulation cam_voltage_follower;   /* consistent.c with voltage_follower.c's hooks: closures 'form', 'spring' */
 extern const CamFormulation cam_speed_follower;   /* voltage_follower.c: the speed drive, closures 'form', 'spring' */
 
 /* The fixed-step paper scheme's state (paper.PaperScheme: FIELDS and M_l), in SI units. */

@@ -1,16 +1,24 @@
 /* The energy-consistent formulation under a voltage input (docs/model.md section 5; the readable model: physics/formulations/consistent.py):
- * an ODE with events, advanced by the solvers of cam_solver.h. */
+ * an ODE with events, advanced by the solvers of cam_solver.h; with a follower of its own (section 13.6) too. */
 #include <stdio.h>
+#include <string.h>
 
 #include "cam_solver.h"
+#include "cam_voltage_follower.h"
 
+/* The start; a follower of its own (the formulation's transition hook) sets itself on its flank
+ * (voltage_follower.c cam_vf_start). */
 static int consistent_init(CamDrive *d, CamError *err)
 {
     const double *v = d->model.params.v;
     (void)err;
     cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
     d->form_u = d->u;
-    cam_settle(&d->model, &d->mode, d->x, d->u, 0);
+    memset(&d->speed, 0, sizeof d->speed);
+    if (d->form->transition != NULL)
+        cam_vf_start(d, d->u);
+    else
+        cam_settle(&d->model, &d->mode, d->x, d->u, 0);
     d->solver.k1_valid = 0;
     return CAM_OK;
 }
@@ -22,11 +30,16 @@ static void consistent_set_inputs(CamDrive *d, double u, double omega_ref, doubl
     if (u == d->form_u)
         return;   /* settled for this input already (each advance settles again at its start) */
     d->form_u = u;
-    cam_settle(&d->model, &d->mode, d->x, u, 0);   /* at rest: stuck, or starting now */
+    d->step_events[0] = '\0';
+    if (d->form->transition != NULL)   /* at rest: stuck, or starting now */
+        d->form->transition(d, EV_NONE, d->time);
+    else
+        cam_settle(&d->model, &d->mode, d->x, u, 0);
 }
 
 static int consistent_advance(CamDrive *d, double h, double time, long *steps, CamError *err)
 {
+    d->step_events[0] = '\0';
     return cam_integrate(d, h, time, steps, err);
 }
 
@@ -55,4 +68,11 @@ static void consistent_advice(const CamDrive *d, char *buf, size_t len)
 const CamFormulation cam_consistent = {
     "consistent", 1, consistent_init, consistent_set_inputs, consistent_advance, consistent_outputs,
     consistent_advice, NULL, NULL, NULL,
+};
+
+/* The same with the follower a body of its own (closures 'form', 'spring'; voltage_follower.c): its outputs,
+ * exchange, transitions and step bound as hooks. */
+const CamFormulation cam_voltage_follower = {
+    "consistent", 1, consistent_init, consistent_set_inputs, consistent_advance, cam_vf_outputs, consistent_advice,
+    &cam_vf_exchange, cam_vf_apply, cam_vf_step_limit,
 };

@@ -101,25 +101,20 @@ static void sf_outputs(CamDrive *d, double out[])
 {
     const CamModel *m = &d->model;
     double y[NY], omega_dot = d->form_u, i, step = 1e-6;
-    double direction = cam_motion_sign(d->x[CAM_OMEGA], d->omega_ref, d->omega_dot_ref, fabs(d->time));
-    CamMode held = d->mode;
-    d->mode.stuck = direction == 0.0;   /* the outputs take the left limit's direction: a stop at the step's end */
-    if (direction != 0.0)               /* (its event turned the mode) still moves there */
-        d->mode.direction = direction;
-    cam_vf_outputs(d, out);
+    cam_vf_outputs(d, out);   /* (in the left limit's direction of motion) */
     i = (m->J_0 * omega_dot + out[CAM_O_M]) / m->c_m;
     out[CAM_O_I] = i;
     out[CAM_O_VOLTAGE] = m->R * i + m->c_e * out[CAM_O_OMEGA];
     if (d->mode.contact != 0 && m->L > 0.0 && out[CAM_O_OMEGA] != 0.0) {
         double ahead, behind;
         cam_vf_y(m, &d->mode, d->x, y);
+        y[Y_DIR] = sgn(out[CAM_O_OMEGA]);
         y[0] += step;
         ahead = cam_vf_flank_torque(m, y, omega_dot, d->mode.contact);
         y[0] -= 2.0 * step;
         behind = cam_vf_flank_torque(m, y, omega_dot, d->mode.contact);
         out[CAM_O_VOLTAGE] += m->L * out[CAM_O_OMEGA] * ((ahead - behind) / (2.0 * step)) / m->c_m;
     }
-    d->mode = held;
 }
 
 static void sf_advice(const CamDrive *d, char *buf, size_t len)

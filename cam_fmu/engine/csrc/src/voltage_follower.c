@@ -521,34 +521,6 @@ void cam_vf_start(CamDrive *d, double u)
     d->solver.k1_valid = 0;
 }
 
-static int vf_init(CamDrive *d, CamError *err)
-{
-    const double *v = d->model.params.v;
-    (void)err;
-    cam_initial(&d->model, v[CAM_P_THETA0], v[CAM_P_OMEGA0], v[CAM_P_I0], d->x, &d->mode);
-    d->form_u = d->u;
-    memset(&d->speed, 0, sizeof d->speed);
-    cam_vf_start(d, d->u);
-    return CAM_OK;
-}
-
-static void vf_set_inputs(CamDrive *d, double u, double omega_ref, double omega_dot_ref)
-{
-    (void)omega_ref;
-    (void)omega_dot_ref;
-    if (u == d->form_u)
-        return;   /* settled for this input already (each advance settles again at its start) */
-    d->form_u = u;
-    d->step_events[0] = '\0';
-    cam_vf_apply(d, EV_NONE, d->time);   /* at rest: stuck, or starting now (consistent.c's rule) */
-}
-
-static int vf_advance(CamDrive *d, double h, double time, long *steps, CamError *err)
-{
-    d->step_events[0] = '\0';
-    return cam_integrate(d, h, time, steps, err);
-}
-
 /* Another type's load on its flank at y (docs/model.md 16.3): kind.c's with the flank's P, the follower's q, q_dot
  * and acceleration in y[3], y[4] and *a. */
 static void kind_flank_load(const CamModel *m, const double y[NY], double u, int contact, double *a, CamLoad *load)
@@ -573,6 +545,8 @@ void cam_vf_outputs(CamDrive *d, double out[])
     double y[NY], dd[4], omega_dot, P, i, a;
     CamLoad load;
     cam_vf_y(m, &d->mode, d->x, y);
+    if (m->prescribed)   /* the speed drive: the left limit's direction (a stop at the step's end still moves there) */
+        y[Y_DIR] = cam_motion_sign(d->x[CAM_OMEGA], d->omega_ref, d->omega_dot_ref, fabs(d->time));
     cam_kind_eval(m, y[0], dd);
     i = current(m, y, d->form_u);
     load.alpha = atan(dd[1] / (m->r_b + dd[0]));
@@ -634,17 +608,6 @@ void cam_vf_outputs(CamDrive *d, double out[])
         out[CAM_O_M_SHAFT] = shaft_torque(m, y);
     }
 }
-
-static void vf_advice(const CamDrive *d, char *buf, size_t len)
-{
-    snprintf(buf, len, d->model.solver == CAM_CHOICE_SOLVER_RK45 ? "tighten rtol and atol, or lower h_max"
-             : "lower h_max, or use solver 'rk45'");
-}
-
-const CamFormulation cam_voltage_follower = {
-    "consistent", 1, vf_init, vf_set_inputs, vf_advance, cam_vf_outputs, vf_advice, &cam_vf_exchange, cam_vf_apply,
-    cam_vf_step_limit,
-};
 
 /* N m: the load torque with the follower on the flank `contact` at y (M_f d + P q' and another type's friction). */
 double cam_vf_flank_torque(const CamModel *m, const double y[NY], double u, int contact)
