@@ -102,7 +102,8 @@ typedef struct {
     const CamMethod *method;
     CamStepWork work;
     double x_end[CAM_NX];       /* the accepted step's end state */
-    double f_end[CAM_NX];       /* f there (valid when the step was a full FSAL step) */
+    double f_end[CAM_NX];       /* f there (valid when the step was a full FSAL step, or located in) */
+    int f_end_valid;            /* f_end holds f at x_end */
     double x_hit[CAM_NX];       /* locate: the state just past the zero */
     double before[CAM_MAX_EVENTS], after[CAM_MAX_EVENTS];
     int codes[CAM_MAX_EVENTS];

@@ -1,5 +1,5 @@
 /* The formulations of the drive, by the model's id (physics/formulations: FORMULATIONS) and its follower: each is
- * const data in its own file (consistent.c, paper.c, speed.c; voltage_follower.c, the consistent formulation with a
+ * const data in its own file (consistent.c, paper.c, speed.c; cam_voltage_follower, the consistent formulation with a
  * follower of its own). */
 #include <stddef.h>
 

@@ -153,7 +153,6 @@ typedef struct {                /* the values' arguments but the code and the ti
     const int *codes;           /* the functions located */
     double target;              /* rad: the breakpoint of code -1 */
     double dt;                  /* s: the step's length */
-    double f_end[CAM_NX];       /* f at the step's end (the interpolant's last rate) */
     double x[CAM_MAX_EVENTS][CAM_NX];   /* each function's latest trial state on its event side (<= 0) */
 } Trial;
 
@@ -207,7 +206,7 @@ static double trial_value(Trial *t, int k, double tau)
  * every method's (no stage computed; docs/model.md 10). */
 static double dense_value(Trial *t, int k, double tau)
 {
-    const double *x0 = t->d->x, *f0 = t->d->solver.k1, *x1 = t->it->x_end, *f1 = t->f_end;
+    const double *x0 = t->d->x, *f0 = t->d->solver.k1, *x1 = t->it->x_end, *f1 = t->it->f_end;
     double s = tau / t->dt, r = 1.0 - s, x[CAM_NX];
     int slot;
     memcpy(x, x1, sizeof x);
@@ -269,8 +268,8 @@ static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], cons
         open[k] = before[k] > 0.0 && after[k] <= 0.0;
         if (!open[k])
             continue;
-        if (first < 0 && !exact)
-            cam_rhs(&d->model, &d->mode, it->x_end, d->form_u, t.f_end);
+        if (first < 0 && !exact && !it->f_end_valid)
+            cam_rhs(&d->model, &d->mode, it->x_end, d->form_u, it->f_end);
         g = exact ? dt : illinois(dense_value, &t, k, 0.0, dt, before[k], after[k], tol, &slope);
         if (first < 0 || g < *tau) {
             first = k;
@@ -356,16 +355,16 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
     const CamModel *m = &d->model;
     double t = 0.0, u = d->form_u, remaining, dt, target, cut, tau;
     long steps = 0, retries;
-    int was_stuck = d->mode.stuck, next_valid, status, at_break;
-    CamMode before = d->mode;
+    int was_stuck = d->mode.stuck, status, at_break;
+    CamMode before;
     it->have_before = 0;
-    if (d->form->transition != NULL)   /* the formulation settles its own modes */
-        d->form->transition(d, EV_NONE, time);
-    else
-        cam_settle(m, &d->mode, d->x, u, 0);
-    if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck)
-        || (d->form->transition != NULL && !same_mode(&before, &d->mode)))
+    if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck)) {   /* else settled where the last step ended */
+        if (d->form->transition != NULL)   /* the formulation settles its own modes */
+            d->form->transition(d, EV_NONE, time);
+        else
+            cam_settle(m, &d->mode, d->x, u, 0);
         d->solver.k1_valid = 0;
+    }
     it->n_events = cam_event_codes(m, &d->mode, it->codes);
     while (h - t > 1e-12 * h) {
         if (d->mode.stuck && !m->has_current && m->slots == CAM_NX_RIGID)
@@ -380,7 +379,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
             double limit = d->form->step_limit(d, time + t);
             remaining = limit < remaining ? limit : remaining;
         }
-        next_valid = 0;   /* does it->f_end hold f at the step's end? */
+        it->f_end_valid = 0;
         at_break = 0;
         it->exponential = 0;
         if (d->mode.stuck && m->slots == CAM_NX_RIGID) {   /* only the current moves, exactly (shaft, train: solver) */
@@ -391,12 +390,12 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         } else {
             if (it->method->adaptive) {
                 status = cam_step_adaptive(d, it, remaining, time + t, h, &dt, err);
-                next_valid = !it->exponential;   /* the pair computes no f at its end */
+                it->f_end_valid = !it->exponential;   /* the pair computes no f at its end */
             } else {
                 ensure_k1(d, u);
                 status = cam_step_fixed(d, it, remaining, &dt, &retries, err);
                 steps += retries;
-                next_valid = it->method->tableau != NULL && it->method->tableau->fsal;
+                it->f_end_valid = it->method->tableau != NULL && it->method->tableau->fsal;
             }
             if (status != CAM_OK) {
                 *steps_out = steps;
@@ -412,7 +411,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
                 if (cut != dt) {   /* its first-same-as-last derivative belonged to the longer step */
                     dt = cut;
                     memcpy(it->x_end, it->x_hit, sizeof it->x_end);
-                    next_valid = 0;
+                    it->f_end_valid = 0;
                 }
                 at_break = d->form->transition != NULL;   /* the formulation's modes settle past it */
             }
@@ -421,8 +420,8 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
         if (tau < 0.0) {
             memcpy(d->x, it->x_end, sizeof d->x);
             t += dt;
-            d->solver.k1_valid = next_valid;
-            if (next_valid)
+            d->solver.k1_valid = it->f_end_valid;
+            if (it->f_end_valid)
                 memcpy(d->solver.k1, it->f_end, sizeof d->solver.k1);
             if (at_break) {   /* a jump of s'' may let the follower go at once */
                 before = d->mode;
@@ -470,7 +469,7 @@ int cam_integrate(CamDrive *d, double h, double time, long *steps, CamError *err
     int status;
     /* what the loop reads before writing: the flags, and the slots a rigid drive's steps leave alone (they are
      * copied into d->x whole); zeroing the whole integrator cost a rigid run 0.6 % of its instructions */
-    it.n_events = it.have_before = it.hit = it.exponential = 0;
+    it.n_events = it.have_before = it.hit = it.exponential = it.f_end_valid = 0;
     memset(it.x_end, 0, sizeof it.x_end);
     memset(it.x_hit, 0, sizeof it.x_hit);
     memset(it.work.x_new, 0, sizeof it.work.x_new);

@@ -28,6 +28,7 @@ static void speed_step(CamDrive *d, double time)
     cam_vf_y(m, &d->mode, d->x, y);   /* the follower's own s, v at the old speed */
     if (omega == y[1])
         return;
+    d->solver.k1_valid = 0;   /* f at the step's start moved with the speed */
     y[1] = omega;
     y[Y_DIR] = omega != 0.0 ? sgn(omega) : sgn(u);
     if (contact) {

@@ -466,7 +466,7 @@ double cam_vf_step_limit(const CamDrive *d, double time)
 void cam_vf_apply(CamDrive *d, int code, double time)
 {
     const CamModel *m = &d->model;
-    double y[NY], rebound = d->speed.rebound > time ? d->speed.rebound - time : 0.0;
+    double y[NY], held[NY], rebound = d->speed.rebound > time ? d->speed.rebound - time : 0.0;
     int contact = d->mode.contact, left = d->mode.left;
     long dropped = 0;
     if (code == EV_SIDE) {   /* the friction's branch turned: nothing else happens */
@@ -474,10 +474,13 @@ void cam_vf_apply(CamDrive *d, int code, double time)
         return;
     }
     cam_vf_y(m, &d->mode, d->x, y);
+    memcpy(held, y, sizeof held);
     cam_vf_event_update(d, y, d->form_u, code, &contact, &left, &rebound, time, &dropped);
     if (dropped > 0 && sizeof d->step_events > strlen(d->step_events))
         snprintf(d->step_events + strlen(d->step_events), sizeof d->step_events - strlen(d->step_events),
                  "and %ld more; ", dropped);
+    if (code == EV_NONE && contact == d->mode.contact && left == d->mode.left && !memcmp(held, y, sizeof held))
+        return;   /* settled already: x as it was, not its round trip through y (a restored state repeats its run) */
     cam_vf_x(m, y, d->form_u, contact, left, d->x, &d->mode);
     d->speed.rebound = rebound > 0.0 ? time + rebound : 0.0;
 }
