@@ -195,7 +195,7 @@ static double illinois(Value value, Trial *t, int k, double lo, double hi, doubl
 static double trial_value(Trial *t, int k, double tau)
 {
     double g;
-    trial(t->d, t->it, tau, t->d->form_u); 
+    trial(t->d, t->it, tau, t->d->form_u);
     g = zero_value(t->d, t->codes[k], t->target, t->it->work.x_new, t->d->form_u);
     if (g <= 0.0)
         memcpy(t->x[k], t->it->work.x_new, sizeof t->x[k]);
@@ -216,14 +216,13 @@ static double dense_value(Trial *t, int k, double tau)
     return zero_value(t->d, t->codes[k], t->target, x, t->d->form_u);
 }
 
-/* Function k's zero in (0, end], from g0 > 0 at the step's start to g_end <= 0 at end: seeded on the dense output,
- * then polished on trial states: two secant steps (the first on the interpolant's slope), then two trials a bracket
- * of tol [s] apart about the result, and Illinois from what they leave (each trial inside the bracket narrows it). */
-static double zero_of(Trial *t, int k, double g0, double end, double g_end, double tol)
+/* Function k's zero in (0, end], from g0 > 0 at the step's start to g_end <= 0 at end, polished from its zero `root`
+ * on the dense output [s] on trial states: two secant steps (the first on the interpolant's slope), then two trials a
+ * bracket of tol [s] apart about the result, and Illinois from what they leave (each trial inside narrows it). */
+static double zero_of(Trial *t, int k, double g0, double end, double g_end, double root, double tol)
 {
-    double slope, lo = 0.0, hi = end, g_lo = g0, g_hi = g_end, tau, g, root, last = 0.0, g_last = 0.0;
+    double slope, lo = 0.0, hi = end, g_lo = g0, g_hi = g_end, tau, g, last = 0.0, g_last = 0.0;
     int j;
-    root = illinois(dense_value, t, k, lo, hi, g_lo, g_hi, tol, &slope);
     slope = (dense_value(t, k, root + 1e-4 * t->dt) - dense_value(t, k, root - 1e-4 * t->dt)) / (2e-4 * t->dt);
     for (j = 0; j < 4; j++) {
         tau = j < 2 ? root : root + (j == 2 ? 0.45 : -0.45) * tol;
@@ -257,7 +256,8 @@ static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], cons
 {
     Trial t;
     int k, first = -1, exact = d->mode.stuck && d->model.slots == CAM_NX_RIGID, open[CAM_MAX_EVENTS];
-    double tol = 1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, end = dt, slope, g, g_end[CAM_MAX_EVENTS];
+    double tol = 1e-13 * (1e-300 > dt ? 1e-300 : dt) + 1e-15, end = dt, slope, seed[CAM_MAX_EVENTS],
+           g_end[CAM_MAX_EVENTS];
     t.d = d;
     t.it = it;
     t.codes = codes;
@@ -270,16 +270,13 @@ static int locate(CamDrive *d, CamIntegrator *it, int n, const int codes[], cons
             continue;
         if (first < 0 && !exact && !it->f_end_valid)
             cam_rhs(&d->model, &d->mode, it->x_end, d->form_u, it->f_end);
-        g = exact ? dt : illinois(dense_value, &t, k, 0.0, dt, before[k], after[k], tol, &slope);
-        if (first < 0 || g < *tau) {
-            first = k;
-            *tau = g;
-        }
+        seed[k] = exact ? dt : illinois(dense_value, &t, k, 0.0, dt, before[k], after[k], tol, &slope);
+        first = first < 0 || seed[k] < seed[first] ? k : first;
     }
     while (first >= 0) {   /* polish the first; another function at or below 0 at its zero went before it */
         memcpy(t.x[first], end < dt ? it->x_hit : it->x_end, sizeof t.x[first]);   /* the state at end */
         end = exact ? illinois(trial_value, &t, first, 0.0, end, before[first], g_end[first], tol, &slope)
-                    : zero_of(&t, first, before[first], end, g_end[first], tol);
+                    : zero_of(&t, first, before[first], end, g_end[first], seed[first], tol);
         memcpy(it->x_hit, t.x[first], sizeof it->x_hit);
         *tau = end;
         open[first] = 0;
