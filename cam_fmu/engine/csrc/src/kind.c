@@ -29,11 +29,6 @@ double cam_kind_slope(const CamModel *m, double q)
     return -m->F_gx;
 }
 
-double cam_kind_potential(const CamModel *m, double q, double s)
-{
-    return m->arm ? m->W * sin(q + m->psi_0) : -m->F_gx * s;
-}
-
 double cam_kind_lever(const CamModel *m, const double q[4])
 {
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_FLAT)   /* the face slides at r_b + s from the cam axis */
