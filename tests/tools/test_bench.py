@@ -20,7 +20,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 COLUMNS = ("case", "kind", "solver", "setting", "h_max", "rtol", "atol", "default", "comm_step", "n_steps",
-           "status", "reached_stop", "t_end", "theta_err", "omega_err", "wall_s", "us_per_step", "rtf",
+           "status", "reached_stop", "t_end", "theta_err", "omega_err", "s_err", "wall_s", "us_per_step", "rtf",
            "floor_us_per_step", "cost_ratio", "repeats", "pareto", "error")
 QUICK_FMU_ROWS = {("euler", "h=0.001"), ("rk4", "h=0.001"), ("etdrk4", "h=0.001"),
                   ("rk45", "rtol=1e-06"), ("rk45", "rtol=1e-10"), ("rk23", "rtol=1e-06")}

@@ -15,8 +15,8 @@ from typing import Callable, Sequence
 
 # name: (module, in a plain `cam-fmu bench`, what it measures)
 BENCHMARKS = {
-    "grid": ("grid", True, "theta error and cost ratio of every solver setting x comm step (fig6, backlash, "
-                           "inductance)"),
+    "grid": ("grid", True, "theta error (s error in the speed drive) and cost ratio of every solver setting x comm "
+                           "step (fig6, backlash, inductance, groove_voltage, spring_voltage, spring_jump)"),
     "scenes": ("scenes", True, "us per step of cam.fmu and the C floor on every shipped scene at the defaults"),
     "effects": ("effects", True, "us per step of fig. 6 with each effect switched"),
     "loops": ("loops", True, "tight loops: a C host, fmpy's FMU2Slave, one in-process run"),
@@ -43,6 +43,7 @@ class Context:
     tmp: Path
     quick: bool
     say: Callable[[str], None]
+    cases: tuple[str, ...] = ()   # the grid's cases (cases.CASES); empty: all of them (fig6 with quick)
     _runners: dict = field(default_factory=dict)
 
     def c_floor(self) -> Path:
@@ -61,8 +62,9 @@ class Context:
 
 
 def run(names: Sequence[str], out: Path, quick: bool = False, fmu_path: Path | None = None,
-        log: Callable[[str], None] | None = None) -> int:
-    """Run the benchmarks ``names`` (keys of BENCHMARKS, in their order) into ``out``; 0, or 1 when one says so."""
+        log: Callable[[str], None] | None = None, cases: Sequence[str] = ()) -> int:
+    """Run the benchmarks ``names`` (keys of BENCHMARKS, in their order) into ``out``, the grid on ``cases`` (empty:
+    its default); 0, or 1 when one says so."""
     from ...experiments.fmu_file import check_cam_variables
     from ...fmu.build import ensure_fmu
 
@@ -75,7 +77,7 @@ def run(names: Sequence[str], out: Path, quick: bool = False, fmu_path: Path | N
     out.mkdir(parents=True, exist_ok=True)
     status = 0
     with tempfile.TemporaryDirectory(prefix="cam_bench_") as tmp:
-        ctx = Context(fmu, out, Path(tmp), quick, say)
+        ctx = Context(fmu, out, Path(tmp), quick, say, tuple(cases))
         for name in names:
             say(f"\n# {name}: {BENCHMARKS[name][2]}")
             status |= importlib.import_module(f".{BENCHMARKS[name][0]}", __name__).run(ctx)

@@ -1,12 +1,14 @@
 """The error grid: every solver over a grid of settings and communication steps, cam.fmu through fmpy.
 
 For every solver over a grid of internal settings (fixed-step solvers: h_max; rk45: rtol with atol =
-rtol / 100) and communication steps, on the scenes paper_fig6, backlash, inductance, groove_voltage and spring_voltage (``cases.py``),
-cam.fmu runs through ``fmpy.simulate_fmu`` (one instance, reset between runs, best of a few repeats); per
-run:
+rtol / 100) and communication steps, on the scenes paper_fig6, backlash, inductance, groove_voltage,
+spring_voltage and spring_jump (the speed drive's follower lifting off; ``cases.py``), cam.fmu runs through
+``fmpy.simulate_fmu`` (one instance, reset between runs, best of a few repeats); per run:
 
 - ``theta_err`` [rad], ``omega_err`` [rad/s]: max |FMU - reference| over the communication points, the
   reference being ``reference.simulate_reference`` (scipy, rtol 1e-12; its own theta accuracy is ~1e-9 rad);
+  empty for the speed drive, whose theta and omega are its input's (imposed, exact);
+- ``s_err`` [m]: the same for the follower's position s; the speed drive's cases are ranked by it;
 - ``us_per_step``: wall time of the whole ``simulate_fmu`` call per communication step; ``rtf``: simulated
   seconds per wall second;
 - ``cost_ratio``: us_per_step over the C floor's (``c_floor.py``: the same variables, a trivial model),
@@ -32,14 +34,14 @@ def run(ctx) -> int:
     import numpy as np
 
     comm_steps = (1e-3,) if ctx.quick else COMM_STEPS
-    cases = load_cases(("fig6",) if ctx.quick else CASES)
+    cases = load_cases(ctx.cases or (("fig6",) if ctx.quick else CASES))
     repeats, floor_repeats, min_time = 3, 5, 1.0
     floor, cam = ctx.runner("c_floor"), ctx.runner("cam")
     refs = References(comm_steps)
     rows: list[dict] = []
     ctx.say(f"# cam.fmu: {ctx.fmu}; scenes: " + ", ".join(f"{c.name} ({c.source})" for c in cases))
-    ctx.say("# theta_err, omega_err: max |FMU - reference| [rad], [rad/s]; ratio: us/step over the C floor's at "
-            "the same comm step; * = default settings")
+    ctx.say("# theta_err, omega_err, s_err: max |FMU - reference| [rad], [rad/s], [m] (the speed drive: s only); "
+            "ratio: us/step over the C floor's at the same comm step; * = default settings")
     ctx.say(HEADER)
 
     def emit(row: dict) -> None:
@@ -53,7 +55,7 @@ def run(ctx) -> int:
                            n_steps=n_ref, status="ok", reached_stop=True, t_end=case.stop_time, wall_s=ref_wall,
                            us_per_step=ref_wall / n_ref * 1e6, rtf=case.stop_time / ref_wall, repeats=1,
                            default=False)  # its ratio needs the floor at its comm step: emitted with that block
-        inputs = input_array(case.u, case.stop_time)
+        inputs = input_array(case.u, case.stop_time, case.omega_ref)
         for comm in comm_steps:
             n = int(round(case.stop_time / comm))
             ref = refs.get(case, comm)
@@ -85,8 +87,10 @@ def run(ctx) -> int:
                            rtf=case.stop_time / wall, repeats=done, floor_us_per_step=pair_floor / n * 1e6,
                            cost_ratio=wall / pair_floor)
                 if reached:
-                    row["theta_err"] = float(np.max(np.abs(res["theta"] - ref["theta"])))
-                    row["omega_err"] = float(np.max(np.abs(res["omega"] - ref["omega"])))
+                    row["s_err"] = float(np.max(np.abs(res["s"] - ref["s"])))
+                    if case.omega_ref is None:
+                        row["theta_err"] = float(np.max(np.abs(res["theta"] - ref["theta"])))
+                        row["omega_err"] = float(np.max(np.abs(res["omega"] - ref["omega"])))
                 emit(row)
         if pending_ref is not None:  # the reference's grid is not one of the comm steps
             emit(pending_ref)

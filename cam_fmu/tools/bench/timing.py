@@ -86,8 +86,9 @@ def _reached(result, stop_time: float, n: int) -> bool:
             and math.isclose(float(result["time"][-1]), stop_time, rel_tol=1e-9, abs_tol=1e-12))
 
 
-def input_array(u, stop_time: float):
-    """fmpy input table for a voltage-drive signal (omega_ref, omega_dot_ref held at their start values)."""
+def input_array(u, stop_time: float, omega_ref=None):
+    """fmpy input table of the voltage u and, for the speed drive, omega_ref (signals.Signal; the inputs not given
+    held at their start values)."""
     from ...experiments.runner import signals_table
 
-    return signals_table({"u": u}, stop_time)
+    return signals_table({"u": u, "omega_ref": omega_ref}, stop_time)
