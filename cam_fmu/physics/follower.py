@@ -302,6 +302,11 @@ class FlankFollower:
         """N, the force pulling the follower at s [m] back toward the +1 flank: F_close(s) = F0 + k s - F_gx."""
         return closing_force(s, self.k, self.F0, self.F_gx)
 
+    def flank_closing(self, s: float, v: float) -> float:
+        """N, what closes the follower at s [m], moving at v [m/s], onto its +1 flank: F_close(s) (a train adds its
+        force, physics/train_follower.py)."""
+        return self.closing(s)
+
     def gaps(self, theta: float, s: float) -> tuple[float, float]:
         """(gap to the +1 flank, gap to the -1 flank) [m], both >= 0 in flight (inf: no such flank)."""
         s_cam = self.program.derivatives(theta)[0]

@@ -205,10 +205,6 @@ RULES: tuple[Rule, ...] = (
          "parameter 'k_train' = {k_train} N/m: a train on a follower in a clearance needs the follower as a body of "
          "its own (closure 'form' with its mass m > 0, docs/model.md 14.6); allowed with closure {closure} and c = "
          "{c} m: k_train = 0"),
-    Rule(AllOf(TRAIN, OWN_FOLLOWER, Is("drive", ("speed",))),
-         "parameter 'k_train' = {k_train} N/m: a follower train on the speed drive's follower of its own is not "
-         "checked against the reference yet (the voltage drive's is, docs/model.md 14.6); allowed with closure "
-         "{closure} in the speed drive: k_train = 0 (or drive 'voltage')"),
     *(Rule(AllOf(Not(OSCILLATING), Cmp(Num(name), "!=")),
            f"parameter {name!r} = {{{name}}} {unit} is not used by follower_type {{follower_type}} (only by the "
            f"oscillating types): leave it at its default 0") for name, unit in ARM_UNITS),

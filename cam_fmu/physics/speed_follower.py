@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 from .drive import sign, solve_guide_friction
-from .follower import FlankFollower, Impact, closing_force, contact_sign, impact, required_force
+from .follower import FlankFollower, Impact, contact_sign, impact, required_force
 from .variables import output_record
 
 
@@ -25,9 +25,11 @@ class SpeedFollower(FlankFollower):
         return contact * contact_sign(self.m, s, s1, s2, omega, self.k, self.F0, self.F_gx, self.f0, omega_dot)
 
     def acceleration_scale(self, theta: float, omega: float, omega_dot: float) -> float:
-        """m/s2, a bound of the follower's acceleration relative to the flank near theta (flight against cam)."""
-        s, s1, s2, _ = self.flank(theta, 1.0)
-        return (abs(self.free_acceleration(s, 1.0)) + self.f0 / self.m + abs(s2) * omega * omega
+        """m/s2, a bound of the follower's acceleration relative to the flank near theta (flight against cam), as the
+        voltage drive's (voltage_follower.acceleration_scale) with the imposed omega_dot [rad/s2]: the closing force
+        at the groove's middle over m, the guide's friction, s'' omega^2 and s' omega_dot."""
+        s, s1, s2, _ = self.flank(theta, 0.0)
+        return (abs(self.flank_closing(s, s1 * omega)) / self.m + self.f0 / self.m + abs(s2) * omega * omega
                 + abs(s1 * omega_dot) + 1e-300)
 
     def land(self, theta: float, omega: float, omega_dot: float, v: float, contact: float) -> tuple[float, float, Impact]:
@@ -77,7 +79,7 @@ class SpeedFollower(FlankFollower):
 
         def load(angle: float) -> tuple[float, float, float]:  # (M, J, force along X) with the follower on the flank
             sf, d1, d2, _ = self.flank(angle, contact)
-            push = required_force(self.m, d2, omega, d1, omega_dot) + closing_force(sf, self.k, self.F0, model.F_gx)
+            push = required_force(self.m, d2, omega, d1, omega_dot) + self.flank_closing(sf, d1 * omega)
             t_a = d1 / (model.r_b + self.program.derivatives(angle)[0])
             sigma = sign(d1 * direction)
             f = solve_guide_friction(push * t_a + model.G_y, t_a, sigma, model.mu, model.N_g, 0.0)

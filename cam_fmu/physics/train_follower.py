@@ -1,40 +1,42 @@
-"""A follower train on the follower of its own in the voltage drive (docs/model.md 14.6, 13.6).
+"""A follower train on the follower of its own, in both drives (docs/model.md 14.6, 13.6, 13).
 
-``voltage_follower.VoltageFollower`` with the train's end mass (``physics.train.Train``) as two more states after the
-drive's, y = (theta, omega, i, s, v, [phi, omega_m,] x_e, v_e). The train's force F_train = k_train (s - x_e) +
-d_train (v - v_e) acts between the follower (its own s, v) and the end mass, m_end dv_e/dt = F_train + F_ex (F_ex
-the end mass's weight along X, train.end_weight), so the follower's closing force is F_close(s) + F_train: on its
-flank (s the flank's, v = s' omega, 0 on a stuck cam) in the drive equation, the contact force P, the guide's side
-force and the break-away rule, and in flight (m s_dd = -F_close(s) - F_train - sgn(v) f0). ``math`` only, written
-independently of the C engine.
+The train's end mass (``physics.train.Train``) is two more states after the drive's: y = (theta, omega, i, s, v,
+[phi, omega_m,] x_e, v_e) in the voltage drive (``TrainVoltageFollower``), y = (theta, s, v, x_e, v_e) at imposed
+speed (``TrainSpeedFollower``). The train's force F_train = k_train (s - x_e) + d_train (v - v_e) acts between the
+follower (its own s, v) and the end mass, m_end dv_e/dt = F_train + F_ex (F_ex the end mass's weight along X,
+train.end_weight), so the follower's closing force is F_close(s) + F_train: on its flank (s the flank's, v = s' omega,
+0 on a stuck cam) in the drive equation, the contact force P, the guide's side force and the break-away rule, and in
+flight (m s_dd = -F_close(s) - F_train - sgn(v) f0). ``math`` only, written independently of the C engine.
 
-The base class's equations that take no state (``on_flank``, ``static_force``, ``free_acceleration``, ``direction``)
+The base classes' equations that take no state (``on_flank``, ``static_force``, ``free_acceleration``, ``direction``)
 read the end mass's state bound by the last call that took one (``bind``): every method given y binds it first.
 """
 from __future__ import annotations
 
+from .follower import contact_sign
+from .speed_follower import SpeedFollower
 from .train import Train, end_weight
 from .voltage_follower import VoltageFollower
 
-__all__ = ["TrainVoltageFollower"]
+__all__ = ["TrainSpeedFollower", "TrainVoltageFollower"]
 
 
-class TrainVoltageFollower(VoltageFollower):
-    """The follower of its own on a voltage-driven cam carrying the train (``model.train``, k_train > 0)."""
+class TrainCarrier:
+    """What a follower of its own carrying the train adds to its drive's follower, whichever the drive: the bound end
+    mass and the train's force in the closing force. ``V``: the follower's v in y; ``X_E``: x_e's, v_e after it."""
 
-    def __init__(self, model, train: Train | None = None) -> None:
-        super().__init__(model)
+    V = 4
+
+    def _carry(self, model, train: Train | None) -> None:
         self.train = model.train if train is None else train
         self.F_ex = end_weight(self.train, model.params)   # N, the end mass's weight along X
-        self.X_E = self.size          # index of x_e in y, v_e after it
-        self.size += 2
         self._end = (0.0, 0.0)        # (x_e [m], v_e [m/s]) bound by ``bind``
         self._v = 0.0                 # m/s, the flying follower's velocity bound with it
 
     def bind(self, y) -> None:
         """Take the end mass's state (and the follower's v) from y for the equations that take no state."""
         self._end = (y[self.X_E], y[self.X_E + 1])
-        self._v = y[4]
+        self._v = y[self.V]
 
     def pull(self, s: float, v: float) -> float:
         """N, F_train with the follower at s [m] moving at v [m/s] and the bound end mass."""
@@ -44,6 +46,15 @@ class TrainVoltageFollower(VoltageFollower):
         """(x_e [m], v_e [m/s]): the end mass at rest relative to the follower at s [m], v [m/s], its weight on the
         train's spring."""
         return s + self.F_ex / self.train.k_train, v
+
+    def end_rates(self, F: float, y) -> list[float]:
+        """(x_e', v_e') under the train's force F [N] and the end mass's weight."""
+        return [y[self.X_E + 1], (F + self.F_ex) / self.train.m_end]
+
+    def end_outputs(self, y, F: float) -> dict[str, float]:
+        """The train's outputs s_end, v_end [m, m/s], a_end [m/s2] and F_train [N] at y under the force F [N]."""
+        return dict(s_end=float(y[self.X_E]), v_end=float(y[self.X_E + 1]), a_end=(F + self.F_ex) / self.train.m_end,
+                    F_train=F)
 
     # ------------------------------------------------------------- the closing force with the train's
     def flank_closing(self, s: float, v: float) -> float:
@@ -67,6 +78,47 @@ class TrainVoltageFollower(VoltageFollower):
             return 1.0 if v > 0.0 else -1.0
         net = self.net_at_rest(s)
         return (1.0 if net > 0.0 else -1.0) if abs(net) > self.f0 else 0.0
+
+
+class TrainSpeedFollower(TrainCarrier, SpeedFollower):
+    """The follower of its own on a cam at imposed speed carrying the train: y = (theta, s, v, x_e, v_e)."""
+
+    V, X_E = 2, 3
+
+    def __init__(self, model, train: Train | None = None) -> None:
+        super().__init__(model)
+        self._carry(model, train)
+
+    def held(self, theta: float, omega: float, omega_dot: float, contact: float) -> float:
+        """N, > 0 while the flank ``contact`` holds the follower, the bound end mass's pull in its closing force."""
+        s, s1, s2, _ = self.flank(theta, contact)
+        return contact * contact_sign(self.m, s, s1, s2, omega, self.k, self.F0 + self.pull(s, s1 * omega), self.F_gx,
+                                      self.f0, omega_dot)
+
+    def train_force(self, y, omega: float, contact: float) -> float:
+        """N, F_train at y with the follower on the flank ``contact`` (its s, s' omega; 0: in flight, its own)."""
+        self.bind(y)
+        if contact:
+            s, s1, _, _ = self.flank(y[0], contact)
+            return self.pull(s, s1 * omega)
+        return self.pull(y[1], y[2])
+
+    def outputs_at(self, y, omega: float, omega_dot: float, contact: float, direction: float | None = None) -> dict:
+        """Every output at y with the train's (``SpeedFollower.outputs`` with the end mass bound)."""
+        self.bind(y)
+        record = self.outputs(float(y[0]), omega, omega_dot, float(y[1]), float(y[2]), contact, direction)
+        record.update(self.end_outputs(y, self.train_force(y, omega, contact)))
+        return record
+
+
+class TrainVoltageFollower(TrainCarrier, VoltageFollower):
+    """The follower of its own on a voltage-driven cam carrying the train (``model.train``, k_train > 0)."""
+
+    def __init__(self, model, train: Train | None = None) -> None:
+        super().__init__(model)
+        self._carry(model, train)
+        self.X_E = self.size          # index of x_e in y, v_e after it
+        self.size += 2
 
     # ------------------------------------------------------------- the follower's motion and the end mass's rates
     def motion(self, y, contact: float) -> tuple[float, float]:
@@ -95,8 +147,7 @@ class TrainVoltageFollower(VoltageFollower):
     def rates(self, y, u: float, contact: float, sigma: float = 0.0) -> list[float]:
         self.bind(y)
         dy = super().rates(y, u, contact, sigma)
-        F = self.train_force(y, contact)
-        return dy + [y[self.X_E + 1], (F + self.F_ex) / self.train.m_end]
+        return dy + self.end_rates(self.train_force(y, contact), y)
 
     def friction_power(self, y, u: float, contact: float, sigma: float) -> float:
         self.bind(y)
@@ -130,7 +181,5 @@ class TrainVoltageFollower(VoltageFollower):
         """The follower's outputs with the train's s_end, v_end [m, m/s], a_end [m/s2] and F_train [N]."""
         self.bind(y)
         record = super().outputs(y, u, contact)
-        F = self.train_force(y, contact)
-        record.update(s_end=float(y[self.X_E]), v_end=float(y[self.X_E + 1]),
-                      a_end=(F + self.F_ex) / self.train.m_end, F_train=F)
+        record.update(self.end_outputs(y, self.train_force(y, contact)))
         return record

@@ -106,11 +106,6 @@ class VoltageFollower(FlankFollower):
         f = self.mu * (abs(P * tan_a + self.G_y) + self.N_g)
         return omega_dot, P, f
 
-    def flank_closing(self, s: float, v: float) -> float:
-        """N, what closes the follower at s [m], moving at v [m/s], onto its +1 flank: F_close(s) (a train adds its
-        force, physics/train_follower.py)."""
-        return self.closing(s)
-
     def static_force(self, theta: float, contact: float) -> float:
         """N, the force P along X of the flank ``contact`` on the follower at rest on it, the cam held: it balances
         the spring and gravity, F_close(s) (the guide's friction carries nothing at rest)."""

@@ -53,6 +53,10 @@ class FollowerRun(HybridRun):
     def _speed(self, t: float) -> tuple[float, float]:
         return self.omega_ref.value(t), self.omega_ref.slope(t)
 
+    def _start(self, y: list, omega: float) -> list:
+        """The starting state y = (theta, s, v) with the states a subclass carries after them (none here)."""
+        return y
+
     def run(self, grid: np.ndarray, theta0: float) -> dict[str, np.ndarray]:
         """Rows on ``grid`` [s] from theta0 [rad]: on the +1 flank if it holds the follower, else on -1 (groove),
         else flying from the +1 flank."""
@@ -61,7 +65,7 @@ class FollowerRun(HybridRun):
         flanks = (1.0, -1.0) if body.two_sided else (1.0,)
         contact = next((side for side in flanks if body.held(theta0, omega, omega_dot, side) >= 0.0), 0.0)
         s, s1, _, _ = body.flank(theta0, contact or 1.0)
-        y = [theta0, s, s1 * omega]
+        y = self._start([theta0, s, s1 * omega], omega)
         mode = Mode(Follower.flank(contact) if contact else flying(body, y))
         return self.pieces(grid, t, y, mode, sorted(b for b in self.omega_ref.breaks if t < b < float(grid[-1])))
 
@@ -88,11 +92,11 @@ class FollowerRun(HybridRun):
     # ------------------------------------------------------------- the transitions (docs/model.md 13.7)
     def _lift_off(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
         s, s1, _, _ = self.body.flank(y[0], mode.contact)
-        y = [y[0], s, s1 * self._speed(t)[0]]
+        y = [y[0], s, s1 * self._speed(t)[0], *y[3:]]
         return Mode(flying(self.body, y), mode.shaft, mode.direction), y
 
     def _halt(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
-        y = [y[0], y[1], 0.0]
+        y = [y[0], y[1], 0.0, *y[3:]]
         return Mode(flying(self.body, y), mode.shaft, mode.direction), y
 
     def _touch(self, t: float, y: list, mode: Mode, kind: Event) -> tuple[Mode, list]:
@@ -107,7 +111,7 @@ class FollowerRun(HybridRun):
         after, v, _ = landed
         s, s1, _, _ = body.flank(y[0], flank)
         self._impact(t, y[2] - s1 * omega, v - s1 * omega, after == 0.0, body.acceleration_scale(y[0], omega, omega_dot))
-        y = [y[0], s, v]
+        y = [y[0], s, v, *y[3:]]
         return Mode(Follower.flank(after) if after else flying(body, y), mode.shaft, mode.direction), y
 
     def _settle(self, t: float, y: list, mode: Mode, after_event: bool) -> tuple[Mode, list]:
@@ -127,12 +131,12 @@ class FollowerRun(HybridRun):
         if hit is not None:
             return self._struck(t, y, mode, contact, (after, v, hit))
         if after == 0.0:   # the flank moves away faster than the follower: it flies on with its speed
-            y = [y[0], self.body.flank(y[0], contact)[0], v]
+            y = [y[0], self.body.flank(y[0], contact)[0], v, *y[3:]]
             return Mode(flying(self.body, y), mode.shaft, mode.direction), y
         if self.body.held(y[0], omega, omega_dot, contact) < 0.0:
             return self._lift_off(t, y, mode, Event.LIFT_OFF)
         s, s1, _, _ = self.body.flank(y[0], contact)
-        return mode, [y[0], s, s1 * omega]
+        return mode, [y[0], s, s1 * omega, *y[3:]]
 
     TRANSITIONS = {Event.LIFT_OFF: _lift_off, Event.HALT: _halt, Event.TOUCH_LOWER: _touch, Event.TOUCH_UPPER: _touch,
                    Event.SPEED_STEP: _speed_step}

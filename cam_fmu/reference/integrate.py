@@ -36,7 +36,7 @@ from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
 from .follower_kind import kind_reference
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
-from .train_flight import train_follower_reference
+from .train_flight import train_follower_reference, train_speed_follower_reference
 from .train_speed import speed_train_reference
 from .train_voltage import voltage_train_reference
 from .voltage_flight import follower_voltage_reference
@@ -278,6 +278,8 @@ def _speed_rows(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> list[
 
 def _speed_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
                  options: dict) -> dict[str, np.ndarray]:
+    if model.free_follower:  # the train on the follower's own state (docs/model.md 14.6)
+        return train_speed_follower_reference(model, grid, omega_ref, options, train)
     return speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
 
 

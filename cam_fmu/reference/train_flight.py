@@ -1,4 +1,4 @@
-"""The reference of a follower train on the follower of its own in the voltage drive (docs/model.md 14.6).
+"""The reference of a follower train on the follower of its own (docs/model.md 14.6), in both drives.
 
 ``voltage_flight.VoltageFollowerRun`` with ``physics.train_follower.TrainVoltageFollower``: y = (theta, omega, i, s,
 v, [phi, omega_m,] x_e, v_e) and the energy integrals (hybrid.ENERGY; E_damp adds the train damper's d_train (v -
@@ -9,6 +9,11 @@ In flight a step turns at most TRAIN_PHASE of the follower's ringing on the trai
 stiffness. The end mass starts at rest on the train's spring where its weight holds it, relative to the follower on
 its starting flank (x_e = s - contact c + F_ex / k_train, v_e = s' omega0), moved by ``end_offset`` [m] (a test's
 let-go). Rows add s_end, v_end, a_end and F_train.
+
+At imposed speed (``TrainSpeedFollowerRun``) the same with ``flight.FollowerRun``: y = (theta, s, v, x_e, v_e), the
+end mass's rates beside the follower's on the flank and in flight, its pull in the lift-off's and the flight's forces
+(``physics.train_follower.TrainSpeedFollower``), the same TRAIN_PHASE bound in flight. An impact leaves the end mass
+as it is (the train's spring is finite).
 """
 from __future__ import annotations
 
@@ -20,11 +25,12 @@ from ..physics.formulations.consistent import SIDE_HYSTERESIS
 from ..physics.modes import Event, Follower, Mode, Shaft
 from ..physics.signals import Signal
 from ..physics.train import Train
-from ..physics.train_follower import TrainVoltageFollower
+from ..physics.train_follower import TrainSpeedFollower, TrainVoltageFollower
+from .flight import FollowerRun
 from .hybrid import event, piece_input
 from .voltage_flight import VoltageFollowerRun
 
-__all__ = ["TrainFollowerRun", "train_follower_reference"]
+__all__ = ["TrainFollowerRun", "TrainSpeedFollowerRun", "train_follower_reference", "train_speed_follower_reference"]
 
 # rad: the flying follower's phase on sqrt((k_spring + k_train) / m) in one step at most (the engine's bound): a
 # gap's crossing and return within one step would go unseen.
@@ -70,8 +76,7 @@ class TrainFollowerRun(VoltageFollowerRun):
         if contact and mode.shaft is Shaft.STUCK:  # the train alone changes the flank's force on a stuck cam
             events.append(event(Event.LIFT_OFF, lambda t, y: body.contact_force(y[:n], u_at(t)[0], contact)))
         if not contact:
-            rate = math.sqrt((max(body.k, 0.0) + body.train.k_train) / body.m)
-            options["max_step"] = min(options.get("max_step", math.inf), TRAIN_PHASE / rate)
+            flight_bound(body, options)
             body.bind(y)
             if mode.follower is Follower.HALTED and body.f0 > 0.0:  # held by the guide until the train's pull beats it
 
@@ -109,3 +114,71 @@ def train_follower_reference(model, grid: np.ndarray, u: Signal, options: dict, 
     run = TrainFollowerRun(model, u, options["rtol"], options["atol"], options["energy"], options["method"], train,
                            end_offset)
     return run.run(grid)
+
+
+def flight_bound(body, options: dict) -> None:
+    """Bound a flying step to TRAIN_PHASE of the follower's ringing on the return spring and the train."""
+    rate = math.sqrt((max(body.k, 0.0) + body.train.k_train) / body.m)
+    options["max_step"] = min(options.get("max_step", math.inf), TRAIN_PHASE / rate)
+
+
+class TrainSpeedFollowerRun(FollowerRun):
+    """One run of the speed drive with a follower of its own carrying the train: y = (theta, s, v, x_e, v_e)."""
+
+    label = "train speed follower reference"
+    BODY = TrainSpeedFollower
+
+    def run(self, grid: np.ndarray, theta0: float) -> dict[str, np.ndarray]:
+        """Rows on ``grid`` [s]; the end mass starts at rest on the train relative to the +1 flank's follower (the
+        one that decides which flank holds it)."""
+        body, (omega, _) = self.body, self._speed(float(grid[0]))
+        s, s1, _, _ = body.flank(theta0, 1.0)
+        body.bind([theta0, s, s1 * omega, *body.rest(s, s1 * omega)])
+        return super().run(grid, theta0)
+
+    def _start(self, y: list, omega: float) -> list:
+        """y with the end mass at rest relative to the follower at its start (the train's weight on its spring)."""
+        return [*y, *self.body.rest(y[1], y[2])]
+
+    def _piece(self, t: float, y: list, mode: Mode) -> tuple[list, object, dict]:
+        body, speed, contact = self.body, piece_input(self.omega_ref, self.piece_end), mode.contact
+        body.bind(y)
+        events, rhs, options = super()._piece(t, y, mode)
+        bound = []
+        for fn in events:   # each event function sees the end mass of the state it is given
+            bound.append(event(fn.kind, lambda t, y, fn=fn: (body.bind(y), fn(t, y))[1]))
+
+        def with_end(t, y):
+            body.bind(y)
+            return rhs(t, y) + body.end_rates(body.train_force(y, speed(t)[0], contact), y)
+        if not contact:
+            flight_bound(body, options)
+            if mode.follower is Follower.HALTED and body.f0 > 0.0:  # held by the guide until the train's pull beats it
+                bound.append(event(Event.HALT, lambda t, y: (body.bind(y), body.f0 + SIDE_HYSTERESIS
+                                                             - abs(body.net_at_rest(y[1])))[1]))
+        return bound, with_end, options
+
+    def _settle(self, t: float, y: list, mode: Mode, after_event: bool) -> tuple[Mode, list]:
+        self.body.bind(y)
+        return super()._settle(t, y, mode, after_event)
+
+    # each transition decides (held, land) with the end mass of the state it is given
+    TRANSITIONS = {kind: (lambda fn: lambda self, t, y, mode, kind: (self.body.bind(y), fn(self, t, y, mode, kind))[1])(fn)
+                   for kind, fn in FollowerRun.TRANSITIONS.items()}
+
+    def _row(self, t: float, y, mode: Mode, left: bool) -> dict[str, float]:
+        self.body.bind(y)
+        row = super()._row(t, y, mode, left)
+        omega = self.omega_ref.left_value(t) if t > 0.0 else self.omega_ref.value(t)
+        row.update(self.body.end_outputs(y, self.body.train_force(y, omega, mode.contact)))
+        return row
+
+
+def train_speed_follower_reference(model, grid: np.ndarray, omega_ref: Signal, options: dict,
+                                   train: Train | None = None) -> dict[str, np.ndarray]:
+    """The speed drive with a follower of its own (closures 'spring', 'form' with c > 0) carrying ``train`` (None:
+    the parameters'), on the output grid [s]."""
+    run = TrainSpeedFollowerRun(model, omega_ref, options["rtol"], options["atol"])
+    if train is not None:
+        run.body = TrainSpeedFollower(model, train)
+    return run.run(grid, model.params["theta0"])

@@ -134,11 +134,3 @@ def test_a_follower_held_by_the_guide_in_flight_is_released_where_the_trains_pul
     assert lifted and abs(lifted[0] - lift_off) < 1e-12
     assert released and abs(released[0] - release) < 1e-12, (released, release)
     assert sim.outputs()["v"] > 0.0 and sim.outputs()["N_contact"] == 0.0   # off the flank, flying
-
-
-def test_the_speed_drive_refuses_a_train_on_a_follower_of_its_own_by_name():
-    """Not yet checked against the reference there (its speed drive has no train on a follower of its own)."""
-    from cam_fmu.physics.parameters import ParameterError
-
-    with pytest.raises(ParameterError, match="'k_train' = 20000.0 N/m: a follower train on the speed drive"):
-        DriveSimulator(dict(defaults(), **{**SCENE, "drive": "speed"}, **CLOSURES["spring"]))

@@ -110,3 +110,24 @@ def test_cam_fmu_model_exchange_runs_a_train_on_a_follower_of_its_own_as_co_simu
     assert np.max(np.abs(me["theta"][rows] - cs["theta"])) < 1e-6 * np.max(np.abs(cs["theta"]))
     assert np.max(np.abs(me["F_train"][rows] - cs["F_train"])) < 1e-4 * np.ptp(cs["F_train"])
     assert np.any(cs["N_contact"] == 0.0) and np.ptp(cs["F_train"]) > 1.0
+
+
+def test_cam_fmu_runs_a_train_on_the_speed_drives_follower_of_its_own_as_the_reference_does(engine_fmu_path):
+    """The speed drive (spring_jump's cam above its jump speed, 60 rad/s) with a train on its follower of its own, in
+    co-simulation (the speed drive's only interface: Model Exchange refuses it, docs/model.md 13) against the scipy
+    reference (reference/train_flight.py's TrainSpeedFollowerRun): s and s_end within 1e-6 of the lift, and the
+    follower flies."""
+    from cam_fmu.experiments.scenes import find_scene
+
+    scene = find_scene("spring_jump")
+    params = dict(next(r for r in scene.runs if r.label == "above_1.02").overrides, k_train=2e4, d_train=2.0,
+                  m_end=0.1)
+    reference = simulate_reference(dict(defaults(), **params), scene.stop_time, 1e-3, omega_ref=scene.omega_ref)
+    assert np.any(reference["N_contact"] == 0.0)
+    result = fmpy.simulate_fmu(str(engine_fmu_path), start_values=dict(params, omega_ref=60.0),
+                               stop_time=scene.stop_time, output_interval=1e-3, output=["s", "s_end", "N_contact"])
+    assert np.array_equal(result["time"], reference["time"])
+    for name in ("s", "s_end"):
+        error = np.max(np.abs(result[name] - reference[name]))
+        assert error < 1e-6 * defaults()["lift"], (name, error)
+    assert np.array_equal(result["N_contact"] == 0.0, reference["N_contact"] == 0.0)

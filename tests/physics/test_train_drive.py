@@ -142,11 +142,10 @@ def test_bad_train_is_refused_by_name(fields, word):
         Train(**fields)
 
 
-# (the voltage drive's follower of its own, a clearance included, carries the train: test_train_own_follower.py)
+# (both drives' followers of their own, a clearance included, carry the train: test_train_own_follower.py,
+# tests/engine/test_engine_train_speed_follower.py)
 @pytest.mark.parametrize("scene, word", [(dict(SCENE, drive="voltage", closure="kinematic", c=1e-4), "'c'"),
-                                         (dict(SCENE, drive="voltage", formulation="paper"), "formulation"),
-                                         (dict(SCENE, closure="spring"), "closure"),
-                                         (dict(SCENE, backlash=True, c=1e-4), "'c'")])
+                                         (dict(SCENE, drive="voltage", formulation="paper"), "formulation")])
 def test_train_where_the_reference_cannot_run_it_is_refused(scene, word):
     with pytest.raises(ParameterError, match=word):
         simulate_reference(scene, T_R, T_R / 10, omega_ref=constant(OMEGA), train=Train(k_train=1e6, m_end=1.0))
