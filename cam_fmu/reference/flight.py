@@ -53,6 +53,10 @@ class FollowerRun(HybridRun):
     def _speed(self, t: float) -> tuple[float, float]:
         return self.omega_ref.value(t), self.omega_ref.slope(t)
 
+    def _holds(self, theta: float, omega: float, omega_dot: float, side: float) -> float:
+        """N, > 0 where the flank ``side`` holds the follower at the start (SpeedFollower.held)."""
+        return self.body.held(theta, omega, omega_dot, side)
+
     def _start(self, y: list, omega: float) -> list:
         """The starting state y = (theta, s, v) with the states a subclass carries after them (none here)."""
         return y
@@ -63,7 +67,7 @@ class FollowerRun(HybridRun):
         body, t = self.body, float(grid[0])
         omega, omega_dot = self._speed(t)
         flanks = (1.0, -1.0) if body.two_sided else (1.0,)
-        contact = next((side for side in flanks if body.held(theta0, omega, omega_dot, side) >= 0.0), 0.0)
+        contact = next((side for side in flanks if self._holds(theta0, omega, omega_dot, side) >= 0.0), 0.0)
         s, s1, _, _ = body.flank(theta0, contact or 1.0)
         y = self._start([theta0, s, s1 * omega], omega)
         mode = Mode(Follower.flank(contact) if contact else flying(body, y))

@@ -128,13 +128,11 @@ class TrainSpeedFollowerRun(FollowerRun):
     label = "train speed follower reference"
     BODY = TrainSpeedFollower
 
-    def run(self, grid: np.ndarray, theta0: float) -> dict[str, np.ndarray]:
-        """Rows on ``grid`` [s]; the end mass starts at rest on the train relative to the +1 flank's follower (the
-        one that decides which flank holds it)."""
-        body, (omega, _) = self.body, self._speed(float(grid[0]))
-        s, s1, _, _ = body.flank(theta0, 1.0)
-        body.bind([theta0, s, s1 * omega, *body.rest(s, s1 * omega)])
-        return super().run(grid, theta0)
+    def _holds(self, theta: float, omega: float, omega_dot: float, side: float) -> float:
+        """N, > 0 where the flank ``side`` holds the follower at the start, the end mass at rest relative to it."""
+        s, s1, _, _ = self.body.flank(theta, side)
+        self.body.bind([theta, s, s1 * omega, *self.body.rest(s, s1 * omega)])
+        return self.body.held(theta, omega, omega_dot, side)
 
     def _start(self, y: list, omega: float) -> list:
         """y with the end mass at rest relative to the follower at its start (the train's weight on its spring)."""

@@ -70,3 +70,23 @@ def test_the_train_alone_pulls_the_follower_off():
     assert np.any(ref["contact"] == 0.0)
     assert np.array_equal(got["N_contact"] == 0.0, ref["N_contact"] == 0.0)
     assert np.max(np.abs(got["s"] - ref["s"])) < 1e-9
+
+
+def test_a_tilted_groove_with_friction_starts_on_the_flank_the_weights_press_and_is_the_reference():
+    """Gravity along +X (tilted, gamma 1.2, beta 0.3) presses the follower and, through the train, the end mass's
+    weight onto the groove's -1 flank at the start; guide friction, a ramp of omega_ref, restitution 0.3. The
+    reference first decided the start with the end mass at rest relative to the +1 flank and flew from there; the
+    engine, which rests it relative to each candidate, was right. Measured: s within 1.7e-12 m, F_train 6.3e-8 N, 44
+    impacts. (With restitution 1 and no damper the groove is chaotic: the reference at rtol 1e-10 leaves itself at
+    1e-12 by 4e-4 m within 0.4 s, so no engine can follow it there.)"""
+    from cam_fmu.physics.signals import Signal
+
+    params = dict(drive="speed", rise_law="cycloidal", return_law="cycloidal", lift=0.02, r_b=0.08, m=0.4, G=4.0,
+                  gravity=True, gamma=1.2, beta=0.3, mu=0.05, closure="form", c=5e-4, restitution=0.3, **TRAIN)
+    ramp = Signal([0.0, 0.3, 0.6], [5.0, 60.0, 0.0])
+    ref = simulate_reference(params, 0.6, 1e-3, omega_ref=ramp)
+    got = simulate_engine(params, 0.6, 1e-3, omega_ref=ramp)
+    assert ref["N_contact"][0] < 0.0 and ref["s"][0] == got["s"][0] == 5e-4   # on the -1 flank, s_cam + c
+    assert ref["impacts"][-1] > 10
+    assert np.max(np.abs(got["s"] - ref["s"])) < 1e-10 and np.max(np.abs(got["F_train"] - ref["F_train"])) < 1e-5
+    assert np.array_equal(got["N_contact"] == 0.0, ref["N_contact"] == 0.0)
