@@ -76,9 +76,13 @@ def test_win64_binary_agrees_with_linux64(hosts, fmu_dir, scene):
                 outputs, "free"]
     linux, windows = (_values(_run(hosts, fmu_dir, p, *commands)) for p in ("linux64", "win64"))
     assert len(linux) == len(windows) == 2
+    # The two binaries are one source built by one compiler for two targets; their libms' sin, cos, exp, pow and atan
+    # differ in the last bits (checked: a checksum of the low bytes over 2e5 arguments differs for each), and a follower of its own's impacts (spring, rocker and, since its closure form, backlash) carry
+    # that further through the located events. Measured 2026-11-28: bit for bit at 0.5 s in every scene; at 2 s up
+    # to 7.5e-13 (fig6), 1.3e-12 (backlash), 1.4e-12 (spring), 9.4e-11 (rocker) relative.
     for row_l, row_w in zip(linux, windows):
         for a, b in zip(row_l, row_w):
-            assert b == pytest.approx(a, rel=1e-10 if scene in ("spring", "rocker") else 1e-12, abs=1e-15)
+            assert b == pytest.approx(a, rel=1e-10 if scene in ("spring", "rocker", "backlash") else 1e-12, abs=1e-15)
     assert linux[-1][1] > 5.0  # theta(2 s) [rad]: the cam turned
 
 

@@ -12,9 +12,18 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_installed_package_simulates_a_shipped_scene_on_the_fmu(tmp_path):
+    """The build needs setuptools, wheel (setuptools < 70.1) and numpy without build isolation: they come from the
+    test's own locked environment, put after the new environment's site-packages by a .pth line (its .pth files, the
+    editable install's among them, are not read from there), not from whatever the system Python holds (a machine
+    whose system Python had no wheel failed here, 2026-11-28)."""
+    import sysconfig
+
     env_dir = tmp_path / "venv"
     venv.EnvBuilder(system_site_packages=True, with_pip=False).create(env_dir)
     python = env_dir / "bin" / "python"
+    purelib = subprocess.run([str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                             capture_output=True, text=True, check=True).stdout.strip()
+    (Path(purelib) / "locked_test_env.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
     proc = subprocess.run([str(python), "-m", "pip", "install", "--no-deps", "--no-build-isolation", "-q",
