@@ -146,6 +146,8 @@ TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
 # The follower's kind (docs/model.md 16): an arm's fields with their units, the arm's three it needs first.
 OSCILLATING = Is("follower_type", ("oscillating_roller", "oscillating_flat"))
 OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
+# The translating flat's train (docs/model.md 14.6): its path is s, as the roller's; on the cam only so far.
+FLAT_TRAIN = AllOf(Is("follower_type", ("translating_flat",)), Not(OWN_FOLLOWER))
 ARM_UNITS = (("arm_length", "m"), ("pivot_distance", "m"), ("lift_angle", "rad"), ("J_arm", "kg.m2"),
              ("m_arm", "kg"), ("r_cm_arm", "m"), ("psi_0", "rad"))
 
@@ -219,10 +221,12 @@ RULES: tuple[Rule, ...] = (
          "parameter 'c' = {c} m with follower_type {follower_type}: a clearance needs the follower as a body of its "
          "own (closure 'form' with the follower's mass m > 0, in the consistent formulation or the speed drive; "
          "docs/model.md 16.3); allowed with closure {closure}: c = 0"),
-    Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, TRAIN, AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
-         "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train and a solver "
-         "other than 'etdrk4' (which integrates the roller's electrical pole) so far; allowed with k_shaft = "
-         "{k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: 'translating_roller'"),
+    Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, AllOf(TRAIN, Not(FLAT_TRAIN)),
+                                 AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
+         "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train (but the "
+         "translating flat's on the cam) and a solver other than 'etdrk4' (which integrates the roller's electrical "
+         "pole) so far; allowed with k_shaft = {k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: "
+         "'translating_roller'"),
     Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),
          "parameter 'follower_type' = {follower_type}: the paper's formulation (steps 1-9) has the translating "
          "roller only; allowed with it: 'translating_roller' (or formulation 'consistent', docs/model.md 16)"),

@@ -100,7 +100,7 @@ void cam_kind_contact_load(const CamModel *m, const double q[4], double P, doubl
 }
 
 void cam_kind_load(const CamModel *m, double theta, double omega, double omega_dot, double direction, int engaged,
-                   CamLoad *out)
+                   double axial, CamLoad *out)
 {
     double q[4];
     int k;
@@ -117,8 +117,8 @@ void cam_kind_load(const CamModel *m, double theta, double omega, double omega_d
         out->v = out->a = out->N = 0.0;
         return;
     }
-    cam_kind_contact_load(m, q, m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0]),
-                          direction, out);
+    cam_kind_contact_load(m, q, m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0])
+                          + axial, direction, out);   /* axial: the train's force along q (0 without a train) */
     out->v = q[1] / m->q_scale * omega;   /* the law's lift rates, as the reference's */
     out->a = q[2] / m->q_scale * omega * omega + q[1] / m->q_scale * omega_dot;
 }
@@ -286,13 +286,21 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, A, dA, dJ, V2, domega_dot = 0.0, P, dP;
     double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, dk;
-    double sP, Pc, dPc, qf, force, side = own ? mode->contact : (m->guide_side ? mode->side : 0.0);
+    double sP, Pc, dPc, qf, force, F = 0.0, dF = 0.0, side = own ? mode->contact : (m->guide_side ? mode->side : 0.0);
     CamKindBranch branch;
     int n, moving = !mode->stuck, engaged = mode->contact != 0;
     cam_kind_eval(m, theta, q);
     qf = q[0] - (own ? mode->contact * cam_follower_clearance(m) : 0.0);   /* where the follower is */
     V2 = m->arm && m->W != 0.0 ? -m->W * sin(qf + m->psi_0) : 0.0;   /* d2V/dq2 */
     force = own ? cam_follower_closing(m, qf) : cam_kind_slope(m, q[0]);   /* its load beside its inertia */
+    if (m->train && !own) {   /* a translating type's train (docs/model.md 14.6): its force along q = s, rates */
+        w = moving ? x[CAM_OMEGA] : 0.0;
+        dw = moving ? domega : 0.0;
+        F = cam_train_force(m, theta, w, x[CAM_X_END], x[CAM_V_END]);
+        dF = m->k_train * (q[1] * dtheta - seed[CAM_X_END])
+             + m->d_train * (q[2] * dtheta * w + q[1] * dw - seed[CAM_V_END]);
+        force += F;
+    }
     if (own)
         V2 += cam_follower_stiffness(m);   /* the spring's */
     for (n = 0; n < CAM_NX; n++)
@@ -307,7 +315,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         dlam = lever_rate(m, q) * dtheta;
     }
     A = m->I_f * q[2] * w * w + force;
-    dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta;
+    dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta + dF;
     if (moving && m->follower) {   /* den omega_dot = T - M_f d - A k on the branch cam_rhs holds (model.c) */
         cam_kind_branch(m, q, w, T - m->M_f * d, d, side, force, &branch);
         dk = q[2] * dtheta + m->mu * d * branch.b * dlam;
@@ -351,9 +359,17 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     }
     if (mode->stuck)   /* static friction takes the whole torque */
         dout[CAM_O_M] = dT;
-    dout[CAM_O_S_END] = dout[CAM_O_S];   /* no train with a kind (the rules) */
+    dout[CAM_O_S_END] = dout[CAM_O_S];   /* without a train the end is the follower */
     dout[CAM_O_V_END] = dout[CAM_O_V];
     dout[CAM_O_A_END] = dout[CAM_O_A];
+    if (m->train && !own) {   /* the end mass: x_e' = v_e, m_end v_e' = F_train + F_ex (model.c train_rhs) */
+        ddx[CAM_X_END] = seed[CAM_V_END];
+        ddx[CAM_V_END] = dF / m->m_end;
+        dout[CAM_O_S_END] = seed[CAM_X_END];
+        dout[CAM_O_V_END] = seed[CAM_V_END];
+        dout[CAM_O_A_END] = dF / m->m_end;
+        dout[CAM_O_F_TRAIN] = dF;
+    }
     if (m->arm) {
         dout[CAM_O_PSI] = q[1] * dtheta;
         dout[CAM_O_PSI_DOT] = q[2] * dtheta * w + q[1] * dw;

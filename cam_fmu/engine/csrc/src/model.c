@@ -198,8 +198,8 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
               double axial, CamLoad *out)
 {
     double d[4], s, s1, tan_a, shaft, v, a, sigma, push, f;
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c (no train: the rules refuse it) */
-        cam_kind_load(m, theta, omega, omega_dot, direction, engaged, out);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: the train's force joins P */
+        cam_kind_load(m, theta, omega, omega_dot, direction, engaged, axial, out);
         return;
     }
     cam_profile_eval(&m->profile, theta, d);
