@@ -59,6 +59,8 @@ KIND = {
                                     "lift_angle": 0.15, **ARM, **CYCLOID, "mu": 0.05},
     "translating_flat_friction": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2,
                                   "beta": 0.7, **CYCLOID},
+    "translating_flat_train": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2,
+                               "beta": 0.7, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "L": 1e-3, **CYCLOID},
 }
 FLIGHT = {"spring_in_flight", "spring_in_flight_tilted", "spring_in_flight_L", "spring_in_flight_compliant_L"}
 CASES = {
