@@ -31,6 +31,18 @@ def engine_run(params: dict, stop: float = STOP, step: float = STEP) -> dict[str
     return {name: np.array([r[name] for r in rows]) for name in rows[0]}
 
 
+def speed_run(params: dict, omega_ref: Signal) -> dict[str, np.ndarray]:
+    """The speed drive stepped over the test's grid under omega_ref (its value and slope at each step's start)."""
+    sim = DriveSimulator(params)
+    sim.set_inputs(U, omega_ref.value(0.0), omega_ref.slope(0.0))
+    rows = [sim.outputs()]
+    for k in range(int(round(STOP / STEP))):
+        t = k * STEP
+        sim.do_step(t, STEP, u=U, omega_ref=omega_ref.value(t), omega_dot_ref=omega_ref.slope(t))
+        rows.append(sim.outputs())
+    return {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+
 def worst(engine: dict, reference: dict, name: str) -> float:
     """max |engine - reference| over the grid, relative to the reference's largest |value|."""
     return float(np.max(np.abs(engine[name] - reference[name])) / np.max(np.abs(reference[name])))
@@ -147,14 +159,7 @@ def test_the_speed_drive_carries_the_train_as_the_reference_does(extra):
     a reversal of omega_ref; measured 1e-14 (theta) .. 5e-9 (a_end, the voltage with L) of each output's largest."""
     w = Signal((0.0, 0.4, 0.4, 0.7), (20.0, 35.0, 35.0, -10.0))
     params = dict(defaults(), **dict(TRAIN, drive="speed", **extra))
-    sim = DriveSimulator(params)
-    sim.set_inputs(U, w.value(0.0), w.slope(0.0))
-    rows = [sim.outputs()]
-    for k in range(int(round(STOP / STEP))):
-        t = k * STEP
-        sim.do_step(t, STEP, u=U, omega_ref=w.value(t), omega_dot_ref=w.slope(t))
-        rows.append(sim.outputs())
-    engine = {name: np.array([r[name] for r in rows]) for name in rows[0]}
+    engine = speed_run(params, w)
     reference = simulate_reference(params, STOP, STEP, omega_ref=w)
     for name in NAMES + ("voltage",):
         assert worst(engine, reference, name) < 5e-8, (name, worst(engine, reference, name))

@@ -11,7 +11,7 @@ from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import ParameterError, defaults
 from cam_fmu.physics.signals import Signal
 from cam_fmu.reference.integrate import simulate_reference
-from tests.engine.test_engine_train import STEP, STOP, TRAIN, U, engine_run, worst
+from tests.engine.test_engine_train import STEP, STOP, TRAIN, engine_run, speed_run, worst
 
 FLAT = dict(follower_type="translating_flat")
 # N_contact is the geometry's (the flat's P, the roller's P / cos(alpha)): not compared
@@ -32,14 +32,7 @@ def test_the_flat_with_a_train_drives_as_the_roller_reference_without_friction(e
 def test_the_speed_drive_carries_the_flat_s_train_as_the_roller_reference():
     w = Signal((0.0, 0.4, 0.4, 0.7), (20.0, 35.0, 35.0, -10.0))
     params = dict(defaults(), **dict(TRAIN, drive="speed"))
-    sim = DriveSimulator(dict(params, **FLAT))
-    sim.set_inputs(U, w.value(0.0), w.slope(0.0))
-    rows = [sim.outputs()]
-    for k in range(int(round(STOP / STEP))):
-        t = k * STEP
-        sim.do_step(t, STEP, u=U, omega_ref=w.value(t), omega_dot_ref=w.slope(t))
-        rows.append(sim.outputs())
-    engine = {name: np.array([r[name] for r in rows]) for name in rows[0]}
+    engine = speed_run(dict(params, **FLAT), w)
     reference = simulate_reference(params, STOP, STEP, omega_ref=w)
     for name in NAMES:
         assert worst(engine, reference, name) < 5e-8, (name, worst(engine, reference, name))
