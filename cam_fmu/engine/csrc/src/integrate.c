@@ -353,7 +353,6 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
     double t = 0.0, u = d->form_u, remaining, dt, target, cut, tau;
     long steps = 0, retries;
     int was_stuck = d->mode.stuck, status, at_break;
-    CamMode before;
     it->have_before = 0;
     if (!(d->solver.k1_valid && d->solver.fsal_u == u && !was_stuck)) {   /* else settled where the last step ended */
         if (d->form->transition != NULL)   /* the formulation settles its own modes */
@@ -421,7 +420,7 @@ static int advance(CamDrive *d, CamIntegrator *it, double h, double time, long *
             if (it->f_end_valid)
                 memcpy(d->solver.k1, it->f_end, sizeof d->solver.k1);
             if (at_break) {   /* a jump of s'' may let the follower go at once */
-                before = d->mode;
+                CamMode before = d->mode;
                 d->form->transition(d, EV_BREAK, time + t);
                 if (!same_mode(&before, &d->mode)) {
                     d->solver.k1_valid = 0;

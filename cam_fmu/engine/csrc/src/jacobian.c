@@ -76,6 +76,22 @@ static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const do
 }
 
 /* The tangent of the motor's torque c_m i (L > 0) or c_m (u - c_e omega_m) / R (L = 0). */
+double cam_train_tangent(const CamModel *m, double ds, double dv, const double seed[CAM_NX])
+{
+    return m->train ? m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]) : 0.0;
+}
+
+void cam_train_rows(const CamModel *m, const double seed[CAM_NX], double dF_rate, double dF_out, double ddx[CAM_NX],
+                    double dout[])
+{
+    ddx[CAM_X_END] = seed[CAM_V_END];
+    ddx[CAM_V_END] = dF_rate / m->m_end;
+    dout[CAM_O_S_END] = seed[CAM_X_END];
+    dout[CAM_O_V_END] = seed[CAM_V_END];
+    dout[CAM_O_A_END] = dF_out / m->m_end;
+    dout[CAM_O_F_TRAIN] = dF_out;
+}
+
 static double torque_tangent(const CamModel *m, double domega_m, double di, double du)
 {
     if (m->has_current)
@@ -94,7 +110,7 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     double w, dw, s1, ds1, t, dt, a, da, push, root, i_dot, sigma, f, df, along, dalong, F, dF = 0.0;
     int k, engaged = mode->contact != 0, moving = !mode->stuck;
     cam_rhs(m, mode, x, u, dx);
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: rigid shaft, no train */
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)   /* kind.c: a rigid shaft */
         return cam_kind_tangent(m, mode, x, seed, cam_drive_torque(m, x, omega, u), dT_motor, du, dx[CAM_OMEGA], 0,
                                 ddx, dout);
     cam_profile_eval(&m->profile, theta, d);
@@ -102,12 +118,8 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
         ddx[k] = 0.0;
     /* the train's force k (s - x_e) + d (s' omega - v_e) at the cam's speed (0 while stuck) and its tangent */
     F = cam_train_force_at(m, x, moving ? omega : 0.0);
-    if (m->train) {
-        dF = m->k_train * (d[1] * dtheta - seed[CAM_X_END])
-             + m->d_train * (d[2] * dtheta * (moving ? omega : 0.0) + d[1] * (moving ? domega : 0.0) - seed[CAM_V_END]);
-        ddx[CAM_X_END] = seed[CAM_V_END];
-        ddx[CAM_V_END] = dF / m->m_end;
-    }
+    dF = cam_train_tangent(m, d[1] * dtheta, d[2] * dtheta * (moving ? omega : 0.0) + d[1] * (moving ? domega : 0.0),
+                           seed);
     /* the torque on the cam: the shaft's k twist + d (omega_m - omega) (the cam's speed 0 while stuck), else the motor's */
     dT = m->compliant ? m->k_shaft * dtwist + m->d_shaft * (domega_m - (moving ? domega : 0.0)) : dT_motor;
     if (moving) {
@@ -159,9 +171,10 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
     dout[CAM_O_THETA_M] = dtheta + dtwist;
     dout[CAM_O_OMEGA_M] = domega_m;
     dout[CAM_O_M_SHAFT] = m->compliant ? dT : 0.0;
-    dout[CAM_O_S_END] = m->train ? seed[CAM_X_END] : dout[CAM_O_S];   /* without a train: the follower's */
-    dout[CAM_O_V_END] = m->train ? seed[CAM_V_END] : dout[CAM_O_V];
-    dout[CAM_O_A_END] = m->train ? dF / m->m_end : dout[CAM_O_A];
-    dout[CAM_O_F_TRAIN] = dF;
+    dout[CAM_O_S_END] = dout[CAM_O_S];   /* without a train the end is the follower */
+    dout[CAM_O_V_END] = dout[CAM_O_V];
+    dout[CAM_O_A_END] = dout[CAM_O_A];
+    if (m->train)
+        cam_train_rows(m, seed, dF, dF, ddx, dout);
     return CAM_OK;
 }

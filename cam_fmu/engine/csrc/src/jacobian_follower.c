@@ -112,7 +112,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     if (contact) {
         if (m->train) {   /* on a stuck flank the rates take the follower at rest */
             F_t = m->k_train * (y[3] - y[Y_XE]) + m->d_train * ((stuck ? 0.0 : y[4]) - y[Y_VE]);
-            dF_t = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * ((stuck ? 0.0 : dv) - seed[CAM_V_END]);
+            dF_t = cam_train_tangent(m, ds, stuck ? 0.0 : dv, seed);
         }
         dF = m->k_spring * p[1] * dtheta + dF_t;   /* the closing force at s = s_cam - contact c, a train's */
         if (!stuck) {
@@ -135,8 +135,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
         ds += left * seed[CAM_GAP];
         dv += left * seed[CAM_RATE];
         domega_dot = stuck ? 0.0 : g.drive / m->J_0;
-        if (m->train)
-            dF_t = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]);
+        dF_t = cam_train_tangent(m, ds, dv, seed);
         da = held ? 0.0 : -(m->k_spring * ds + dF_t) / m->m;   /* the free follower's acceleration */
         ddx[CAM_THETA] = domega;
         ddx[CAM_OMEGA] = domega_dot;
@@ -166,12 +165,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     dout[CAM_O_A_END] = da;
     dout[CAM_O_F_TRAIN] = 0.0;
     if (m->train) {   /* the end mass's rows, its force at the follower's own s, v (the rates': at rest if stuck) */
-        dF_out = m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]);
-        ddx[CAM_X_END] = seed[CAM_V_END];
-        ddx[CAM_V_END] = (contact ? dF_t : dF_out) / m->m_end;
-        dout[CAM_O_S_END] = seed[CAM_X_END];
-        dout[CAM_O_V_END] = seed[CAM_V_END];
-        dout[CAM_O_A_END] = dF_out / m->m_end;
-        dout[CAM_O_F_TRAIN] = dF_out;
+        dF_out = cam_train_tangent(m, ds, dv, seed);
+        cam_train_rows(m, seed, contact ? dF_t : dF_out, dF_out, ddx, dout);
     }
 }

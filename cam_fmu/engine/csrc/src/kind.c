@@ -286,21 +286,13 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     double q[4], theta = x[CAM_THETA], dtheta = seed[CAM_THETA], domega = seed[CAM_OMEGA];
     double di = m->has_current ? seed[CAM_CURRENT] : 0.0, w, dw, A, dA, dJ, V2, domega_dot = 0.0, P, dP;
     double k = m->q_scale, dalpha, dN, d = mode->stuck ? 0.0 : mode->direction, lam = 0.0, dlam = 0.0, dk;
-    double sP, Pc, dPc, qf, force, F = 0.0, dF = 0.0, side = own ? mode->contact : (m->guide_side ? mode->side : 0.0);
+    double sP, Pc, dPc, qf, force, dF = 0.0, side = own ? mode->contact : (m->guide_side ? mode->side : 0.0);
     CamKindBranch branch;
     int n, moving = !mode->stuck, engaged = mode->contact != 0;
     cam_kind_eval(m, theta, q);
     qf = q[0] - (own ? mode->contact * cam_follower_clearance(m) : 0.0);   /* where the follower is */
     V2 = m->arm && m->W != 0.0 ? -m->W * sin(qf + m->psi_0) : 0.0;   /* d2V/dq2 */
     force = own ? cam_follower_closing(m, qf) : cam_kind_slope(m, q[0]);   /* its load beside its inertia */
-    if (m->train && !own) {   /* a translating type's train (docs/model.md 14.6): its force along q = s, rates */
-        w = moving ? x[CAM_OMEGA] : 0.0;
-        dw = moving ? domega : 0.0;
-        F = cam_train_force(m, theta, w, x[CAM_X_END], x[CAM_V_END]);
-        dF = m->k_train * (q[1] * dtheta - seed[CAM_X_END])
-             + m->d_train * (q[2] * dtheta * w + q[1] * dw - seed[CAM_V_END]);
-        force += F;
-    }
     if (own)
         V2 += cam_follower_stiffness(m);   /* the spring's */
     for (n = 0; n < CAM_NX; n++)
@@ -309,6 +301,10 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         omega_dot = 0.0;
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
+    if (m->train && !own) {   /* a translating type's train (docs/model.md 14.6): its force along q = s */
+        force += cam_train_force(m, theta, w, x[CAM_X_END], x[CAM_V_END]);
+        dF = cam_train_tangent(m, q[1] * dtheta, q[2] * dtheta * w + q[1] * dw, seed);
+    }
     dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;
     if (m->mu != 0.0) {   /* the friction's lever and its rate */
         lam = cam_kind_lever(m, q);
@@ -362,14 +358,8 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     dout[CAM_O_S_END] = dout[CAM_O_S];   /* without a train the end is the follower */
     dout[CAM_O_V_END] = dout[CAM_O_V];
     dout[CAM_O_A_END] = dout[CAM_O_A];
-    if (m->train && !own) {   /* the end mass: x_e' = v_e, m_end v_e' = F_train + F_ex (model.c train_rhs) */
-        ddx[CAM_X_END] = seed[CAM_V_END];
-        ddx[CAM_V_END] = dF / m->m_end;
-        dout[CAM_O_S_END] = seed[CAM_X_END];
-        dout[CAM_O_V_END] = seed[CAM_V_END];
-        dout[CAM_O_A_END] = dF / m->m_end;
-        dout[CAM_O_F_TRAIN] = dF;
-    }
+    if (m->train && !own)   /* the end mass (model.c train_rhs) */
+        cam_train_rows(m, seed, dF, dF, ddx, dout);
     if (m->arm) {
         dout[CAM_O_PSI] = q[1] * dtheta;
         dout[CAM_O_PSI_DOT] = q[2] * dtheta * w + q[1] * dw;
