@@ -122,6 +122,22 @@ def flight_bound(body, options: dict) -> None:
     options["max_step"] = min(options.get("max_step", math.inf), TRAIN_PHASE / rate)
 
 
+def _bound_event(body, fn):
+    """The event function ``fn`` (t, y) seeing the end mass of the state it is given (``body.bind`` first)."""
+    def value(t, y):
+        body.bind(y)
+        return fn(t, y)
+    return event(fn.kind, value)
+
+
+def _bound_transition(fn):
+    """The transition ``fn`` deciding (held, land) with the end mass of the state it is given."""
+    def transition(run, t, y, mode, kind):
+        run.body.bind(y)
+        return fn(run, t, y, mode, kind)
+    return transition
+
+
 class TrainSpeedFollowerRun(FollowerRun):
     """One run of the speed drive with a follower of its own carrying the train: y = (theta, s, v, x_e, v_e)."""
 
@@ -142,9 +158,7 @@ class TrainSpeedFollowerRun(FollowerRun):
         body, speed, contact = self.body, piece_input(self.omega_ref, self.piece_end), mode.contact
         body.bind(y)
         events, rhs, options = super()._piece(t, y, mode)
-        bound = []
-        for fn in events:   # each event function sees the end mass of the state it is given
-            bound.append(event(fn.kind, lambda t, y, fn=fn: (body.bind(y), fn(t, y))[1]))
+        bound = [_bound_event(body, fn) for fn in events]
 
         def with_end(t, y):
             body.bind(y)
@@ -152,17 +166,15 @@ class TrainSpeedFollowerRun(FollowerRun):
         if not contact:
             flight_bound(body, options)
             if mode.follower is Follower.HALTED and body.f0 > 0.0:  # held by the guide until the train's pull beats it
-                bound.append(event(Event.HALT, lambda t, y: (body.bind(y), body.f0 + SIDE_HYSTERESIS
-                                                             - abs(body.net_at_rest(y[1])))[1]))
+                release = event(Event.HALT, lambda t, y: body.f0 + SIDE_HYSTERESIS - abs(body.net_at_rest(y[1])))
+                bound.append(_bound_event(body, release))
         return bound, with_end, options
 
     def _settle(self, t: float, y: list, mode: Mode, after_event: bool) -> tuple[Mode, list]:
         self.body.bind(y)
         return super()._settle(t, y, mode, after_event)
 
-    # each transition decides (held, land) with the end mass of the state it is given
-    TRANSITIONS = {kind: (lambda fn: lambda self, t, y, mode, kind: (self.body.bind(y), fn(self, t, y, mode, kind))[1])(fn)
-                   for kind, fn in FollowerRun.TRANSITIONS.items()}
+    TRANSITIONS = {kind: _bound_transition(fn) for kind, fn in FollowerRun.TRANSITIONS.items()}
 
     def _row(self, t: float, y, mode: Mode, left: bool) -> dict[str, float]:
         self.body.bind(y)
