@@ -136,38 +136,6 @@ static int to_double(Span f, int kind, double *value)
     return end != buf + pos;
 }
 
-/* Growable (angle, lift) columns. */
-typedef struct {
-    double *angle, *lift;
-    size_t n, cap;
-} Rows;
-
-static int push(Rows *r, double angle, double lift)
-{
-    if (r->n == r->cap) {
-        size_t cap = r->cap ? 2 * r->cap : 64;
-        double *a, *l;
-        if (cap > CAM_TABLE_MAX_ROWS) {
-            cap = CAM_TABLE_MAX_ROWS;
-        }
-        a = realloc(r->angle, cap * sizeof *a);
-        if (a == NULL) {
-            return 1;
-        }
-        r->angle = a;
-        l = realloc(r->lift, cap * sizeof *l);
-        if (l == NULL) {
-            return 1;
-        }
-        r->lift = l;
-        r->cap = cap;
-    }
-    r->angle[r->n] = angle;
-    r->lift[r->n] = lift;
-    r->n++;
-    return 0;
-}
-
 /* The interpolant's slopes and piece coefficients from knots angle[0..n-1], lift[0..n-1] (n >= 2). */
 static void build(CamTable *t)
 {
@@ -388,11 +356,11 @@ static int read_row(const Parser *ps, const char *line, size_t n, size_t n_field
 }
 
 /* A row at 360 deg: it closes the period, after a first row at 0 deg and with that row's lift. */
-static int close_period(Parser *ps, const Rows *rows, const RowInfo *r, CamError *err)
+static int close_period(Parser *ps, const CamTable *table, const RowInfo *r, CamError *err)
 {
     char q1[200], q2[200];
     const RowInfo *first = &ps->first;
-    if (rows->n == 0 || first->degrees != 0.0) {
+    if (table->n == 0 || first->degrees != 0.0) {
         return row_fail(err, ps->line, ps->row, "a row at 360 deg closes the period: it must come last, "
                         "after a first row at 0 deg");
     }
@@ -408,12 +376,12 @@ static int close_period(Parser *ps, const Rows *rows, const RowInfo *r, CamError
 }
 
 /* A row inside the period: its angle above the previous one's by at least the minimum spacing, then kept. */
-static int append_row(Parser *ps, Rows *rows, RowInfo *r, CamError *err)
+static int append_row(Parser *ps, CamTable *table, RowInfo *r, CamError *err)
 {
     char q1[200], q2[200];
     const RowInfo *prev = &ps->prev;
     r->radians = r->degrees * DEG;
-    if (rows->n > 0) {
+    if (table->n > 0) {
         if (r->degrees <= prev->degrees) {
             return row_fail(err, ps->line, ps->row, "angle %s deg %s %s deg of row %lu (line %lu); angles must "
                             "increase strictly", cam_text(r->angle.s, r->angle.n, q1, sizeof q1),
@@ -428,14 +396,15 @@ static int append_row(Parser *ps, Rows *rows, RowInfo *r, CamError *err)
                             (unsigned long)prev->line);
         }
     }
-    if (rows->n >= CAM_TABLE_MAX_ROWS) {
+    if (table->n >= CAM_TABLE_MAX_ROWS) {
         return cam_error(err, CAM_ERR_PARAMETER, "motion table: more than %d rows (line %lu)", CAM_TABLE_MAX_ROWS,
                          (unsigned long)ps->line);
     }
-    if (push(rows, r->radians, r->mm * 1e-3)) {
-        return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory at row %lu", (unsigned long)ps->row);
+    if (table->angle != NULL) {   /* the second pass: the rows into the table's block */
+        table->angle[table->n] = r->radians;
+        table->lift[table->n] = r->mm * 1e-3;
     }
-    if (rows->n == 1) {
+    if (++table->n == 1) {
         ps->first = *r;
     }
     ps->prev = *r;
@@ -443,13 +412,13 @@ static int append_row(Parser *ps, Rows *rows, RowInfo *r, CamError *err)
 }
 
 /* The whole table: at least two rows, and the last far enough from the first one's angle + 360 deg. */
-static int check_period(const Parser *ps, const Rows *rows, CamError *err)
+static int check_period(const Parser *ps, const CamTable *table, CamError *err)
 {
     char q1[200], q2[200];
     const RowInfo *first = &ps->first, *prev = &ps->prev;
-    if (rows->n < 2) {
+    if (table->n < 2) {
         return cam_error(err, CAM_ERR_PARAMETER, "motion table: need at least 2 rows 'angle_deg, lift_mm' (a closing "
-                         "row at 360 deg not counted), got %lu", (unsigned long)rows->n);
+                         "row at 360 deg not counted), got %lu", (unsigned long)table->n);
     }
     if ((first->degrees + 360.0) - prev->degrees < CAM_TABLE_MIN_SPACING_DEG) {
         return row_fail(err, prev->line, prev->row, "angle %s deg is closer than 1e-06 deg to %s deg + 360 deg of "
@@ -461,8 +430,9 @@ static int check_period(const Parser *ps, const Rows *rows, CamError *err)
     return CAM_OK;
 }
 
-/* The rows of a motion table's text (docs/cam_design.md: the format and the refusals), line by line. */
-static int parse(const char *text, size_t len, Rows *rows, CamError *err)
+/* The rows of a motion table's text (docs/cam_design.md: the format and the refusals), line by line: counted
+ * into table->n, and stored where table->angle, table->lift are allocated. */
+static int parse(const char *text, size_t len, CamTable *table, CamError *err)
 {
     Parser ps;
     size_t pos = 0;
@@ -493,38 +463,34 @@ static int parse(const char *text, size_t len, Rows *rows, CamError *err)
         if ((status = read_row(&ps, text + start, stop - start, n_fields, field, &r, err)) != CAM_OK) {
             return status;
         }
-        status = r.degrees == 360.0 ? close_period(&ps, rows, &r, err) : append_row(&ps, rows, &r, err);
+        status = r.degrees == 360.0 ? close_period(&ps, table, &r, err) : append_row(&ps, table, &r, err);
         if (status != CAM_OK) {
             return status;
         }
     }
-    return check_period(&ps, rows, err);
+    return check_period(&ps, table, err);
 }
 
 int cam_table_init(CamTable *t, const char *text, size_t text_len, CamError *err)
 {
-    Rows rows;
     double *block;
     size_t n;
     int status;
     memset(t, 0, sizeof *t);
-    memset(&rows, 0, sizeof rows);
     if (text == NULL && text_len > 0) {
         return cam_error(err, CAM_ERR_PARAMETER, "motion table: no text");
     }
-    if ((status = parse(text, text_len, &rows, err)) != CAM_OK) {
-        free(rows.angle);
-        free(rows.lift);
+    if ((status = parse(text, text_len, t, err)) != CAM_OK) {   /* the first pass counts the rows */
+        memset(t, 0, sizeof *t);
         return status;
     }
-    n = rows.n;
+    n = t->n;
     block = malloc(7 * n * sizeof *block);
     if (block == NULL) {
-        free(rows.angle);
-        free(rows.lift);
+        memset(t, 0, sizeof *t);
         return cam_error(err, CAM_ERR_MEMORY, "motion table: out of memory for %lu rows", (unsigned long)n);
     }
-    t->n = n;
+    t->n = 0;
     t->angle = block;
     t->lift = block + n;
     t->slope = block + 2 * n;
@@ -532,10 +498,7 @@ int cam_table_init(CamTable *t, const char *text, size_t text_len, CamError *err
     t->c2 = block + 4 * n;
     t->e2 = block + 5 * n;
     t->c3 = block + 6 * n;
-    memcpy(t->angle, rows.angle, n * sizeof *block);
-    memcpy(t->lift, rows.lift, n * sizeof *block);
-    free(rows.angle);
-    free(rows.lift);
+    parse(text, text_len, t, err);   /* the second pass, over text the first accepted, stores them */
     build(t);
     return CAM_OK;
 }
