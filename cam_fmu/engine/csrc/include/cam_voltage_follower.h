@@ -12,7 +12,9 @@
 #define Y_TWIST 5               /* y[5], y[6]: a compliant shaft's twist [rad] and rotor speed [rad/s] */
 #define Y_ROTOR 6
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
-#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck */
+#define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck;
+                                 * held over a step (a stop ends it): a Runge-Kutta stage past omega = 0 with sgn(omega)
+                                 * would turn the friction inside the step and misplace the stop (3.3e-6 rad at 7e-4 s) */
 #define Y_XE 9                  /* y[9], y[10]: a follower train's end mass [m, m/s] (docs/model.md 14.6; 0 without) */
 #define Y_VE 10
 
@@ -28,9 +30,10 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
 double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY]);
 /* m/s2: the scale of the follower's relative acceleration at y (the Zeno guard's and the rebound's). */
 double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u);
-/* On the flank `contact` at y: d = (s_cam, s', s'', s''') at the cam, omega_dot [rad/s2], the contact force P [N]. */
+/* On the flank `contact` at y: d = (s_cam, s', s'', s''') at the cam, omega_dot [rad/s2], the contact force P [N]
+ * and (n_r not NULL) the guide's side force N_r [N] (0 without guide friction). */
 void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
-                     double *P);
+                     double *P, double *n_r);
 /* The follower's s, v set on the flank `contact` at y. */
 void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact);
 /* rad/s2: > 0 where the stuck shaft starts, *dir the way it starts. */

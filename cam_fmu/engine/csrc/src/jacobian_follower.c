@@ -121,7 +121,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
                                            cam_follower_closing(m, y[3]) + F_t, y[Y_DIR], 0.0, dq, &f, &df);
             ddx[CAM_THETA] = domega;
             ddx[CAM_OMEGA] = domega_dot;
-            cam_vf_on_flank(m, y, d->form_u, contact, p, &dy[1], &P);
+            cam_vf_on_flank(m, y, d->form_u, contact, p, &dy[1], &P, NULL);
         } else {
             P = cam_follower_closing(m, y[3]) + F_t;
             f = df = 0.0;

@@ -68,13 +68,6 @@ static double shaft_torque(const CamModel *m, const double y[NY])
     return m->k_shaft * y[Y_TWIST] + m->d_shaft * (y[Y_ROTOR] - y[1]);
 }
 
-/* The shaft's direction of motion, held over a step (a stop ends it; 0: stuck): a Runge-Kutta stage past omega = 0
- * with sgn(omega) would turn the friction inside the step and misplace the stop (3.3e-6 rad at steps of 7e-4 s). */
-static double shaft_direction(const double y[NY])
-{
-    return y[Y_DIR];
-}
-
 /* N m: what drives the cam side, the motor's torque (rigid) or the shaft's, less the shaft's friction against the
  * direction `dir`. */
 double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, double dir)
@@ -84,67 +77,47 @@ double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, dou
     return drive - m->M_f * dir;
 }
 
-static double torque(const CamModel *m, const double y[NY], double u)
-{
-    return cam_vf_torque_toward(m, y, u, shaft_direction(y));
-}
-
 /* On the flank `contact` at y, the shaft moving toward `dir`: d = (s_cam, s', s'', s'''), omega_dot [rad/s2] and the
  * force P [N] along X of the coupled equations; with guide friction f = mu (|N_r| + |N_g|) solved with omega_dot
  * (model.c load_terms with F_close in gravity's place: N_r = n0 + sigma kappa f, kappa = (J_0 / J) tan(alpha)). */
 static void flank_toward(const CamModel *m, const double y[NY], double u, int contact, double dir, double d[4],
                          double *omega_dot, double *P, double *n_r)
 {
-    double omega = y[1], F, J, inertial, x0, sigma, tan_a, f, n0, kappa;
+    double omega = y[1], F, J, inertial, x0, sigma, tan_a, kappa, n0, f = 0.0;
+    int guided = m->mu != 0.0 && m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER;   /* the guide's friction */
     cam_kind_eval(m, y[0], d);
     F = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), d[1] * omega);
-    if (m->prescribed) {   /* the speed drive: omega_dot imposed (u), the flank's force follows */
-        double push = m->I_f * (d[2] * omega * omega + d[1] * u) + F;
-        *omega_dot = u;
-        *P = push;
-        *n_r = 0.0;
-        if (m->mu == 0.0 || m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER)
-            return;   /* another type's friction loads the cam, not the follower */
-        sigma = sgn(d[1] * dir);   /* the guide's friction with the side force (J_0 = inf: kappa = tan(alpha)) */
-        tan_a = d[1] / (m->r_b + d[0]);
-        n0 = push * tan_a + m->G_y;
-        f = cam_guide_friction(n0, tan_a, sigma, m->mu, m->N_g, 0.0);
-        *P = push + sigma * f;
-        *n_r = n0 + sigma * tan_a * f;
-        return;
-    }
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c's equation, the flank's b = contact */
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER && !m->prescribed) {   /* kind.c's, b = contact */
         CamKindBranch branch;
         *omega_dot = cam_kind_branch(m, d, omega, cam_vf_torque_toward(m, y, u, dir), dir, contact, F, &branch);
         *P = branch.P;
         *n_r = 0.0;   /* no side event: the friction's kink is the lift-off itself (docs/model.md 16.3) */
         return;
     }
-    if (m->mu == 0.0) {
-        *omega_dot = (cam_vf_torque_toward(m, y, u, dir) - (m->m * d[2] * omega * omega + F) * d[1])
-                     / (m->J_0 + m->m * d[1] * d[1]);
-        *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F;
-        *n_r = 0.0;
-        return;
-    }
-    J = m->J_0 + m->m * d[1] * d[1];
-    inertial = m->m * d[2] * omega * omega + F;
-    x0 = (cam_vf_torque_toward(m, y, u, dir) - inertial * d[1]) / J;
+    /* the translating roller, or any type under the speed drive's imposed omega_dot = u (J_0 = inf: kappa = tan(alpha);
+     * another type's friction loads the cam there, not the follower) */
+    J = m->J_0 + m->I_f * d[1] * d[1];
+    inertial = m->I_f * d[2] * omega * omega + F;
+    x0 = m->prescribed ? u : (cam_vf_torque_toward(m, y, u, dir) - inertial * d[1]) / J;
     sigma = sgn(d[1] * dir);
     tan_a = d[1] / (m->r_b + d[0]);
-    n0 = (inertial + m->m * d[1] * x0) * tan_a + m->G_y;
-    kappa = m->J_0 / J * tan_a;
-    f = cam_guide_friction(n0, kappa, sigma, m->mu, m->N_g, 0.0);
-    *omega_dot = x0 - sigma * f * d[1] / J;
-    *P = m->m * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
-    *n_r = n0 + sigma * kappa * f;
+    kappa = m->prescribed ? tan_a : m->J_0 / J * tan_a;
+    n0 = (inertial + m->I_f * d[1] * x0) * tan_a + m->G_y;
+    if (guided)
+        f = cam_guide_friction(n0, kappa, sigma, m->mu, m->N_g, 0.0);
+    *omega_dot = m->prescribed ? u : x0 - sigma * f * d[1] / J;
+    *P = m->I_f * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
+    *n_r = guided ? n0 + sigma * kappa * f : 0.0;
 }
 
 /* flank_toward in the shaft's direction; the cam stuck: at rest, the contact's force P = F_close(s) balancing the
  * spring and gravity (the guide's friction at rest carries nothing), omega_dot = 0. */
-static void flank_terms(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
-                        double *P, double *n_r)
+void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
+                     double *P, double *n_r)
 {
+    double unused;
+    if (n_r == NULL)
+        n_r = &unused;
     if (y[Y_DIR] == 0.0) {
         cam_kind_eval(m, y[0], d);
         *P = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), 0.0);
@@ -152,7 +125,7 @@ static void flank_terms(const CamModel *m, const double y[NY], double u, int con
         *n_r = *P * d[1] / (m->r_b + d[0]) + m->G_y;
         return;
     }
-    flank_toward(m, y, u, contact, shaft_direction(y), d, omega_dot, P, n_r);
+    flank_toward(m, y, u, contact, y[Y_DIR], d, omega_dot, P, n_r);
 }
 
 /* rad/s2: > 0 where the stuck shaft starts (model.c cam_breakaway_margin with the follower's contact): the larger of
@@ -172,32 +145,14 @@ double cam_vf_breakaway(const CamModel *m, const double y[NY], double u, int con
     return fmax(forward, backward);
 }
 
-void cam_vf_on_flank(const CamModel *m, const double y[NY], double u, int contact, double d[4], double *omega_dot,
-                     double *P)
-{
-    double n_r;
-    flank_terms(m, y, u, contact, d, omega_dot, P, &n_r);
-}
-
-/* N: the guide's side force N_r on the flank `contact` at y (0 without guide friction). */
-static double side_force(const CamModel *m, const double y[NY], double u, int contact)
-{
-    double d[4], omega_dot, P, n_r;
-    flank_terms(m, y, u, contact, d, &omega_dot, &P, &n_r);
-    return n_r;
-}
-
-/* m/s2: the flying follower's acceleration at y with the friction's direction -sigma (0: held by it). */
-static double free_acceleration(const CamModel *m, const double y[NY], double sigma)
-{
-    return sigma == 0.0 ? 0.0 : (-closing_at(m, y, y[3], y[4]) - sigma * cam_follower_friction0(m)) / m->I_f;
-}
-
-/* The flying follower's acceleration at y (the guide's friction only where it acts in flight). */
+/* m/s2: the flying follower's acceleration at y, the guide's friction (where it acts in flight) against the
+ * direction y[Y_SIGMA] (0: held by it). */
 static double flight_acceleration(const CamModel *m, const double y[NY])
 {
-    return cam_follower_friction0(m) == 0.0 ? -closing_at(m, y, y[3], y[4]) / m->I_f
-                                            : free_acceleration(m, y, y[Y_SIGMA]);
+    double f0 = cam_follower_friction0(m);
+    if (f0 == 0.0)
+        return -closing_at(m, y, y[3], y[4]) / m->I_f;
+    return y[Y_SIGMA] == 0.0 ? 0.0 : (-closing_at(m, y, y[3], y[4]) - y[Y_SIGMA] * f0) / m->I_f;
 }
 
 /* The flying follower's direction over the next step: sgn(v), or at a halt the way the net force pushes it beyond
@@ -238,14 +193,14 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
         return;
     }
     if (contact) {
-        double P, n_r;
-        flank_terms(m, y, u, contact, d, &dy[1], &P, &n_r);
+        double P;
+        cam_vf_on_flank(m, y, u, contact, d, &dy[1], &P, NULL);
         dy[3] = d[1] * y[1];
         dy[4] = d[2] * y[1] * y[1] + d[1] * dy[1];
         end_mass_rates(m, y, d[0] - contact * cam_follower_clearance(m), dy[3], dy);
         return;
     }
-    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : (m->prescribed ? u : torque(m, y, u) / m->J_0);   /* the cam stuck: the follower
+    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : (m->prescribed ? u : cam_vf_torque_toward(m, y, u, y[Y_DIR]) / m->J_0);   /* the cam stuck: the follower
                                                                                       * flies alone */
     dy[3] = y[4];
     dy[4] = flight_acceleration(m, y);
@@ -270,7 +225,7 @@ double cam_vf_event_value(const CamModel *m, double u, int code, int contact, co
     if (code == EV_BREAK_AWAY)
         return -cam_vf_breakaway(m, y, u, contact, &omega_dot);
     if (code == EV_LIFT_OFF) {
-        cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P);
+        cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P, NULL);
         return contact * P;
     }
     if (code == EV_HALT && y[Y_SIGMA] == 0.0)   /* held by the guide: released where a train's pull beats f0 */
@@ -289,7 +244,7 @@ double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u
     cam_kind_eval(m, y[0], d);
     return fabs(closing_at(m, y, d[0], d[1] * y[1]) / m->I_f) + cam_follower_friction0(m) / m->I_f
            + fabs(d[2]) * y[1] * y[1]
-           + fabs(d[1] * (m->prescribed ? u : torque(m, y, u) / m->J_0)) + 1e-300;
+           + fabs(d[1] * (m->prescribed ? u : cam_vf_torque_toward(m, y, u, y[Y_DIR]) / m->J_0)) + 1e-300;
 }
 
 /* ------------------------------------------------------------------ the model contract's view (x, mode)
@@ -323,8 +278,11 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
     mode->sigma = 0.0;
     mode->side = 0.0;
     if (contact) {   /* the side force's sign: the kink of |N_r| ends a step (docs/model.md 10) */
-        if (y[Y_DIR] != 0.0 && m->mu > 0.0 && !m->prescribed)   /* imposed motion: P's kink changes nothing */
-            mode->side = sgn(side_force(m, y, u, contact));
+        double P, n_r, omega_dot;
+        if (y[Y_DIR] != 0.0 && m->mu > 0.0 && !m->prescribed) {   /* imposed motion: P's kink changes nothing */
+            cam_vf_on_flank(m, y, u, contact, dd, &omega_dot, &P, &n_r);
+            mode->side = sgn(n_r);
+        }
         return;
     }
     cam_kind_eval(m, y[0], dd);
@@ -346,7 +304,7 @@ static void working_y(const CamModel *m, const CamMode *mode, const double x[CAM
     y[Y_DIR] = mode->stuck ? 0.0 : mode->direction;
     y[Y_XE] = m->train ? x[CAM_X_END] : 0.0;
     y[Y_VE] = m->train ? x[CAM_V_END] : 0.0;
-    y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; flank_terms) */
+    y[3] = y[4] = 0.0;   /* on a flank the rates take s, v from the flank (cam_vf_y's; cam_vf_on_flank) */
     if (!mode->contact) {
         cam_kind_eval(m, y[0], dd);
         y[3] = dd[0] - mode->left * cam_follower_clearance(m) + mode->left * x[CAM_GAP] / cam_follower_length(m);
@@ -411,7 +369,7 @@ void cam_vf_values(const CamModel *m, const CamMode *mode, int n, const int code
     working_y(m, mode, x, y, d);
     for (k = 0; k < n; k++) {
         if ((codes[k] == EV_LIFT_OFF || codes[k] == EV_SIDE) && P != P)   /* the flank's forces, once */
-            flank_terms(m, y, u, mode->contact, d, &omega_dot, &P, &n_r);
+            cam_vf_on_flank(m, y, u, mode->contact, d, &omega_dot, &P, &n_r);
         g[k] = codes[k] == EV_LIFT_OFF ? mode->contact * P
                : (codes[k] == EV_SIDE ? mode->side * n_r + CAM_SIDE_HYSTERESIS
                                       : cam_vf_event_value(m, u, codes[k], mode->contact, y));
@@ -524,20 +482,27 @@ void cam_vf_start(CamDrive *d, double u)
     d->solver.k1_valid = 0;
 }
 
-/* Another type's load on its flank at y (docs/model.md 16.3): kind.c's with the flank's P, the follower's q, q_dot
- * and acceleration in y[3], y[4] and *a. */
-static void kind_flank_load(const CamModel *m, const double y[NY], double u, int contact, double *a, CamLoad *load)
+/* The load on the flank `contact` at y: another type's by kind.c (docs/model.md 16.3), the roller's M_f d + P s' with
+ * N along its normal; the cam stuck, static friction takes it all (the speed drive's cam at rest: the flank's holding
+ * torque). */
+static void flank_load(const CamModel *m, const double y[NY], double u, int contact, CamLoad *load)
 {
-    double q[4], omega_dot, P;
-    cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P);
-    if (y[Y_DIR] == 0.0) {   /* stuck: static friction takes it all, the flank holds the follower at rest */
-        cam_kind_contact_load(m, q, P, 0.0, load);
-        if (!m->prescribed)   /* (the speed drive's cam at rest: the flank's holding torque) */
-            load->M = cam_vf_torque_toward(m, y, u, 0.0);
+    double q[4], omega_dot, P, tan_a;
+    cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P, NULL);
+    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
+        cam_kind_contact_load(m, q, P, y[Y_DIR], load);
     } else {
-        cam_kind_contact_load(m, q, P, shaft_direction(y), load);
+        tan_a = q[1] / (m->r_b + q[0]);
+        load->alpha = atan(tan_a);
+        load->M = m->M_f * y[Y_DIR] + P * q[1];
+        load->N = cam_normal_force(P, tan_a);   /* signed as contact */
+        load->J = m->J_0 + m->m * q[1] * q[1];
+        load->f = 0.0;
     }
-    *a = q[2] * y[1] * y[1] + q[1] * omega_dot;
+    if (y[Y_DIR] == 0.0 && !m->prescribed)
+        load->M = cam_vf_torque_toward(m, y, u, 0.0);
+    load->v = q[1] * y[1];
+    load->a = q[2] * y[1] * y[1] + q[1] * omega_dot;
 }
 
 /* voltage_follower.outputs: the follower's own s, v, a (another type: its own q, q_dot, in the law's lift units, and
@@ -545,36 +510,21 @@ static void kind_flank_load(const CamModel *m, const double y[NY], double u, int
 void cam_vf_outputs(CamDrive *d, double out[])
 {
     const CamModel *m = &d->model;
-    double y[NY], dd[4], omega_dot, P, i, a;
+    double y[NY], dd[4], i;
     CamLoad load;
     cam_vf_y(m, &d->mode, d->x, y);
     if (m->prescribed)   /* the speed drive: the left limit's direction (a stop at the step's end still moves there) */
         y[Y_DIR] = cam_motion_sign(d->x[CAM_OMEGA], d->omega_ref, d->omega_dot_ref, fabs(d->time));
     cam_kind_eval(m, y[0], dd);
     i = current(m, y, d->form_u);
-    load.alpha = atan(dd[1] / (m->r_b + dd[0]));
     load.s_cam = dd[0];
-    load.f = 0.0;
-    load.N = 0.0;   /* in flight */
-    if (d->mode.contact != 0 && m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
-        kind_flank_load(m, y, d->form_u, d->mode.contact, &a, &load);
-        load.v = y[4];
-        load.a = a;
-    } else if (d->mode.contact != 0) {
-        int contact = d->mode.contact;
-        double tan_a = dd[1] / (m->r_b + dd[0]);
-        cam_vf_on_flank(m, y, d->form_u, contact, dd, &omega_dot, &P);
-        /* stuck: static friction takes it all */
-        load.M = y[Y_DIR] == 0.0 && !m->prescribed ? cam_vf_torque_toward(m, y, d->form_u, 0.0)
-                 : m->M_f * shaft_direction(y) + P * dd[1];
-        load.N = cam_normal_force(P, tan_a);   /* signed as contact */
-        load.J = m->J_0 + m->m * dd[1] * dd[1];
-        load.v = dd[1] * y[1];
-        load.a = dd[2] * y[1] * y[1] + dd[1] * omega_dot;
-        y[3] = dd[0] - contact * cam_follower_clearance(m);
-    } else {
-        load.M = m->M_f * shaft_direction(y);
+    if (d->mode.contact != 0) {
+        flank_load(m, y, d->form_u, d->mode.contact, &load);
+    } else {   /* in flight */
+        load.alpha = atan(dd[1] / (m->r_b + dd[0]));
+        load.M = m->M_f * y[Y_DIR];
         load.J = m->J_0;
+        load.N = load.f = 0.0;
         load.v = y[4];
         load.a = flight_acceleration(m, y);
     }
@@ -615,12 +565,7 @@ void cam_vf_outputs(CamDrive *d, double out[])
 /* N m: the load torque with the follower on the flank `contact` at y (M_f d + P q' and another type's friction). */
 double cam_vf_flank_torque(const CamModel *m, const double y[NY], double u, int contact)
 {
-    double q[4], omega_dot, P, a;
     CamLoad load;
-    if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {
-        kind_flank_load(m, y, u, contact, &a, &load);
-        return load.M;
-    }
-    cam_vf_on_flank(m, y, u, contact, q, &omega_dot, &P);
-    return m->M_f * shaft_direction(y) + P * q[1];
+    flank_load(m, y, u, contact, &load);
+    return load.M;
 }

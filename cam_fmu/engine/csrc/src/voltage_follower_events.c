@@ -51,7 +51,7 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     impact(m, y, d[1], 0.0);
     unstick(y);
     y[4] = d[1] * y[1];
-    cam_vf_on_flank(m, y, u, flank, d, &omega_dot, &P);
+    cam_vf_on_flank(m, y, u, flank, d, &omega_dot, &P, NULL);
     return flank * P >= 0.0 ? flank : 0;
 }
 
@@ -63,7 +63,7 @@ int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact)
     if (!contact)
         return 0;
     cam_vf_set_on_flank(m, y, contact);
-    cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P);
+    cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P, NULL);
     return contact * P >= 0.0 ? contact : 0;
 }
 
