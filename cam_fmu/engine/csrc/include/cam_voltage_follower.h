@@ -26,8 +26,6 @@ double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, dou
 double cam_vf_flight_direction(const CamModel *m, const double y[NY]);
 /* The rates of y on the flank `contact` (0: in flight) under the input u [V]. */
 void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], double dy[NY]);
-/* The event function `code` at y (> 0: nothing happens). */
-double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY]);
 /* m/s2: the scale of the follower's relative acceleration at y (the Zeno guard's and the rebound's). */
 double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u);
 /* On the flank `contact` at y: d = (s_cam, s', s'', s''') at the cam, omega_dot [rad/s2], the contact force P [N]
@@ -46,11 +44,8 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
               CamMode *mode);
 /* (cam_vf_rhs, cam_vf_codes, cam_vf_value: the model contract's, declared in cam_model.h.) */
 /* On the flank `contact`: the follower set on it, or lifted off at once where its contact force is already < 0: the
- * contact after. */
-int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact);
-/* On the flank `contact`: the follower set on it, or let go where the flank would pull (*left: the flank it lets
- * go of); the contact after. */
-int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left);
+ * contact after, *left (if not NULL) the flank it lets go of where it does. */
+int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact, int *left);
 /* A lift-off or touch-down `code` from `contact` at y at time [s]: the contact after (see voltage_follower.c). */
 int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact, double time, double *rebound,
                       int *left, long *dropped);

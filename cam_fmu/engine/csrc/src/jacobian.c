@@ -9,11 +9,6 @@
 
 #include "cam_model.h"
 
-static double sign_of(double x)
-{
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
-}
-
 /* The guide friction f = mu (side n0 + N_g) / (1 - side mu sigma kappa) (cam_guide_friction, model.c) on the branch
  * side (0: the one that holds there) and its tangent *df from those of n0 and kappa. */
 static double friction_tangent(const CamModel *m, double n0, double dn0, double kappa, double dkappa, double sigma,
@@ -49,7 +44,7 @@ double cam_flank_tangent(const CamModel *m, const double d[4], double omega, dou
     *f_out = *df_out = 0.0;
     if (m->mu == 0.0)
         return dx0;
-    sigma = sign_of(s1 * dir);
+    sigma = cam_sign(s1 * dir);
     tan_a = s1 / base;
     dtan = (ds1 * base - s1 * s1 * dtheta) / (base * base);
     n0 = (inertial + m->m * s1 * x0) * tan_a + m->G_y;
@@ -156,7 +151,7 @@ int cam_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_NX], 
         a = d[2] * w * w + s1 * omega_dot;
         da = d[2] * dtheta * w * w + 2.0 * d[2] * w * dw + ds1 * omega_dot + s1 * domega_dot;
         push = m->m * a - m->F_gx + F;   /* cam_load: the friction at the axial force, on the branch that holds */
-        sigma = sign_of(s1 * (moving ? mode->direction : 0.0));
+        sigma = cam_sign(s1 * (moving ? mode->direction : 0.0));
         f = friction_tangent(m, push * t + m->G_y, (m->m * da + dF) * t + push * dt, t, dt, sigma, 0.0, &df);
         along = push + sigma * f;
         dalong = m->m * da + dF + sigma * df;

@@ -48,7 +48,7 @@ static double lever_rate(const CamModel *m, const double q[4])
         t = tan(m->delta0 + q[0]);
         return (1.0 + t * t) * q[1] * (1.0 - q[1]) - t * q[2];
     }
-    return (q[1] > 0.0 ? 1.0 : (q[1] < 0.0 ? -1.0 : 0.0)) * q[2];
+    return cam_sign(q[1]) * q[2];
 }
 
 double cam_kind_branch(const CamModel *m, const double q[4], double omega, double drive, double direction,
@@ -87,7 +87,7 @@ void cam_kind_contact_load(const CamModel *m, const double q[4], double P, doubl
         double delta = m->delta0 + q[0], d = m->pivot_distance, L = m->arm_length, turn = q[1] * direction;
         alpha = atan2(d * cos(delta) - L * (1.0 - q[1]), d * sin(delta));
         /* the contact supplies P and the pivot's friction against the arm's turn */
-        N = (m->mu != 0.0 ? P + m->mu * fabs(P) * (turn > 0.0 ? 1.0 : (turn < 0.0 ? -1.0 : 0.0)) : P)
+        N = (m->mu != 0.0 ? P + m->mu * fabs(P) * cam_sign(turn) : P)
             / (L * cos(alpha));
     } else if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_FLAT) {   /* the face at l from the pivot (15.2) */
         N = P * (1.0 - q[1]) / (m->pivot_distance * cos(m->delta0 + q[0]));
@@ -150,9 +150,6 @@ static int wedge_check(const CamModel *m, CamError *err)
     return CAM_OK;
 }
 
-/* The refusals of geometry that cannot be built whose limits are closed forms (kinematics/follower_checks.py and
- * the cam classes' constructors): the arm cannot reach the cam, the pivot inside the base circle, an arm turned to
- * the pressure angle's 90 deg or a face past the perpendicular. */
 /* Geometry that the contour on a 0.1 deg grid cannot build (kinematics/follower_checks.py refuse_unbuildable): a
  * roller arm's cam sweeping over its pivot (the roller's centre sqrt(d^2 + L^2 - 2 d L cos(delta)) from the cam axis,
  * the cam built on its pitch curve), an oscillating face turning faster than the cam (psi' >= 1: the contact runs off
@@ -206,6 +203,9 @@ static int contour_check(const CamModel *m, CamError *err)
     return CAM_OK;
 }
 
+/* The refusals of geometry that cannot be built whose limits are closed forms (kinematics/follower_checks.py and
+ * the cam classes' constructors): the arm cannot reach the cam, the pivot inside the base circle, an arm turned to
+ * the pressure angle's 90 deg or a face past the perpendicular; then the contour's and the friction's. */
 int cam_kind_check(const CamModel *m, CamError *err)
 {
     double L = m->arm_length, d = m->pivot_distance, r_b = m->r_b, lift_angle = m->params.v[CAM_P_LIFT_ANGLE], top;
@@ -336,11 +336,11 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     if (engaged) {   /* cam_kind_load at the state's omega_dot */
         P = A + m->I_f * q[1] * omega_dot;
         dP = dA + m->I_f * (q[2] * dtheta * omega_dot + q[1] * domega_dot);
-        sP = P > 0.0 ? 1.0 : (P < 0.0 ? -1.0 : 0.0);
+        sP = cam_sign(P);
         Pc = P;   /* the roller arm's contact supplies P and the pivot's friction against the arm's turn */
         dPc = dP;
         if (m->mu != 0.0 && m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {
-            double turn = q[1] * d, st = turn > 0.0 ? 1.0 : (turn < 0.0 ? -1.0 : 0.0);
+            double turn = q[1] * d, st = cam_sign(turn);
             Pc = P + m->mu * fabs(P) * st;
             dPc = dP + m->mu * sP * dP * st;
         }

@@ -17,7 +17,7 @@ typedef struct {
     double x0, J, sigma, f, n0, kappa;
 } Terms;
 
-static double sign_of(double x)
+double cam_sign(double x)
 {
     return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
 }
@@ -56,7 +56,7 @@ static void load_terms(const CamModel *m, double theta, double omega, double dri
     t->x0 = (drive - inertial * s1) / J;
     if (m->mu == 0.0)
         return;
-    t->sigma = sign_of(s1 * direction);
+    t->sigma = cam_sign(s1 * direction);
     tan_a = s1 / (m->r_b + s);
     t->n0 = (inertial + mass * s1 * t->x0) * tan_a + m->G_y;
     t->kappa = m->J_0 / J * tan_a;
@@ -217,7 +217,7 @@ void cam_load(const CamModel *m, double theta, double omega, double omega_dot, d
     }
     v = s1 * omega;
     a = d[2] * omega * omega + s1 * omega_dot;
-    sigma = sign_of(s1 * direction);
+    sigma = cam_sign(s1 * direction);
     push = m->m * a - m->F_gx + axial;   /* N: axial force without friction */
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     out->M = shaft + (push + sigma * f) * s1;

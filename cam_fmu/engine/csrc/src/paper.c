@@ -13,11 +13,6 @@
 
 #include "cam_drive.h"
 
-static double sign(double x)
-{
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
-}
-
 static double quasi_static_current(const CamModel *m, double u, double omega)
 {
     return (u - m->c_e * omega) / m->R;
@@ -109,13 +104,13 @@ static int scheme_step(CamDrive *d, double T, double u, long budget, long *used,
     /* shaft friction with its sign, or stuck this step (stiction, which the paper leaves out) */
     stuck = 0;
     if (p->omega != 0.0) {
-        shaft = m->M_f * sign(p->omega);
+        shaft = m->M_f * cam_sign(p->omega);
     } else {
         net = drive - p->M_l;
         if (fabs(net) <= m->M_f)
             stuck = 1;
         else
-            shaft = m->M_f * sign(net);
+            shaft = m->M_f * cam_sign(net);
     }
     omega_old = p->omega;
     if (!stuck) {
@@ -154,12 +149,12 @@ static int scheme_step(CamDrive *d, double T, double u, long budget, long *used,
     tan_a = s1 / (m->r_b + s_cam);
     p->alpha = atan(tan_a);
     push = m->m * p->a - m->F_gx;
-    sigma = sign(p->v);
+    sigma = cam_sign(p->v);
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);
     p->M_l = (push + sigma * f) * X;
     /* step 8: eq. (4) */
     p->J = m->J_0 + m->m * X * X;
-    p->M = m->M_f * sign(p->omega) + p->M_l;
+    p->M = m->M_f * cam_sign(p->omega) + p->M_l;
     return CAM_OK;
 }
 
@@ -227,7 +222,7 @@ static int paper_advance(CamDrive *d, double h, double time, long *steps, CamErr
  * the profile (it moved in the last calculation step, v != 0, or c = 0); 0 while it rests in the clearance. */
 static double paper_contact_force(const CamModel *m, const CamPaperState *p, const double dd[4])
 {
-    double tan_a = dd[1] / (m->r_b + dd[0]), push = m->m * p->a - m->F_gx, sigma = sign(p->v), f;
+    double tan_a = dd[1] / (m->r_b + dd[0]), push = m->m * p->a - m->F_gx, sigma = cam_sign(p->v), f;
     if (p->v == 0.0 && m->c > 0.0)
         return 0.0;
     f = cam_guide_friction(push * tan_a + m->G_y, tan_a, sigma, m->mu, m->N_g, 0.0);

@@ -144,7 +144,7 @@ double cam_motion_sign(double omega, double omega_ref, double omega_dot_ref, dou
 {
     double stop = 1e-12 * (t > 1.0 ? t : 1.0) * fabs(omega_dot_ref) + 4.0 * DBL_EPSILON * fabs(omega_ref);
     double x = fabs(omega) <= stop ? omega_ref : omega;
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
+    return cam_sign(x);
 }
 
 /* speed.speed_drive_outputs: c_m i = J_0 omega_dot + M (J_0 = J_m + J_cam); the voltage adds L di/dt, di/dt = omega dM/dtheta

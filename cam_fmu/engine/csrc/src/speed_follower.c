@@ -11,11 +11,6 @@
 #include "cam_solver.h"
 #include "cam_voltage_follower.h"
 
-static double sgn(double x)
-{
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
-}
-
 /* The step of omega to the input omega_ref at the step's start (physics.speed_follower.speed_step): the flank's
  * speed jumps, the follower's does not; a flank now moving away lets it fly on, one moving into it strikes it;
  * below the Zeno guard's relative speed it stays on; in flight its gap's rate is taken from the new flank's. */
@@ -30,7 +25,7 @@ static void speed_step(CamDrive *d, double time)
         return;
     d->solver.k1_valid = 0;   /* f at the step's start moved with the speed */
     y[1] = omega;
-    y[Y_DIR] = omega != 0.0 ? sgn(omega) : sgn(u);
+    y[Y_DIR] = omega != 0.0 ? cam_sign(omega) : cam_sign(u);
     if (contact) {
         cam_kind_eval(m, y[0], q);
         w = y[4] - q[1] * omega;
@@ -80,7 +75,7 @@ static void sf_set_inputs(CamDrive *d, double u, double omega_ref, double omega_
     d->x[CAM_OMEGA] = omega_ref;
     d->mode.stuck = omega_ref == 0.0;
     if (omega_ref != 0.0)
-        d->mode.direction = sgn(omega_ref);
+        d->mode.direction = cam_sign(omega_ref);
     d->form_u = omega_dot_ref;
     cam_vf_start(d, omega_dot_ref);
 }
@@ -109,7 +104,7 @@ static void sf_outputs(CamDrive *d, double out[])
     if (d->mode.contact != 0 && m->L > 0.0 && out[CAM_O_OMEGA] != 0.0) {
         double ahead, behind;
         cam_vf_y(m, &d->mode, d->x, y);
-        y[Y_DIR] = sgn(out[CAM_O_OMEGA]);
+        y[Y_DIR] = cam_sign(out[CAM_O_OMEGA]);
         y[0] += step;
         ahead = cam_vf_flank_torque(m, y, omega_dot, d->mode.contact);
         y[0] -= 2.0 * step;

@@ -155,7 +155,7 @@ static void settle_motion(const CamModel *m, CamMode *mode, double x[CAM_NX], do
                 rate = cam_torque(m, 0.0, x[CAM_CURRENT], u) - torque;
             if (m->compliant && rate == 0.0 && m->has_current)   /* no torque yet: where the current heads */
                 rate = (u - m->R * x[CAM_CURRENT] - m->c_e * 0.0) / m->L;
-            direction = rate > 0.0 ? 1.0 : (rate < 0.0 ? -1.0 : 0.0);
+            direction = cam_sign(rate);
         } else {
             direction = forward >= backward ? 1.0 : -1.0;
         }

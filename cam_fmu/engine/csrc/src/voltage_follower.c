@@ -37,12 +37,6 @@
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
 
-
-static double sgn(double x)
-{
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
-}
-
 /* N: the train's force F_train = k_train (s - x_e) + d_train (v - v_e) on its end mass, the follower at s [m] moving
  * at v [m/s]; its reaction loads the follower (docs/model.md 14.6; 0 without a train). */
 static double train_force(const CamModel *m, const double y[NY], double s, double v)
@@ -99,7 +93,7 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
     J = m->J_0 + m->I_f * d[1] * d[1];
     inertial = m->I_f * d[2] * omega * omega + F;
     x0 = m->prescribed ? u : (cam_vf_torque_toward(m, y, u, dir) - inertial * d[1]) / J;
-    sigma = sgn(d[1] * dir);
+    sigma = cam_sign(d[1] * dir);
     tan_a = d[1] / (m->r_b + d[0]);
     kappa = m->prescribed ? tan_a : m->J_0 / J * tan_a;
     n0 = (inertial + m->I_f * d[1] * x0) * tan_a + m->G_y;
@@ -161,9 +155,9 @@ double cam_vf_flight_direction(const CamModel *m, const double y[NY])
 {
     double net;
     if (y[4] != 0.0)
-        return sgn(y[4]);
+        return cam_sign(y[4]);
     net = -closing_at(m, y, y[3], 0.0);
-    return fabs(net) > cam_follower_friction0(m) ? sgn(net) : 0.0;
+    return fabs(net) > cam_follower_friction0(m) ? cam_sign(net) : 0.0;
 }
 
 /* A train's end mass: its rates under the follower at s [m] moving at v [m/s] (held at 0 without a train). */
@@ -216,27 +210,6 @@ void cam_vf_set_on_flank(const CamModel *m, double y[NY], int contact)
     y[4] = d[1] * y[1];
 }
 
-/* The event function `code` at y on or off the flank `contact` (> 0: nothing happens). */
-double cam_vf_event_value(const CamModel *m, double u, int code, int contact, const double y[NY])
-{
-    double d[4], omega_dot, P;
-    if (code == EV_STOP)
-        return y[Y_DIR] * y[1];
-    if (code == EV_BREAK_AWAY)
-        return -cam_vf_breakaway(m, y, u, contact, &omega_dot);
-    if (code == EV_LIFT_OFF) {
-        cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P, NULL);
-        return contact * P;
-    }
-    if (code == EV_HALT && y[Y_SIGMA] == 0.0)   /* held by the guide: released where a train's pull beats f0 */
-        return cam_follower_friction0(m) + RELEASE_MARGIN - fabs(closing_at(m, y, y[3], 0.0));
-    if (code == EV_HALT)
-        return y[Y_SIGMA] * y[4];
-    cam_kind_eval(m, y[0], d);
-    return code == EV_TOUCH_UP ? y[3] - (d[0] - cam_follower_clearance(m)) + CAM_TOUCH / cam_follower_length(m)
-                               : (d[0] + cam_follower_clearance(m)) - y[3] + CAM_TOUCH / cam_follower_length(m);
-}
-
 /* m/s2: a bound of the follower's acceleration relative to the flank near y (voltage_follower.acceleration_scale). */
 double cam_vf_acceleration_scale(const CamModel *m, const double y[NY], double u)
 {
@@ -281,7 +254,7 @@ void cam_vf_x(const CamModel *m, const double y[NY], double u, int contact, int 
         double P, n_r, omega_dot;
         if (y[Y_DIR] != 0.0 && m->mu > 0.0 && !m->prescribed) {   /* imposed motion: P's kink changes nothing */
             cam_vf_on_flank(m, y, u, contact, dd, &omega_dot, &P, &n_r);
-            mode->side = sgn(n_r);
+            mode->side = cam_sign(n_r);
         }
         return;
     }
@@ -364,15 +337,27 @@ int cam_vf_codes(const CamModel *m, const CamMode *mode, int codes[CAM_MAX_EVENT
 void cam_vf_values(const CamModel *m, const CamMode *mode, int n, const int codes[], const double x[CAM_NX],
                    double u, double g[])
 {
-    double y[NY], d[4], omega_dot, P = NAN, n_r = NAN;
-    int k;
-    working_y(m, mode, x, y, d);
+    double y[NY], d[4], omega_dot, P = NAN, n_r = NAN, dir, c = cam_follower_clearance(m);
+    double touch = CAM_TOUCH / cam_follower_length(m);
+    int k, code;
+    working_y(m, mode, x, y, d);   /* in flight d is the cam's q at theta */
     for (k = 0; k < n; k++) {
-        if ((codes[k] == EV_LIFT_OFF || codes[k] == EV_SIDE) && P != P)   /* the flank's forces, once */
+        code = codes[k];
+        if ((code == EV_LIFT_OFF || code == EV_SIDE) && P != P)   /* the flank's forces, once */
             cam_vf_on_flank(m, y, u, mode->contact, d, &omega_dot, &P, &n_r);
-        g[k] = codes[k] == EV_LIFT_OFF ? mode->contact * P
-               : (codes[k] == EV_SIDE ? mode->side * n_r + CAM_SIDE_HYSTERESIS
-                                      : cam_vf_event_value(m, u, codes[k], mode->contact, y));
+        if (code == EV_LIFT_OFF)
+            g[k] = mode->contact * P;
+        else if (code == EV_SIDE)
+            g[k] = mode->side * n_r + CAM_SIDE_HYSTERESIS;
+        else if (code == EV_STOP)
+            g[k] = y[Y_DIR] * y[1];
+        else if (code == EV_BREAK_AWAY)
+            g[k] = -cam_vf_breakaway(m, y, u, mode->contact, &dir);
+        else if (code == EV_HALT)   /* held by the guide (sigma 0): released where a train's pull beats f0 */
+            g[k] = y[Y_SIGMA] == 0.0 ? cam_follower_friction0(m) + RELEASE_MARGIN - fabs(closing_at(m, y, y[3], 0.0))
+                                     : y[Y_SIGMA] * y[4];
+        else
+            g[k] = code == EV_TOUCH_UP ? y[3] - (d[0] - c) + touch : (d[0] + c) - y[3] + touch;
     }
 }
 
@@ -459,26 +444,25 @@ static void relax_train(const CamModel *m, double y[NY], int contact)
  * rest decided by its rule) under the input u (the voltage, or the speed drive's imposed acceleration). */
 void cam_vf_start(CamDrive *d, double u)
 {
+    const CamModel *m = &d->model;
+    double y[NY], other[NY];
+    int contact, left = 1;
     d->mode.contact = CAM_ON_LOWER_FLANK;   /* or (a groove) on its upper flank where that one holds */
     d->mode.left = CAM_ON_LOWER_FLANK;
     d->mode.s_free = 0.0;
     d->x[CAM_GAP] = d->x[CAM_RATE] = 0.0;
-    {
-        double y[NY], other[NY];
-        int contact, left = 1;
-        cam_vf_y(&d->model, &d->mode, d->x, y);
-        relax_train(&d->model, y, 1);
-        contact = cam_vf_settle(&d->model, y, u, 1);
-        if (!contact && d->model.closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
-            memcpy(other, y, sizeof other);
-            relax_train(&d->model, other, -1);
-            if ((contact = cam_vf_settle(&d->model, other, u, -1)) != 0)
-                memcpy(y, other, sizeof other);
-        }
-        if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
-            cam_vf_at_rest(&d->model, y, u, &contact, &left, 0);
-        cam_vf_x(&d->model, y, u, contact, contact != 0 ? contact : left, d->x, &d->mode);
+    cam_vf_y(m, &d->mode, d->x, y);
+    relax_train(m, y, 1);
+    contact = cam_vf_settle(m, y, u, 1, NULL);
+    if (!contact && m->closure == CAM_CHOICE_CLOSURE_FORM) {   /* a groove: its other flank, if it holds */
+        memcpy(other, y, sizeof other);
+        relax_train(m, other, -1);
+        if ((contact = cam_vf_settle(m, other, u, -1, NULL)) != 0)
+            memcpy(y, other, sizeof other);
     }
+    if (y[Y_DIR] == 0.0)   /* with the input's start value; the first step decides again with the host's */
+        cam_vf_at_rest(m, y, u, &contact, &left, 0);
+    cam_vf_x(m, y, u, contact, contact != 0 ? contact : left, d->x, &d->mode);
     d->solver.k1_valid = 0;
 }
 

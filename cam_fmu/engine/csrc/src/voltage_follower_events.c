@@ -8,19 +8,6 @@
 
 #include "cam_voltage_follower.h"
 
-/* The impact of the follower on the flank at y with restitution e: y's omega and v after (follower.impact). */
-static void impact(const CamModel *m, double y[NY], double s1, double e)
-{
-    double w = y[4] - s1 * y[1], m_eff = m->I_f * m->J_0 / (m->J_0 + m->I_f * s1 * s1);
-    if (m->prescribed) {   /* the speed drive's cam (J_0 = inf): its speed is kept */
-        y[4] -= (1.0 + e) * w;
-        return;
-    }
-    double P = -(1.0 + e) * m_eff * w;
-    y[4] += P / m->I_f;
-    y[1] -= s1 * P / m->J_0;
-}
-
 /* A stuck cam struck by the follower: its static friction, a finite force, gives no impulse; the cam moves off
  * where the impact turned it (omega != 0; on a dwell, s' = 0, it stays stuck). A turning cam the impact turns back
  * (a light cam, a heavy follower) moves on the new way: its shaft's friction turns with it (held the old way,
@@ -31,6 +18,22 @@ static void unstick(double y[NY])
         y[Y_DIR] = y[1] > 0.0 ? 1.0 : -1.0;
 }
 
+/* The impact of the follower on the flank `flank` at y (the cam's d = q at theta) with restitution e: y's follower
+ * on the flank, omega and v after (follower.impact), the shaft's direction unstuck. */
+static void impact(const CamModel *m, double y[NY], const double d[4], int flank, double e)
+{
+    double w = y[4] - d[1] * y[1], m_eff = m->I_f * m->J_0 / (m->J_0 + m->I_f * d[1] * d[1]), P;
+    y[3] = d[0] - flank * cam_follower_clearance(m);
+    P = -(1.0 + e) * m_eff * w;
+    if (m->prescribed) {   /* the speed drive's cam (J_0 = inf): its speed is kept */
+        y[4] -= (1.0 + e) * w;
+    } else {
+        y[4] += P / m->I_f;
+        y[1] -= d[1] * P / m->J_0;
+    }
+    unstick(y);
+}
+
 /* A touch-down on the flank `flank` at y (voltage_follower.land): the contact after; y's follower on the flank,
  * omega and v after. */
 static int land(const CamModel *m, double y[NY], double u, int flank, double *rebound)
@@ -38,42 +41,33 @@ static int land(const CamModel *m, double y[NY], double u, int flank, double *re
     double d[4], before[NY], w, omega_dot, P, scale = cam_vf_acceleration_scale(m, y, u);
     memcpy(before, y, sizeof before);
     cam_kind_eval(m, y[0], d);
-    y[3] = d[0] - flank * cam_follower_clearance(m);
-    impact(m, y, d[1], m->restitution);
-    unstick(y);
+    impact(m, y, d, flank, m->restitution);
     w = y[4] - d[1] * y[1];
     if (w * w >= 2.0 * scale * (CAM_ZENO_HEIGHT / cam_follower_length(m))) {
         *rebound = w != 0.0 ? fabs(w) / (2.0 * cam_vf_acceleration_scale(m, y, u)) : 0.0;
         return 0;
     }
     memcpy(y, before, sizeof before);   /* plastic: the flank holds it where its force points away */
-    y[3] = d[0] - flank * cam_follower_clearance(m);
-    impact(m, y, d[1], 0.0);
-    unstick(y);
+    impact(m, y, d, flank, 0.0);
     y[4] = d[1] * y[1];
     cam_vf_on_flank(m, y, u, flank, d, &omega_dot, &P, NULL);
     return flank * P >= 0.0 ? flank : 0;
 }
 
 /* On the flank `contact`: the follower set on it, or lifted off at once where contact P is already < 0 (a jump of
- * s''): the contact after. */
-int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact)
+ * s''): the contact after; *left (left NULL: not kept) the flank it lets go of where it does. */
+int cam_vf_settle(const CamModel *m, double y[NY], double u, int contact, int *left)
 {
     double d[4], omega_dot, P;
     if (!contact)
         return 0;
     cam_vf_set_on_flank(m, y, contact);
     cam_vf_on_flank(m, y, u, contact, d, &omega_dot, &P, NULL);
-    return contact * P >= 0.0 ? contact : 0;
-}
-
-/* settle, and *left the flank the follower lets go of where it does. */
-int cam_vf_settle_from(const CamModel *m, double y[NY], double u, int contact, int *left)
-{
-    int after = cam_vf_settle(m, y, u, contact);
-    if (contact && !after)
+    if (contact * P >= 0.0)
+        return contact;
+    if (left != NULL)
         *left = contact;
-    return after;
+    return 0;
 }
 
 /* The lift-off or touch-down `code` from the contact `contact` at y at time [s] (a touch-down: the impact and the
@@ -113,19 +107,13 @@ int cam_vf_transition(CamDrive *d, double y[NY], double u, int code, int contact
  * the follower go (the cam stuck, it flies alone and lands on the cam at rest). */
 void cam_vf_at_rest(const CamModel *m, double y[NY], double u, int *contact, int *left, int at_threshold)
 {
-    double dir, margin;
+    double dir;
     y[1] = 0.0;
-    y[Y_DIR] = 0.0;
-    if (m->prescribed) {   /* the speed drive: the imposed acceleration u turns it (0: at rest) */
-        y[Y_DIR] = u > 0.0 ? 1.0 : (u < 0.0 ? -1.0 : 0.0);
-        *contact = cam_vf_settle_from(m, y, u, *contact, left);
-        return;
-    }
-    *contact = cam_vf_settle_from(m, y, u, *contact, left);
-    margin = cam_vf_breakaway(m, y, u, *contact, &dir);
-    if (margin > 0.0 || at_threshold) {
+    y[Y_DIR] = m->prescribed ? cam_sign(u) : 0.0;   /* the speed drive: u turns it */
+    *contact = cam_vf_settle(m, y, u, *contact, left);
+    if (!m->prescribed && (cam_vf_breakaway(m, y, u, *contact, &dir) > 0.0 || at_threshold)) {
         y[Y_DIR] = dir;
-        *contact = cam_vf_settle_from(m, y, u, *contact, left);
+        *contact = cam_vf_settle(m, y, u, *contact, left);
     }
 }
 
@@ -150,7 +138,7 @@ void cam_vf_event_update(CamDrive *d, double y[NY], double u, int code, int *con
         y[4] = 0.0;   /* the friction turns, or holds the follower (its direction at the next step) */
     } else if (code == EV_LIFT_OFF || code == EV_TOUCH_UP || code == EV_TOUCH_DOWN) {
         *contact = cam_vf_transition(d, y, u, code, *contact, time, rebound, left, dropped);
-    } else if (*contact && !(*contact = cam_vf_settle_from(&d->model, y, u, *contact, left))) {
+    } else if (*contact && !(*contact = cam_vf_settle(&d->model, y, u, *contact, left))) {
         cam_follower_note(d->step_events, sizeof d->step_events, dropped, "follower: lift-off at t = %.9g s "
                           "(theta = %.6g rad); ", time, y[0]);
     }
