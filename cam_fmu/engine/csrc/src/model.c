@@ -17,11 +17,6 @@ typedef struct {
     double x0, J, sigma, f, n0, kappa;
 } Terms;
 
-double cam_sign(double x)
-{
-    return x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
-}
-
 double cam_normal_force(double along_x, double tan_a)
 {
     return along_x * sqrt(1.0 + tan_a * tan_a);

@@ -77,7 +77,7 @@ double cam_vf_torque_toward(const CamModel *m, const double y[NY], double u, dou
 static void flank_toward(const CamModel *m, const double y[NY], double u, int contact, double dir, double d[4],
                          double *omega_dot, double *P, double *n_r)
 {
-    double omega = y[1], F, J, inertial, x0, sigma, tan_a, kappa, n0, f = 0.0;
+    double omega = y[1], F, J, inertial, x0, sigma = 0.0, tan_a, kappa = 0.0, n0 = 0.0, f = 0.0;
     int guided = m->mu != 0.0 && m->kind == CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER;   /* the guide's friction */
     cam_kind_eval(m, y[0], d);
     F = closing_at(m, y, d[0] - contact * cam_follower_clearance(m), d[1] * omega);
@@ -93,12 +93,13 @@ static void flank_toward(const CamModel *m, const double y[NY], double u, int co
     J = m->J_0 + m->I_f * d[1] * d[1];
     inertial = m->I_f * d[2] * omega * omega + F;
     x0 = m->prescribed ? u : (cam_vf_torque_toward(m, y, u, dir) - inertial * d[1]) / J;
-    sigma = cam_sign(d[1] * dir);
-    tan_a = d[1] / (m->r_b + d[0]);
-    kappa = m->prescribed ? tan_a : m->J_0 / J * tan_a;
-    n0 = (inertial + m->I_f * d[1] * x0) * tan_a + m->G_y;
-    if (guided)
+    if (guided) {
+        sigma = cam_sign(d[1] * dir);
+        tan_a = d[1] / (m->r_b + d[0]);
+        kappa = m->prescribed ? tan_a : m->J_0 / J * tan_a;
+        n0 = (inertial + m->I_f * d[1] * x0) * tan_a + m->G_y;
         f = cam_guide_friction(n0, kappa, sigma, m->mu, m->N_g, 0.0);
+    }
     *omega_dot = m->prescribed ? u : x0 - sigma * f * d[1] / J;
     *P = m->I_f * (d[2] * omega * omega + d[1] * *omega_dot) + F + sigma * f;
     *n_r = guided ? n0 + sigma * kappa * f : 0.0;
