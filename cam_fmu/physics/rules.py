@@ -146,8 +146,9 @@ TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
 # The follower's kind (docs/model.md 16): an arm's fields with their units, the arm's three it needs first.
 OSCILLATING = Is("follower_type", ("oscillating_roller", "oscillating_flat"))
 OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
-# The translating flat's train (docs/model.md 14.6): its path is s, as the roller's; on the cam only so far.
-FLAT_TRAIN = AllOf(Is("follower_type", ("translating_flat",)), Not(OWN_FOLLOWER))
+# The translating flat's train (docs/model.md 14.6): its path is s, as the roller's, on the cam and on a follower of
+# its own.
+FLAT_TRAIN = Is("follower_type", ("translating_flat",))
 ARM_UNITS = (("arm_length", "m"), ("pivot_distance", "m"), ("lift_angle", "rad"), ("J_arm", "kg.m2"),
              ("m_arm", "kg"), ("r_cm_arm", "m"), ("psi_0", "rad"))
 
@@ -224,7 +225,7 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, AllOf(TRAIN, Not(FLAT_TRAIN)),
                                  AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
          "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train (but the "
-         "translating flat's on the cam) and a solver other than 'etdrk4' (which integrates the roller's electrical "
+         "translating flat's) and a solver other than 'etdrk4' (which integrates the roller's electrical "
          "pole) so far; allowed with k_shaft = {k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: "
          "'translating_roller'"),
     Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),

@@ -11,7 +11,11 @@ from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import ParameterError, defaults
 from cam_fmu.physics.signals import Signal
 from cam_fmu.reference.integrate import simulate_reference
+from cam_fmu.experiments.engine_runs import simulate_engine
 from tests.engine.test_engine_train import STEP, STOP, TRAIN, engine_run, speed_run, worst
+from tests.engine.test_engine_train_own_follower import CLOSURES as OWN_CLOSURES, COAST, SCENE as OWN_SCENE
+from tests.engine.test_engine_train_own_follower import stored_energy
+from tests.engine.test_engine_train_speed_follower import TRAIN as SPEED_TRAIN, runs as speed_runs
 
 FLAT = dict(follower_type="translating_flat")
 # N_contact is the geometry's (the flat's P, the roller's P / cos(alpha)): not compared
@@ -56,8 +60,50 @@ def test_the_flat_s_train_keeps_its_energy_balance_with_friction():
     assert np.max(np.abs(gap)) < 5e-5 * np.max(np.abs(integral(np.abs(work)))), np.max(np.abs(gap))
 
 
-@pytest.mark.parametrize("extra", [dict(closure="spring", m=1.0, k_spring=1e3, F_spring0=20.0),
-                                   dict(follower_type="oscillating_roller")], ids=["own-follower", "arm"])
-def test_a_train_not_run_yet_is_refused_by_name(extra):
+def test_a_train_not_run_yet_is_refused_by_name():
+    """An arm's train is torsional, under parameters of its own (not built yet): k_train on an arm is refused."""
     with pytest.raises(ParameterError, match="follower_type"):
-        DriveSimulator(dict(defaults(), **TRAIN, **dict(FLAT, **extra)))
+        DriveSimulator(dict(defaults(), **TRAIN, **dict(FLAT, follower_type="oscillating_roller")))
+
+
+def test_the_flat_s_train_on_a_follower_of_its_own_flies_as_the_roller_reference_without_friction():
+    """The voltage drive, closure 'spring', the train pulling the follower off (reference/train_flight.py's roller,
+    written apart): measured theta 2.7e-12 rad, s 6.7e-13 m, s_end 5.4e-13 m, F_train 1.2e-8 N, M 2.5e-10 N m, with
+    234 of 501 samples in flight and 4 touch-downs."""
+    params = dict(defaults(), **OWN_SCENE, **OWN_CLOSURES["spring"], d_train=2.0)
+    reference = simulate_reference(params, 0.5, 1e-3, u=None)
+    engine = simulate_engine(dict(params, **FLAT), 0.5, 1e-3)
+    assert np.sum(reference["contact"] == 0.0) > 100 and reference["impacts"][-1] >= 2.0   # it flies and lands
+    for name, bound in (("theta", 1e-11), ("s", 5e-12), ("s_end", 5e-12), ("F_train", 1e-7), ("M", 2e-9)):
+        error = np.max(np.abs(engine[name] - reference[name]))
+        assert error < bound, (name, error)
+    assert np.array_equal(engine["N_contact"] == 0.0, reference["contact"] == 0.0)
+
+
+@pytest.mark.parametrize("scene_name, label", [("spring_jump", "above_1.02"), ("groove_crossover", "form")])
+def test_the_speed_drive_s_flat_with_a_train_flies_as_the_roller_reference_without_friction(scene_name, label):
+    """The speed drive's follower of its own (reference/train_flight.py's TrainSpeedFollowerRun for the roller):
+    measured s within 1.9e-11 m, F_train 2.5e-7 N, M 1.8e-8 N m past the jump; 3.6e-11 m, 6.6e-7 N, 4.4e-8 N m across
+    the groove (the roller's own agreement there: 3.3e-11 m, 6.2e-7 N)."""
+    got, ref = speed_runs(scene_name, label, dict(SPEED_TRAIN, mu=0.0), dict(FLAT))
+    assert np.any(ref["contact"] == 0.0) and ref["impacts"][-1] >= 1.0
+    for name, bound in (("s", 2e-10), ("s_end", 2e-10), ("F_train", 4e-6), ("M", 3e-7), ("theta", 1e-12)):
+        error = np.max(np.abs(got[name] - ref[name]))
+        assert error < bound, (name, error)
+
+
+def test_a_coasting_flat_on_a_follower_of_its_own_keeps_its_energy_with_the_train():
+    """Restitution 1, an undamped train, no friction, no motor torque, 0.5 s in the groove: the stored energy the
+    test writes from the outputs (test_engine_train_own_follower.stored_energy, the flat's s, v being the roller's)
+    stays constant through flights and impacts: measured 5.0e-10 J of 0.92 J through 77 touch-downs."""
+    p = dict(defaults(), **OWN_SCENE, **OWN_CLOSURES["form"], **COAST, **FLAT)
+    sim = DriveSimulator(p)
+    sim.set_inputs(0.0, 0.0, 0.0)
+    rows = [sim.outputs()]
+    for k in range(500):
+        sim.do_step(k * 1e-3, 1e-3, u=0.0, omega_ref=0.0, omega_dot_ref=0.0)
+        rows.append(sim.outputs())
+    energy = np.array([stored_energy(p, out) for out in rows])
+    assert np.max(np.abs(energy - energy[0])) < 5e-8 * energy[0]
+    assert sum(event["name"].startswith("engage") for event in sim.events()) >= 20
+    assert np.ptp([out["F_train"] for out in rows]) > 10.0   # N: the train rings

@@ -14,13 +14,15 @@ from cam_fmu.reference import simulate_reference
 TRAIN = dict(k_train=2e4, d_train=2.0, m_end=0.1)   # N/m, N.s/m, kg: 71 Hz on the held follower
 
 
-def runs(scene_name: str, label: str, change: dict, interval: float = 1e-3) -> tuple[dict, dict]:
-    """(engine, reference) outputs of a scene's run with ``change``, on the same grid."""
+def runs(scene_name: str, label: str, change: dict, engine_change: dict | None = None,
+         interval: float = 1e-3) -> tuple[dict, dict]:
+    """(engine, reference) outputs of a scene's run with ``change`` (the engine's with ``engine_change`` on top), on
+    the same grid."""
     scene = find_scene(scene_name)
     run = next(r for r in scene.runs if r.label == label)
     params = dict(run.overrides, **change)
     ref = simulate_reference(params, scene.stop_time, interval, omega_ref=scene.omega_ref)
-    got = simulate_engine(params, scene.stop_time, interval, omega_ref=scene.omega_ref)
+    got = simulate_engine(dict(params, **(engine_change or {})), scene.stop_time, interval, omega_ref=scene.omega_ref)
     return got, ref
 
 

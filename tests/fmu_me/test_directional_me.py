@@ -133,6 +133,8 @@ _FLAT_SPRING = {**CYCLOID, "follower_type": "translating_flat", "mu": 0.05, "gam
                 "closure": "spring", "k_spring": 300.0, "F_spring0": 3.0, "omega0": 20.0}
 # A follower train on the follower of its own (docs/model.md 14.6): its end mass rings on the flank and in flight.
 _TRAIN = {"k_train": 2e4, "d_train": 5.0, "m_end": 0.2}
+# the flat face's on a spring whose preload holds it under the random states' pull of the train (up to 25 N)
+_FLAT_TRAIN = {**_FLAT_SPRING, **_TRAIN, "k_spring": 3000.0, "F_spring0": 40.0}
 FOLLOWER_CASES.update({
     "spring_train/contact": ({**_SPRING, **_TRAIN}, "contact", 0.0),
     "spring_train/stuck": ({**_SPRING, **_TRAIN, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
@@ -148,6 +150,9 @@ FOLLOWER_CASES.update({
     "arm_spring_L/flight": (_ARM_SPRING, "flight", 150.0),
     "flat_spring/contact": (_FLAT_SPRING, "contact", 0.0),
     "flat_spring/flight": (_FLAT_SPRING, "flight", 150.0),
+    "flat_spring_train/contact": (_FLAT_TRAIN, "contact", 0.0),
+    "flat_spring_train/stuck": ({**_FLAT_TRAIN, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
+    "flat_spring_train/flight": (_FLAT_TRAIN, "flight", 150.0),
 })
 
 

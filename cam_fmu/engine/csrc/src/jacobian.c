@@ -70,7 +70,6 @@ static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const do
                              &df);
 }
 
-/* The tangent of the motor's torque c_m i (L > 0) or c_m (u - c_e omega_m) / R (L = 0). */
 double cam_train_tangent(const CamModel *m, double ds, double dv, const double seed[CAM_NX])
 {
     return m->train ? m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]) : 0.0;
@@ -87,6 +86,7 @@ void cam_train_rows(const CamModel *m, const double seed[CAM_NX], double dF_rate
     dout[CAM_O_F_TRAIN] = dF_out;
 }
 
+/* The tangent of the motor's torque c_m i (L > 0) or c_m (u - c_e omega_m) / R (L = 0). */
 static double torque_tangent(const CamModel *m, double domega_m, double di, double du)
 {
     if (m->has_current)

@@ -301,8 +301,8 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         omega_dot = 0.0;
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
-    if (m->train && !own) {   /* a translating type's train (docs/model.md 14.6): its force along q = s */
-        force += cam_train_force(m, theta, w, x[CAM_X_END], x[CAM_V_END]);
+    if (m->train) {   /* a translating type's train (docs/model.md 14.6): its force along q = s at the follower */
+        force += m->k_train * (qf - x[CAM_X_END]) + m->d_train * (q[1] * w - x[CAM_V_END]);
         dF = cam_train_tangent(m, q[1] * dtheta, q[2] * dtheta * w + q[1] * dw, seed);
     }
     dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;
@@ -358,7 +358,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     dout[CAM_O_S_END] = dout[CAM_O_S];   /* without a train the end is the follower */
     dout[CAM_O_V_END] = dout[CAM_O_V];
     dout[CAM_O_A_END] = dout[CAM_O_A];
-    if (m->train && !own)   /* the end mass (model.c train_rhs) */
+    if (m->train)   /* the end mass (model.c train_rhs) */
         cam_train_rows(m, seed, dF, dF, ddx, dout);
     if (m->arm) {
         dout[CAM_O_PSI] = q[1] * dtheta;
