@@ -96,7 +96,9 @@ class KindDriveModel(DriveModel):
         refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0 and not self.free_follower),
                                          ("'k_shaft' (compliant shaft)", self.compliant),
                                          # the follower train as parameters (where the table has them)
-                                         ("'k_train' (follower train)", p.get("k_train", 0.0) > 0.0)) if on]
+                                         ("'k_train' (follower train)", p.get("k_train", 0.0) > 0.0),
+                                         ("'k_train_arm' (an arm's torsional train)",
+                                          p.get("k_train_arm", 0.0) > 0.0)) if on]
         if refused:
             raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam or as a body of its own "
                                  f"(closure 'spring', or 'form' with a clearance and a mass m > 0; docs/model.md "

@@ -225,8 +225,18 @@ FOLLOWER_KIND_PARAMETERS: tuple[ParameterSpec, ...] = (
     _P("psi_0", "rad", 0.0, "the arm's angle above the horizontal (of the cam's plane) at psi = 0", low=-math.pi,
        high=math.pi),
 )
+# An oscillating follower's train is torsional (docs/model.md 14.6): a torsion spring-damper from the arm to an end
+# inertia J_end, under parameters of their own units (no parameter changes unit with the type).
+ARM_TRAIN_PARAMETERS: tuple[ParameterSpec, ...] = (
+    _P("k_train_arm", "N.m/rad", 0.0, "an oscillating follower's torsional train stiffness between the arm and its end "
+       "inertia J_end (0: no train; docs/model.md 14.6)", low=0.0, high=1e9),
+    _P("d_train_arm", "N.m.s/rad", 0.0, "damping of the arm's torsional train (used only with k_train_arm > 0)",
+       low=0.0, high=1e6),
+    _P("J_end", "kg.m2", 0.0, "the arm's train's end inertia about its own axis (used only with k_train_arm > 0)",
+       low=0.0, high=1e3),
+)
 PARAMETERS: tuple[ParameterSpec, ...] = (_MODEL + _PROGRAM + _MODE + _SOLVER + FOLLOWER_PARAMETERS + TRAIN_PARAMETERS
-                                         + FOLLOWER_KIND_PARAMETERS)
+                                         + FOLLOWER_KIND_PARAMETERS + ARM_TRAIN_PARAMETERS)
 BY_NAME: dict[str, ParameterSpec] = {p.name: p for p in PARAMETERS}
 
 

@@ -143,6 +143,7 @@ FOLLOWER_MODEL = AnyOf(Is("drive", FOLLOWER_DRIVES), Is("formulation", VOLTAGE_F
 OWN_FOLLOWER = AnyOf(SPRING, AllOf(FORM, Cmp(CLEARANCE, ">"), Cmp(MASS, ">"), FOLLOWER_MODEL))
 COMPLIANT = Cmp(Num("k_shaft"), ">")
 TRAIN = Cmp(Num("k_train"), ">")   # the follower train (docs/model.md 14.6)
+ARM_TRAIN = Cmp(Num("k_train_arm"), ">")   # an arm's torsional train (14.6)
 # The follower's kind (docs/model.md 16): an arm's fields with their units, the arm's three it needs first.
 OSCILLATING = Is("follower_type", ("oscillating_roller", "oscillating_flat"))
 OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
@@ -150,7 +151,8 @@ OTHER_KIND = Not(Is("follower_type", ("translating_roller",)))
 # its own.
 FLAT_TRAIN = Is("follower_type", ("translating_flat",))
 ARM_UNITS = (("arm_length", "m"), ("pivot_distance", "m"), ("lift_angle", "rad"), ("J_arm", "kg.m2"),
-             ("m_arm", "kg"), ("r_cm_arm", "m"), ("psi_0", "rad"))
+             ("m_arm", "kg"), ("r_cm_arm", "m"), ("psi_0", "rad"), ("k_train_arm", "N.m/rad"),
+             ("d_train_arm", "N.m.s/rad"), ("J_end", "kg.m2"))
 
 PLASTIC = ("has plastic impacts only (docs/model.md 6.2); allowed with it: 0 (or closure 'form' or 'spring' in the "
            "consistent formulation)")
@@ -195,6 +197,15 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(Not(TRAIN), AnyOf(Cmp(Num("d_train"), "!="), Cmp(Num("m_end"), "!="))),
          "parameters 'd_train' = {d_train} N.s/m, 'm_end' = {m_end} kg with k_train = 0 (no train): they act only "
          "through a train; allowed with it: 0 (a rigid train's mass belongs in m)"),
+    Rule(AllOf(OSCILLATING, Not(ARM_TRAIN), AnyOf(Cmp(Num("d_train_arm"), "!="), Cmp(Num("J_end"), "!="))),
+         "parameters 'd_train_arm' = {d_train_arm} N.m.s/rad, 'J_end' = {J_end} kg.m2 with k_train_arm = 0 (no "
+         "train): they act only through an arm's train; allowed with it: 0 (a rigid train's inertia belongs in J_arm)"),
+    Rule(AllOf(OSCILLATING, ARM_TRAIN, Not(Cmp(Num("J_end"), ">"))),
+         "parameter 'J_end' = {J_end} kg.m2: an arm's torsional train (k_train_arm = {k_train_arm} N.m/rad) needs its "
+         "end inertia; allowed with k_train_arm > 0: J_end in (0, 1e3] kg.m2"),
+    Rule(AllOf(OSCILLATING, ARM_TRAIN, OWN_FOLLOWER),
+         "parameter 'k_train_arm' = {k_train_arm} N.m/rad: an arm's train runs with the arm on the cam so far, not "
+         "with a follower of its own (closure {closure}); allowed with it: k_train_arm = 0 (docs/model.md 14.6)"),
     Rule(AllOf(TRAIN, Not(Cmp(Num("m_end"), ">"))),
          "parameter 'm_end' = {m_end} kg: a follower train (k_train = {k_train} N/m) needs its end mass; allowed with "
          "k_train > 0: m_end in (0, 1e4] kg"),
@@ -224,10 +235,10 @@ RULES: tuple[Rule, ...] = (
          "docs/model.md 16.3); allowed with closure {closure}: c = 0"),
     Rule(AllOf(OTHER_KIND, AnyOf(COMPLIANT, AllOf(TRAIN, Not(FLAT_TRAIN)),
                                  AllOf(Is("solver", ("etdrk4",)), Not(Is("drive", ("speed",)))))),
-         "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train (but the "
-         "translating flat's) and a solver other than 'etdrk4' (which integrates the roller's electrical "
-         "pole) so far; allowed with k_shaft = {k_shaft} N.m/rad, k_train = {k_train} N/m, solver {solver}: "
-         "'translating_roller'"),
+         "parameter 'follower_type' = {follower_type}: runs on a rigid shaft, with no follower train along X (but "
+         "the translating flat's; an arm's is torsional: k_train_arm, d_train_arm, J_end) and a solver other than "
+         "'etdrk4' (which integrates the roller's electrical pole) so far; allowed with k_shaft = {k_shaft} N.m/rad, "
+         "k_train = {k_train} N/m, solver {solver}: 'translating_roller'"),
     Rule(AllOf(OTHER_KIND, Is("formulation", ("paper",)), Not(Is("drive", ("speed",)))),
          "parameter 'follower_type' = {follower_type}: the paper's formulation (steps 1-9) has the translating "
          "roller only; allowed with it: 'translating_roller' (or formulation 'consistent', docs/model.md 16)"),

@@ -13,11 +13,12 @@ import pytest
 from cam_fmu.engine.simulator import CamError, DriveSimulator, _set_parameter, engine
 from cam_fmu.physics import rules
 from cam_fmu.physics.drive import DriveModel, own_follower
-from cam_fmu.physics.parameters import BY_NAME, FOLLOWER_KIND_PARAMETERS, ParameterError, resolve
+from cam_fmu.physics.parameters import ARM_TRAIN_PARAMETERS, BY_NAME, FOLLOWER_KIND_PARAMETERS, ParameterError, resolve
 
 PER_RULE = 3       # cases kept for each rule
 ACCEPTED = 12      # and parameter sets no rule refuses
 DRAWS = 40000     # the follower kind's eight fields make the later rules' cases rare (the last one met at 40000)
+KIND_FIELDS = FOLLOWER_KIND_PARAMETERS + ARM_TRAIN_PARAMETERS   # the kind's, and an arm's train's
 
 
 def candidates(name: str) -> list:
@@ -38,16 +39,16 @@ def kind_fields(rng: random.Random, params: dict) -> dict:
     drawn."""
     draw = rng.random()
     if draw < 1 / 3:
-        return {p.name: p.default for p in FOLLOWER_KIND_PARAMETERS}
+        return {p.name: p.default for p in KIND_FIELDS}
     if draw < 2 / 3:
         kind = params["follower_type"]
         arm = kind.startswith("oscillating")
         needed = ("arm_length", "pivot_distance", "lift_angle")   # each set, or now and then missing
         return {p.name: (rng.choice(candidates(p.name)[-1:] * 5 + [0.0]) if arm and p.name in needed
-                         else params[p.name] if arm else p.default) for p in FOLLOWER_KIND_PARAMETERS
+                         else params[p.name] if arm else p.default) for p in KIND_FIELDS
                 if p.name != "follower_type"}
-    one = rng.choice([p.name for p in FOLLOWER_KIND_PARAMETERS if p.name != "follower_type"])
-    return {p.name: params[p.name] if p.name == one else p.default for p in FOLLOWER_KIND_PARAMETERS
+    one = rng.choice([p.name for p in KIND_FIELDS if p.name != "follower_type"])
+    return {p.name: params[p.name] if p.name == one else p.default for p in KIND_FIELDS
             if p.name != "follower_type"}
 
 

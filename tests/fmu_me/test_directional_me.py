@@ -59,6 +59,11 @@ KIND = {
                                     "lift_angle": 0.15, **ARM, **CYCLOID, "mu": 0.05},
     "translating_flat_friction": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2,
                                   "beta": 0.7, **CYCLOID},
+    "oscillating_roller_train": {"omega0": 20.0, "follower_type": "oscillating_roller", "lift_angle": 0.3, **ARM,
+                                 "k_train_arm": 500.0, "d_train_arm": 0.05, "J_end": 2e-3, **CYCLOID},
+    "oscillating_flat_train_friction": {"omega0": 20.0, "follower_type": "oscillating_flat", "lift_angle": 0.15,
+                                        **ARM, "mu": 0.05, "k_train_arm": 500.0, "d_train_arm": 0.05, "J_end": 2e-3,
+                                        **CYCLOID},
     "translating_flat_train": {"omega0": 20.0, "follower_type": "translating_flat", "mu": 0.05, "gamma": 1.2,
                                "beta": 0.7, "k_train": 2e4, "d_train": 2.0, "m_end": 0.2, "L": 1e-3, **CYCLOID},
 }

@@ -62,8 +62,8 @@ int cam_step_fixed(CamDrive *d, CamIntegrator *it, double remaining, double *dt_
                 snprintf(f, sizeof f, "%.3g", method->max_sweep / fastest);
                 char g[120] = "";
                 if (m->train)   /* cam_profile_rate: a radian of the train's phase counts as a feature */
-                    snprintf(g, sizeof g, "; and the follower train's %.4g 1/s from k_train, d_train, m_end, a "
-                             "radian of its ringing counted as a feature", m->train_rate);
+                    snprintf(g, sizeof g, "; and the follower train's %.4g 1/s from %s, a radian of its ringing "
+                             "counted as a feature", m->train_rate, cam_train_names(m));
                 return cam_error(err, CAM_ERR_SIMULATION,
                                  "solver '%s' with h_max = %s s turns the cam through %s of the profile's finest "
                                  "feature in one step (omega = %s rad/s%s), more than %s: its first-order error is "

@@ -46,9 +46,9 @@ static void stiff_cause(const CamModel *m, char *buf, size_t len)
     double shaft, pole;
     buf[0] = '\0';
     if (m->train && m->train_rate * m->h_max > 1.0) {
-        snprintf(buf, len, "; the follower train's rate sqrt(k_train / m_end) + d_train / m_end = %.3g 1/s asks for "
-                 "steps of about %.3g s (a tenth of that with a fixed step: soften k_train or raise m_end, or raise "
-                 "max_steps)", m->train_rate, 1.0 / m->train_rate);
+        snprintf(buf, len, "; the follower train's rate (%s) = %.3g 1/s asks for steps of about %.3g s (a tenth "
+                 "of that with a fixed step: soften its spring or raise its end's inertia, or raise max_steps)",
+                 cam_train_names(m), m->train_rate, 1.0 / m->train_rate);
         return;
     }
     if (!m->compliant)

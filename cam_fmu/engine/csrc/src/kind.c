@@ -68,6 +68,11 @@ double cam_kind_branch(const CamModel *m, const double q[4], double omega, doubl
     return omega_dot;
 }
 
+const char *cam_train_names(const CamModel *m)
+{
+    return m->arm ? "sqrt(k_train_arm / J_end) + d_train_arm / J_end" : "sqrt(k_train / m_end) + d_train / m_end";
+}
+
 void cam_kind_outputs(const CamModel *m, double theta, double omega, double out[])
 {
     double q[4];
@@ -118,7 +123,7 @@ void cam_kind_load(const CamModel *m, double theta, double omega, double omega_d
         return;
     }
     cam_kind_contact_load(m, q, m->I_f * (q[2] * omega * omega + q[1] * omega_dot) + cam_kind_slope(m, q[0])
-                          + axial, direction, out);   /* axial: the train's force along q (0 without a train) */
+                          + axial / m->q_scale, direction, out);   /* axial: the train's force along s (0 without) */
     out->v = q[1] / m->q_scale * omega;   /* the law's lift rates, as the reference's */
     out->a = q[2] / m->q_scale * omega * omega + q[1] / m->q_scale * omega_dot;
 }
@@ -256,6 +261,15 @@ void cam_kind_init(CamModel *m)
            ? (v[CAM_P_G] * L + v[CAM_P_M_ARM] * CAM_G_N * v[CAM_P_R_CM_ARM]) * in_plane : 0.0;
     m->psi_0 = v[CAM_P_PSI_0];
     m->F_gx = m->G_y = m->N_g = 0.0;   /* an arm's weight is W's torque (beta is refused with gravity) */
+    if (v[CAM_P_K_TRAIN_ARM] > 0.0) {   /* the torsional train in the law's lift units along s (docs/model.md 14.6) */
+        double k2 = m->q_scale * m->q_scale;
+        m->train = 1;
+        m->k_train = v[CAM_P_K_TRAIN_ARM] * k2;
+        m->d_train = v[CAM_P_D_TRAIN_ARM] * k2;
+        m->m_end = v[CAM_P_J_END] * k2;
+        m->F_ex = 0.0;   /* the end inertia turns about its own centre: no weight's torque */
+        m->train_rate = sqrt(m->k_train / m->m_end) + m->d_train / m->m_end;
+    }
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {   /* cam_kind_check refuses the arm out of reach */
         if (fabs(d - L) < r_b && r_b < d + L)
             m->delta0 = acos((d * d + L * L - r_b * r_b) / (2.0 * d * L));
@@ -301,9 +315,9 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         omega_dot = 0.0;
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
-    if (m->train) {   /* a translating type's train (docs/model.md 14.6): its force along q = s at the follower */
-        force += m->k_train * (qf - x[CAM_X_END]) + m->d_train * (q[1] * w - x[CAM_V_END]);
-        dF = cam_train_tangent(m, q[1] * dtheta, q[2] * dtheta * w + q[1] * dw, seed);
+    if (m->train) {   /* the train (docs/model.md 14.6): its force along s at the follower, its torque along an arm's q */
+        force += (m->k_train * (qf / k - x[CAM_X_END]) + m->d_train * (q[1] * w / k - x[CAM_V_END])) / k;
+        dF = cam_train_tangent(m, q[1] * dtheta / k, (q[2] * dtheta * w + q[1] * dw) / k, seed);
     }
     dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;
     if (m->mu != 0.0) {   /* the friction's lever and its rate */
@@ -311,7 +325,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         dlam = lever_rate(m, q) * dtheta;
     }
     A = m->I_f * q[2] * w * w + force;
-    dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta + dF;
+    dA = m->I_f * (q[3] * dtheta * w * w + 2.0 * q[2] * w * dw) + V2 * q[1] * dtheta + dF / k;
     if (moving && m->follower) {   /* den omega_dot = T - M_f d - A k on the branch cam_rhs holds (model.c) */
         cam_kind_branch(m, q, w, T - m->M_f * d, d, side, force, &branch);
         dk = q[2] * dtheta + m->mu * d * branch.b * dlam;

@@ -68,7 +68,8 @@ double cam_omega_dot(const CamModel *m, double theta, double omega, double torqu
         return drive / m->J_0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* kind.c: q, I_f, dV/dq, its friction */
         cam_kind_eval(m, theta, q);
-        return cam_kind_branch(m, q, omega, drive, direction, side, cam_kind_slope(m, q[0]) + axial, &branch);
+        return cam_kind_branch(m, q, omega, drive, direction, side, cam_kind_slope(m, q[0]) + axial / m->q_scale,
+                               &branch);   /* the train's force along s: an arm's torque along q over q_scale */
     }
     load_terms(m, theta, omega, drive, direction, side, axial, &t);
     if (m->mu == 0.0)
@@ -86,8 +87,8 @@ double cam_side_force(const CamModel *m, double theta, double omega, double torq
         return 0.0;
     if (m->kind != CAM_CHOICE_FOLLOWER_TYPE_TRANSLATING_ROLLER) {   /* P: its sign is the kind's friction branch */
         cam_kind_eval(m, theta, q);
-        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side, cam_kind_slope(m, q[0]) + axial,
-                        &branch);
+        cam_kind_branch(m, q, omega, torque - m->M_f * direction, direction, side,
+                        cam_kind_slope(m, q[0]) + axial / m->q_scale, &branch);
         return branch.P;
     }
     load_terms(m, theta, omega, torque - m->M_f * direction, direction, side, axial, &t);
@@ -141,46 +142,30 @@ double cam_current_at_rest(const CamModel *m, double i, double u, double dt)
     return target + (i - target) * exp(-dt * m->R / m->L);
 }
 
-/* dx/dt of the two-mass drive (docs/model.md section 12): the cam side as the rigid drive's under the shaft's
- * torque, the rotor J_m omega_m' = c_m i - M_shaft, the twist's rate omega_m - omega. */
-static void compliant_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
-{
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], omega_motor = x[CAM_OMEGA_M];
-    double shaft = cam_drive_torque(m, x, omega, u);   /* x[CAM_OMEGA] is 0 while stuck */
-    double F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
-    if (mode->stuck) {
-        dx[CAM_THETA] = 0.0;
-        dx[CAM_OMEGA] = 0.0;
-    } else {
-        dx[CAM_THETA] = omega;
-        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, shaft, mode->direction, mode->contact != 0,
-                                      m->guide_side ? mode->side : 0.0, F);
-    }
-    train_rhs(m, x, F, dx);
-    dx[CAM_TWIST] = omega_motor - omega;
-    dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - shaft) / m->J_m;
-    dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
-}
-
 void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], double u, double dx[CAM_NX])
 {
-    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], F;
+    double theta = x[CAM_THETA], omega = x[CAM_OMEGA], i = x[CAM_CURRENT], drive, F;
     if (m->follower_states) {   /* the follower's gap and rate are states (voltage_follower.c) */
         cam_vf_rhs(m, mode, x, u, dx);
         return;
     }
-    if (m->compliant) {
-        compliant_rhs(m, mode, x, u, dx);
-        return;
-    }
+    drive = cam_drive_torque(m, x, omega, u);   /* the motor's, or a compliant shaft's (x[CAM_OMEGA] is 0 while stuck) */
     F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;
         dx[CAM_OMEGA] = 0.0;
     } else {
         dx[CAM_THETA] = omega;
-        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, cam_torque(m, omega, i, u), mode->direction,
-                                      mode->contact != 0, m->guide_side ? mode->side : 0.0, F);
+        dx[CAM_OMEGA] = cam_omega_dot(m, theta, omega, drive, mode->direction, mode->contact != 0,
+                                      m->guide_side ? mode->side : 0.0, F);
+    }
+    if (m->compliant) {   /* the two-mass drive (docs/model.md 12): the rotor J_m omega_m' = c_m i - M_shaft */
+        double omega_motor = x[CAM_OMEGA_M];
+        train_rhs(m, x, F, dx);
+        dx[CAM_TWIST] = omega_motor - omega;
+        dx[CAM_OMEGA_M] = (cam_torque(m, omega_motor, i, u) - drive) / m->J_m;
+        dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega_motor) / m->L : 0.0;
+        return;
     }
     dx[CAM_CURRENT] = m->has_current ? (u - m->R * i - m->c_e * omega) / m->L : 0.0;
     if (m->train) {   /* a train: its end mass moves, the rigid shaft's slots are held */
