@@ -203,9 +203,6 @@ RULES: tuple[Rule, ...] = (
     Rule(AllOf(OSCILLATING, ARM_TRAIN, Not(Cmp(Num("J_end"), ">"))),
          "parameter 'J_end' = {J_end} kg.m2: an arm's torsional train (k_train_arm = {k_train_arm} N.m/rad) needs its "
          "end inertia; allowed with k_train_arm > 0: J_end in (0, 1e3] kg.m2"),
-    Rule(AllOf(OSCILLATING, ARM_TRAIN, OWN_FOLLOWER),
-         "parameter 'k_train_arm' = {k_train_arm} N.m/rad: an arm's train runs with the arm on the cam so far, not "
-         "with a follower of its own (closure {closure}); allowed with it: k_train_arm = 0 (docs/model.md 14.6)"),
     Rule(AllOf(TRAIN, Not(Cmp(Num("m_end"), ">"))),
          "parameter 'm_end' = {m_end} kg: a follower train (k_train = {k_train} N/m) needs its end mass; allowed with "
          "k_train > 0: m_end in (0, 1e4] kg"),

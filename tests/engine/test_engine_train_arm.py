@@ -1,8 +1,9 @@
 """An oscillating follower's torsional train in the C engine (docs/model.md 14.6, issue 41): a torsion spring
 k_train_arm [N m/rad] and damper d_train_arm [N m s/rad] from the arm to an end inertia J_end [kg m2], with the arm
-on the cam in both drives. Checked against what the tests write themselves in the arm's own terms (psi, the end's
-angle psi_e = s_end lift_angle / lift): the residual vibration's closed form after a cycloidal rise, a coasting
-drive's stored energy, the rigid arm with J_end on it as k_train_arm grows; what is not built is refused by name."""
+on the cam or as a body of its own, in both drives. Checked against what the tests write themselves in the arm's own
+terms (psi, the end's angle psi_e = s_end lift_angle / lift): the residual vibration's closed form after a cycloidal
+rise, a coasting drive's stored energy (on the cam and through flights), the lift-off the train causes, the rigid arm
+with J_end on it as k_train_arm grows; what is not built is refused by name."""
 from __future__ import annotations
 
 import math
@@ -95,16 +96,75 @@ def test_a_stiffening_train_converges_to_the_rigid_arm_carrying_j_end_as_one_ove
         assert 8.0 < coarse / fine < 12.0, errors
 
 
+def arm_energy(p: dict, out: dict) -> np.ndarray:
+    """J: the cam side's and the arm's kinetic energy, the return spring about the pivot (L F_spring0 psi + k_spring
+    L^2 psi^2 / 2), the weight's W sin(psi + psi_0) and the torsional train's, from the outputs."""
+    L = p["arm_length"]
+    W = (p["G"] * L + p["m_arm"] * G_N * p["r_cm_arm"]) * math.sin(p["gamma"])
+    I_f = p["J_arm"] + p["m"] * L * L
+    psi, rate = out["psi"], out["psi_dot"]
+    psi_e, rate_e = end_angle(p, out)
+    F0, k = p.get("F_spring0", 0.0), p.get("k_spring", 0.0)
+    return (0.5 * (p["J_m"] + p["J_cam"]) * out["omega"] ** 2 + 0.5 * I_f * rate ** 2 + L * F0 * psi
+            + 0.5 * k * L * L * psi * psi + W * np.sin(psi + p["psi_0"]) + 0.5 * p["J_end"] * rate_e ** 2
+            + 0.5 * p["k_train_arm"] * (psi - psi_e) ** 2)
+
+
+@pytest.mark.parametrize("follower_type", list(TYPES))
+def test_a_coasting_arm_of_its_own_keeps_its_energy_through_flights_with_the_train(follower_type):
+    """The arm in a groove (c = 0.5 mm) as a body of its own, restitution 1, an undamped train, no friction, no motor
+    torque: arm_energy stays constant over 0.5 s of flights and impacts (measured 1.5e-10 J with 89 touch-downs for
+    the roller arm, 3.1e-10 J with 72 for the flat face, of 0.31 J). The engine's own energy guard had caught the
+    account's missing train term here (0.0017 J 'created'), before the fix."""
+    p = dict(defaults(), **ARM, **CYCLOID, follower_type=follower_type, lift_angle=TYPES[follower_type],
+             R=1e4, c_e=1e-6, c_m=1e-6, omega0=30.0, M_f=0.0, mu=0.0, restitution=1.0, closure="form", c=5e-4,
+             k_train_arm=500.0, J_end=2e-3)
+    sim = DriveSimulator(p)
+    sim.set_inputs(0.0, 0.0, 0.0)
+    rows = [sim.outputs()]
+    for k in range(500):
+        sim.do_step(k * 1e-3, 1e-3, u=0.0)
+        rows.append(sim.outputs())
+    out = {name: np.array([row[name] for row in rows]) for name in rows[0]}
+    energy = arm_energy(p, out)
+    assert sum(event["name"].startswith("engage") for event in sim.events()) >= 50
+    assert np.max(np.abs(energy - energy[0])) < 5e-9 * energy[0]
+
+
+@pytest.mark.parametrize("follower_type", list(TYPES))
+def test_the_train_pulls_the_arm_off_its_spring_at_the_closed_form_instant(follower_type):
+    """The cam held on its upper dwell, the arm on its return spring at psi = lift_angle, the end inertia turned back
+    by A = -1.5 Q0 / k_train_arm and let go (undamped): the flank's torque is Q0 + k_train_arm |A| cos(w t) with
+    Q0 = L (F_spring0 + k_spring L psi) + W cos(psi + psi_0), w = sqrt(k_train_arm / J_end), so the arm leaves at
+    t = arccos(-Q0 / (k_train_arm |A|)) / w: the engine's logged lift-off, measured 2.0e-13 s from it."""
+    la = TYPES[follower_type]
+    p = dict(defaults(), **ARM, **CYCLOID, M_f=0.0, mu=0.0, closure="spring", k_spring=300.0, F_spring0=3.0,
+             follower_type=follower_type, lift_angle=la, k_train_arm=500.0, J_end=2e-3, omega0=0.0, theta0=2.0)
+    sim = DriveSimulator(p)
+    sim.set_inputs(0.0, 0.0, 0.0)
+    L = p["arm_length"]
+    W = (p["G"] * L + p["m_arm"] * G_N * p["r_cm_arm"]) * math.sin(p["gamma"])
+    Q0 = L * (p["F_spring0"] + p["k_spring"] * L * la) + W * math.cos(la + p["psi_0"])
+    A = -1.5 * Q0 / p["k_train_arm"]
+    state = sim.get_state()
+    state["y"][5] += A * p["lift"] / la   # x_end: the end's angle in the law's lift units
+    state["energy"] = None
+    sim.set_state(state)
+    expected = math.acos(-Q0 / (p["k_train_arm"] * abs(A))) / math.sqrt(p["k_train_arm"] / p["J_end"])
+    for n in range(100):
+        sim.do_step(n * 1e-4, 1e-4, u=0.0)
+    lift_offs = [event["time"] for event in sim.events() if event["name"] == "contact"]
+    assert lift_offs and abs(lift_offs[0] - expected) < 1e-10
+
+
 @pytest.mark.parametrize("change, named", [
     (dict(follower_type="oscillating_roller", lift_angle=0.3, k_train=2e4, m_end=0.2), "k_train_arm"),
     (dict(follower_type="translating_flat", k_train_arm=500.0, J_end=2e-3), "k_train_arm"),
     (dict(follower_type="oscillating_roller", lift_angle=0.3, k_train_arm=500.0), "J_end"),
-    (dict(follower_type="oscillating_roller", lift_angle=0.3, d_train_arm=0.1), "d_train_arm"),
-    (dict(follower_type="oscillating_flat", lift_angle=0.15, k_train_arm=500.0, J_end=2e-3, closure="spring",
-          k_spring=300.0, F_spring0=3.0, G=4.0), "k_train_arm")])
+    (dict(follower_type="oscillating_roller", lift_angle=0.3, d_train_arm=0.1), "d_train_arm")])
 def test_what_is_not_built_is_refused_by_name(change, named):
     """k_train (along X) on an arm, the arm's train on a translating type or without its end inertia, its damper
-    alone, and an arm's train on a follower of its own (not built yet)."""
+    alone."""
     arm = ARM if change["follower_type"].startswith("oscillating") else {}
     with pytest.raises(ParameterError, match=named):
         DriveSimulator(dict(defaults(), **arm, **change))

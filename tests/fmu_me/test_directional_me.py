@@ -140,6 +140,7 @@ _FLAT_SPRING = {**CYCLOID, "follower_type": "translating_flat", "mu": 0.05, "gam
 _TRAIN = {"k_train": 2e4, "d_train": 5.0, "m_end": 0.2}
 # the flat face's on a spring whose preload holds it under the random states' pull of the train (up to 25 N)
 _FLAT_TRAIN = {**_FLAT_SPRING, **_TRAIN, "k_spring": 3000.0, "F_spring0": 40.0}
+_ARM_TRAIN = {"k_train_arm": 500.0, "d_train_arm": 0.05, "J_end": 2e-3}   # an arm's torsional train
 FOLLOWER_CASES.update({
     "spring_train/contact": ({**_SPRING, **_TRAIN}, "contact", 0.0),
     "spring_train/stuck": ({**_SPRING, **_TRAIN, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
@@ -155,6 +156,10 @@ FOLLOWER_CASES.update({
     "arm_spring_L/flight": (_ARM_SPRING, "flight", 150.0),
     "flat_spring/contact": (_FLAT_SPRING, "contact", 0.0),
     "flat_spring/flight": (_FLAT_SPRING, "flight", 150.0),
+    "arm_groove_train/contact": ({**_ARM_GROOVE, **_ARM_TRAIN}, "contact", 0.0),
+    "arm_groove_train/flight": ({**_ARM_GROOVE, **_ARM_TRAIN}, "flight", 100.0),
+    "arm_spring_train_L/contact": ({**_ARM_SPRING, **_ARM_TRAIN}, "contact", 0.0),
+    "arm_spring_train_L/stuck": ({**_ARM_SPRING, **_ARM_TRAIN, "omega0": 0.0, "u": 0.0, "theta0": 2.0}, "stuck", 0.0),
     "flat_spring_train/contact": (_FLAT_TRAIN, "contact", 0.0),
     "flat_spring_train/stuck": ({**_FLAT_TRAIN, "omega0": 0.0, "u": 0.0}, "stuck", 0.0),
     "flat_spring_train/flight": (_FLAT_TRAIN, "flight", 150.0),
@@ -398,7 +403,7 @@ def test_follower_of_its_own_derivatives_match_central_differences(engine_fmu_pa
         assert np.abs(analytic[NX - 1 if mode == "flight" else slice(None)]).max() > 0.0
 
     try:
-        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) > 0.0)
+        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) + start.get("k_train_arm", 0.0) > 0.0)
         assert_matches_differences(me, case, draw, moving)
     finally:
         me.close()
@@ -432,7 +437,7 @@ def test_model_structure_lists_what_a_sparsity_probe_finds(engine_fmu_path):
         me.close()
     for start, mode, speed in FOLLOWER_CASES.values():   # and in every mode the event updates reach
         me = Me(engine_fmu_path, start)
-        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) > 0.0)
+        enter_follower_mode(me, mode, speed, start.get("k_train", 0.0) + start.get("k_train_arm", 0.0) > 0.0)
         for _ in range(3):
             random_follower_state(me, rng, mode, start.get("c", 1e-3))
             fd = me.central(1e-6)

@@ -45,9 +45,9 @@ static void kind_tangent(const CamDrive *d, const double x[CAM_ME_NX], const dou
             dq_dot = q[2] * dtheta * y[1] + q[1] * domega;
             dout[CAM_O_V] = dout[CAM_O_V_END] = dq_dot / m->q_scale;
             dout[CAM_O_PSI_DOT] = m->arm ? dq_dot : 0.0;
-            if (m->train)   /* the end mass's rates take the follower at rest, the outputs at omega (a translating q) */
-                cam_train_rows(m, seed, cam_train_tangent(m, q[1] * dtheta, 0.0, seed),
-                               cam_train_tangent(m, q[1] * dtheta, dq_dot, seed), ddx, dout);
+            if (m->train)   /* the end mass's rates take the follower at rest, the outputs at omega (lift units) */
+                cam_train_rows(m, seed, cam_train_tangent(m, q[1] * dtheta / m->q_scale, 0.0, seed),
+                               cam_train_tangent(m, q[1] * dtheta / m->q_scale, dq_dot / m->q_scale, seed), ddx, dout);
         }
         return;
     }
@@ -59,8 +59,8 @@ static void kind_tangent(const CamDrive *d, const double x[CAM_ME_NX], const dou
     V2 = cam_follower_stiffness(m) + (m->arm && m->W != 0.0 ? -m->W * sin(y[3] + m->psi_0) : 0.0);
     dq = q[1] * dtheta + left * seed[CAM_GAP] / cam_follower_length(m);   /* the gap's slots in m along the path */
     dq_dot = q[2] * dtheta * y[1] + q[1] * domega + left * seed[CAM_RATE] / cam_follower_length(m);
-    dF_t = cam_train_tangent(m, dq, dq_dot, seed);   /* a translating type's train (0 without one) */
-    dq_dd = -(V2 * dq + dF_t) / m->I_f;   /* I_f q_f_dd = -Q_close(q_f) */
+    dF_t = cam_train_tangent(m, dq / m->q_scale, dq_dot / m->q_scale, seed);   /* a train's, lift units (0: none) */
+    dq_dd = -(V2 * dq + dF_t / m->q_scale) / m->I_f;   /* I_f q_f_dd = -Q_close(q_f) */
     domega_dot = stuck ? 0.0 : g.drive / m->J_0;
     ddx[CAM_THETA] = domega;   /* the rates' theta_dot = omega in flight, the cam stuck at omega = 0 too */
     ddx[CAM_OMEGA] = domega_dot;

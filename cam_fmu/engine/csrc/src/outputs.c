@@ -90,7 +90,7 @@ static double mechanical(const CamEnergy *e, const double out[])
     if (e->own_follower && e->arm_length > 0.0) {   /* an arm's (rigid shaft: the rules): about its pivot, 16.3 */
         double psi = out[CAM_O_PSI], L = e->arm_length, rate = out[CAM_O_PSI_DOT];
         return 0.5 * e->J_0 * omega * omega + 0.5 * e->m * rate * rate + L * e->F_spring0 * psi
-               + 0.5 * e->k_spring * L * L * psi * psi + arm_energy(e, out);
+               + 0.5 * e->k_spring * L * L * psi * psi + arm_energy(e, out) + train_energy(e, out);
     }
     if (e->own_follower) {   /* the cam side's and the follower's kinetic energy, the spring's F0 s + k s^2 / 2 */
         double own = 0.5 * e->J_0 * omega * omega + 0.5 * e->m * v * v + e->F_spring0 * s

@@ -37,17 +37,20 @@
 #define POLE_STEP 0.1           /* a step at most this many electrical time constants (1 / pole) */
 #define FLIGHT_ANGLE 1e-2       /* rad: cam angle of one adaptive step in flight (a gap's crossing and return unseen) */
 
-/* N: the train's force F_train = k_train (s - x_e) + d_train (v - v_e) on its end mass, the follower at s [m] moving
- * at v [m/s]; its reaction loads the follower (docs/model.md 14.6; 0 without a train). */
-static double train_force(const CamModel *m, const double y[NY], double s, double v)
+/* N: the train's force F_train = k_train (s - x_e) + d_train (v - v_e) on its end mass, the follower at q, q_dot
+ * (s = q / q_scale: an arm's train in the law's lift units); its reaction loads the follower (docs/model.md 14.6; 0
+ * without a train). */
+static double train_force(const CamModel *m, const double y[NY], double q, double q_dot)
 {
-    return m->train ? m->k_train * (s - y[Y_XE]) + m->d_train * (v - y[Y_VE]) : 0.0;
+    return m->train ? m->k_train * (q / m->q_scale - y[Y_XE]) + m->d_train * (q_dot / m->q_scale - y[Y_VE]) : 0.0;
 }
 
-/* N: what closes the follower onto its +1 flank at s, v: the return spring and gravity, and a train's force. */
-static double closing_at(const CamModel *m, const double y[NY], double s, double v)
+/* N (an arm: N m): what closes the follower onto its +1 flank at q, q_dot: the return spring and gravity, and a
+ * train's force along q. */
+static double closing_at(const CamModel *m, const double y[NY], double q, double q_dot)
 {
-    return m->train ? cam_follower_closing(m, s) + train_force(m, y, s, v) : cam_follower_closing(m, s);
+    return m->train ? cam_follower_closing(m, q) + train_force(m, y, q, q_dot) / m->q_scale
+                    : cam_follower_closing(m, q);
 }
 
 /* A: the armature current, the state's with L > 0, else quasi-static at the rotor's speed. */
@@ -437,8 +440,8 @@ static void relax_train(const CamModel *m, double y[NY], int contact)
     if (!m->train)
         return;
     cam_kind_eval(m, y[0], d);
-    y[Y_XE] = d[0] - contact * cam_follower_clearance(m) + m->F_ex / m->k_train;
-    y[Y_VE] = d[1] * y[1];
+    y[Y_XE] = (d[0] - contact * cam_follower_clearance(m)) / m->q_scale + m->F_ex / m->k_train;
+    y[Y_VE] = d[1] * y[1] / m->q_scale;
 }
 
 /* The follower's start at the drive's x (on its lower flank, or a groove's upper one where that holds; the shaft at
