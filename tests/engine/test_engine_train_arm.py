@@ -18,6 +18,7 @@ from cam_fmu.experiments.engine_runs import simulate_engine
 from cam_fmu.physics.parameters import ParameterError, defaults
 from cam_fmu.physics.signals import Signal
 from cam_fmu.reference.integrate import simulate_reference
+from tests.engine.test_engine_train_own_follower import coast
 
 G_N = 9.80665
 ARM = {"arm_length": 0.15, "pivot_distance": 0.18, "J_arm": 2e-3, "m_arm": 0.2, "r_cm_arm": 0.07, "psi_0": 0.3,
@@ -61,13 +62,7 @@ def test_a_coasting_drive_keeps_its_energy_with_the_arm_s_train(follower_type):
     (roller arm) and 1.8e-11 J (flat face) of 0.31 J."""
     p = dict(defaults(), **ARM, **CYCLOID, follower_type=follower_type, lift_angle=TYPES[follower_type],
              R=1e4, c_e=1e-6, c_m=1e-6, omega0=30.0, M_f=0.0, mu=0.0, k_train_arm=500.0, J_end=2e-3)
-    sim = DriveSimulator(p)
-    sim.set_inputs(0.0, 0.0, 0.0)
-    rows = [sim.outputs()]
-    for k in range(500):
-        sim.do_step(k * 1e-3, 1e-3, u=0.0)
-        rows.append(sim.outputs())
-    out = {name: np.array([row[name] for row in rows]) for name in rows[0]}
+    sim, out = coast(p)
     W = (p["G"] * p["arm_length"] + p["m_arm"] * G_N * p["r_cm_arm"]) * math.sin(p["gamma"])
     psi_e, rate_e = end_angle(p, out)
     twist = out["psi"] - psi_e
@@ -119,13 +114,7 @@ def test_a_coasting_arm_of_its_own_keeps_its_energy_through_flights_with_the_tra
     p = dict(defaults(), **ARM, **CYCLOID, follower_type=follower_type, lift_angle=TYPES[follower_type],
              R=1e4, c_e=1e-6, c_m=1e-6, omega0=30.0, M_f=0.0, mu=0.0, restitution=1.0, closure="form", c=5e-4,
              k_train_arm=500.0, J_end=2e-3)
-    sim = DriveSimulator(p)
-    sim.set_inputs(0.0, 0.0, 0.0)
-    rows = [sim.outputs()]
-    for k in range(500):
-        sim.do_step(k * 1e-3, 1e-3, u=0.0)
-        rows.append(sim.outputs())
-    out = {name: np.array([row[name] for row in rows]) for name in rows[0]}
+    sim, out = coast(p)
     energy = arm_energy(p, out)
     assert sum(event["name"].startswith("engage") for event in sim.events()) >= 50
     assert np.max(np.abs(energy - energy[0])) < 5e-9 * energy[0]

@@ -13,8 +13,7 @@ from cam_fmu.physics.signals import Signal
 from cam_fmu.reference.integrate import simulate_reference
 from cam_fmu.experiments.engine_runs import simulate_engine
 from tests.engine.test_engine_train import STEP, STOP, TRAIN, engine_run, speed_run, worst
-from tests.engine.test_engine_train_own_follower import CLOSURES as OWN_CLOSURES, COAST, SCENE as OWN_SCENE
-from tests.engine.test_engine_train_own_follower import stored_energy
+from tests.engine.test_engine_train_own_follower import CLOSURES as OWN_CLOSURES, SCENE as OWN_SCENE
 from tests.engine.test_engine_train_speed_follower import TRAIN as SPEED_TRAIN, runs as speed_runs
 
 FLAT = dict(follower_type="translating_flat")
@@ -90,20 +89,3 @@ def test_the_speed_drive_s_flat_with_a_train_flies_as_the_roller_reference_witho
     for name, bound in (("s", 2e-10), ("s_end", 2e-10), ("F_train", 4e-6), ("M", 3e-7), ("theta", 1e-12)):
         error = np.max(np.abs(got[name] - ref[name]))
         assert error < bound, (name, error)
-
-
-def test_a_coasting_flat_on_a_follower_of_its_own_keeps_its_energy_with_the_train():
-    """Restitution 1, an undamped train, no friction, no motor torque, 0.5 s in the groove: the stored energy the
-    test writes from the outputs (test_engine_train_own_follower.stored_energy, the flat's s, v being the roller's)
-    stays constant through flights and impacts: measured 5.0e-10 J of 0.92 J through 77 touch-downs."""
-    p = dict(defaults(), **OWN_SCENE, **OWN_CLOSURES["form"], **COAST, **FLAT)
-    sim = DriveSimulator(p)
-    sim.set_inputs(0.0, 0.0, 0.0)
-    rows = [sim.outputs()]
-    for k in range(500):
-        sim.do_step(k * 1e-3, 1e-3, u=0.0, omega_ref=0.0, omega_dot_ref=0.0)
-        rows.append(sim.outputs())
-    energy = np.array([stored_energy(p, out) for out in rows])
-    assert np.max(np.abs(energy - energy[0])) < 5e-8 * energy[0]
-    assert sum(event["name"].startswith("engage") for event in sim.events()) >= 20
-    assert np.ptp([out["F_train"] for out in rows]) > 10.0   # N: the train rings
