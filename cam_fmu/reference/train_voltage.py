@@ -125,11 +125,9 @@ class _VoltageTrain(VoltageRun):
 
     def _side_force(self, y, u_t: float, mode: _Mode, side: float) -> float:
         """N_r [N] on the branch ``side`` (0: the one that holds), the train's force in the axial force."""
-        model, omega = self.model, y[OMEGA]
+        omega = y[OMEGA]
         F, _ = self._force(y, omega)
-        drive = self._torque(y, u_t, omega) - model.M_f * mode.direction
-        g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
-        return g.n0 + g.sigma * g.kappa * g.f
+        return self.model.side_force(y[THETA], omega, self._torque(y, u_t, omega), mode.direction, side, F)
 
     def _margin(self, y, u_t: float) -> float:
         """> 0 when the held shaft would start [rad/s2]: the larger acceleration either way, friction against it."""
@@ -161,8 +159,7 @@ class _VoltageTrain(VoltageRun):
             rates[e_shaft] = model.M_f * mode.direction * omega
             if self.guide:
                 drive = torque - model.M_f * mode.direction
-                g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
-                rates[e_guide] = g.sigma * g.f * v
+                rates[e_guide] = model.follower_friction_power(y[THETA], omega, drive, mode.direction, side, F)
         return rates
 
     # ------------------------------------------------------------ the hybrid run's parts
