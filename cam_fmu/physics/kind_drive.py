@@ -21,7 +21,9 @@ from the pivot, lambda = p / l = tan(delta) (1 - psi') (the friction along the f
 torque on the arm); oscillating roller: the roller rolls, the pivot carries a Coulomb torque mu |P| against the arm's
 turn, lambda = |psi'|. The friction's power mu |P| lambda |omega| is the loss. Lagrange's equation with
 J(theta) = J_0 + I_f q'^2 gives omega_dot; |P| depends on omega_dot, solved exactly on the branch sgn(P) (held between
-the side events of the reference, as the guide's N_r). Plain functions of floats, as physics/drive.py.
+the side events of the reference, as the guide's N_r). A translating flat carries the follower train's force F_train
+(``axial`` [N], docs/model.md 14.6) along s: it adds to P, so to the friction mu |P| lambda; an arm's train
+(torsional) is refused naming follower_type. Plain functions of floats, as physics/drive.py.
 """
 from __future__ import annotations
 

@@ -61,7 +61,8 @@ def simulate_reference(
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
     m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_INTEGRALS
     (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py; with a
-    follower of its own, reference/train_flight.py).
+    follower of its own, reference/train_flight.py); a translating flat on the cam runs the same references with
+    physics.kind_drive.KindDriveModel (its P carries F_train), an arm's train is refused naming follower_type.
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
     'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the

@@ -3,7 +3,8 @@ together by scipy, with the shaft's and the guide's Coulomb friction.
 
 y = (theta, omega, i, x_e, v_e, W_train, E_train_damp, E_in, E_copper, E_shaft, E_guide): the rigid drive's
 equation (5.1) with the train's force F_train on the follower (``DriveModel.omega_dot``'s ``axial``: it enters the
-axial force, so the guide's side force N_r and its friction f), i a state with L > 0 (held, and quasi-static,
+axial force, so the guide's side force N_r and its friction f; a translating flat's KindDriveModel takes it into its P,
+whose sign is then the side event and mu |P| (r_b + s) the friction, E_guide its loss), i a state with L > 0 (held, and quasi-static,
 with L = 0), the end mass's two states and six energy integrals: W_train = int F_train v dt, E_train_damp =
 int d_train (v - v_e)^2 dt, E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide =
 int f |v| dt. The run is reference/hybrid.py's loop with the consistent drive's modes (physics/formulations/
