@@ -234,8 +234,10 @@ class DriveModel:
             return g.x0
         return g.x0 - g.sigma * g.f * g.s1 / g.J
 
-    def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
-        """The guide's side force N_r [N] while the follower is engaged and moving (0 without guide friction).
+    def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0,
+                   axial: float = 0.0) -> float:
+        """The guide's side force N_r [N] while the follower is engaged and moving (0 without guide friction);
+        ``axial`` [N]: the follower train's force on the follower (docs/model.md 14.6).
 
         |N_r| has a kink where N_r changes sign (the friction mu |N_r| does): the
         integrators locate that zero as an event instead of stepping over it
@@ -243,8 +245,15 @@ class DriveModel:
         """
         if self.mu == 0.0 or not self.follower:
             return 0.0
-        g = self.guide_terms(theta, omega, torque - self.M_f * direction, direction, side)
+        g = self.guide_terms(theta, omega, torque - self.M_f * direction, direction, side, axial)
         return g.n0 + g.sigma * g.kappa * g.f
+
+    def follower_friction_power(self, theta: float, omega: float, drive: float, direction: float, side: float,
+                                axial: float = 0.0) -> float:
+        """The guide's friction power [W] on the branch ``side`` held, sigma f v (= f |v| while d = sgn(omega):
+        smooth through the stop), ``drive`` = T - M_f d [N m], ``axial`` [N] the train's force."""
+        g = self.guide_terms(theta, omega, drive, direction, side, axial)
+        return g.sigma * g.f * (g.s1 * omega)
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True,
              axial: float = 0.0) -> LoadState:

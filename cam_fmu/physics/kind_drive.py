@@ -21,7 +21,9 @@ from the pivot, lambda = p / l = tan(delta) (1 - psi') (the friction along the f
 torque on the arm); oscillating roller: the roller rolls, the pivot carries a Coulomb torque mu |P| against the arm's
 turn, lambda = |psi'|. The friction's power mu |P| lambda |omega| is the loss. Lagrange's equation with
 J(theta) = J_0 + I_f q'^2 gives omega_dot; |P| depends on omega_dot, solved exactly on the branch sgn(P) (held between
-the side events of the reference, as the guide's N_r). Plain functions of floats, as physics/drive.py.
+the side events of the reference, as the guide's N_r). A translating flat carries the follower train's force F_train
+(``axial`` [N], docs/model.md 14.6) along s: it adds to P, so to the friction mu |P| lambda; an arm's train
+(torsional) is refused naming follower_type. Plain functions of floats, as physics/drive.py.
 """
 from __future__ import annotations
 
@@ -95,10 +97,10 @@ class KindDriveModel(DriveModel):
         kind = self.kind.follower_type
         refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0 and not self.free_follower),
                                          ("'k_shaft' (compliant shaft)", self.compliant),
-                                         # the follower train as parameters (where the table has them)
-                                         ("'k_train' (follower train)", p.get("k_train", 0.0) > 0.0),
                                          ("'k_train_arm' (an arm's torsional train)",
                                           p.get("k_train_arm", 0.0) > 0.0)) if on]
+        if p.get("k_train", 0.0) > 0.0:
+            self.refuse_train()
         if refused:
             raise ParameterError(f"follower_type {kind!r} runs with the follower on the cam or as a body of its own "
                                  f"(closure 'spring', or 'form' with a clearance and a mass m > 0; docs/model.md "
@@ -107,6 +109,13 @@ class KindDriveModel(DriveModel):
         if self.kind.oscillating and p["gravity"] and p["beta"] != 0.0:
             raise ParameterError(f"parameter 'beta' = {p['beta']!r} rad is not used by follower_type {kind!r} "
                                  f"(the arm's angle to gravity is its psi_0): leave it at 0")
+
+    def refuse_train(self) -> None:
+        """Refuse the follower train on an arm: its train would be torsional, about the pivot, not built."""
+        if self.kind.oscillating:
+            raise ParameterError(f"the follower train ('k_train' > 0) does not run with follower_type "
+                                 f"{self.kind.follower_type!r} (an arm's torsional train is not built): allowed "
+                                 f"follower_type 'translating_roller' or 'translating_flat'")
 
     # ----------------------------------------------------------- the kind's terms
     def coordinate(self, theta: float) -> tuple[float, float, float, float]:
@@ -160,10 +169,10 @@ class KindDriveModel(DriveModel):
                                  f"{math.degrees(at):.4g} deg (J_0 + I_f q' (q' - mu lambda) = {worst:.4g} kg m2 "
                                  f"<= 0): allowed where it stays > 0 (lower mu or add inertia J_cam)")
 
-    def _terms(self, theta: float, omega: float) -> tuple[float, float, float]:
-        """(A, q', lambda): P = A + I_f q' omega_dot."""
+    def _terms(self, theta: float, omega: float, axial: float = 0.0) -> tuple[float, float, float]:
+        """(A, q', lambda): P = A + I_f q' omega_dot; ``axial`` [N]: the train's force along q, in A."""
         q, q1, q2, s = self.coordinate(theta)
-        A = self.I_f * q2 * omega * omega + self.potential_slope(q)
+        A = self.I_f * q2 * omega * omega + self.potential_slope(q) + axial
         return A, q1, self.lever(q, q1, s) if self.mu else 0.0
 
     def _branch(self, A: float, q1: float, lam: float, drive: float, direction: float,
@@ -183,33 +192,51 @@ class KindDriveModel(DriveModel):
     def omega_dot(self, theta: float, omega: float, torque: float, direction: float, engaged: bool = True,
                   side: float = 0.0, axial: float = 0.0) -> float:
         """Angular acceleration [rad/s2]: J(theta) omega_dot = c_m i - M_f d - (A + mu |P| lambda d) ... solved on
-        the branch of sgn(P) (module doc); ``side`` fixes that branch (+1/-1), 0 chooses it."""
+        the branch of sgn(P) (module doc); ``side`` fixes that branch (+1/-1), 0 chooses it. ``axial`` [N]: the
+        follower train's force on a translating flat along s (docs/model.md 14.6), a part of P."""
         if axial:
-            raise ParameterError(f"the follower train does not run with follower_type {self.kind.follower_type!r}")
+            self.refuse_train()
         drive = torque - self.M_f * direction
-        if not self.follower:
+        if not (self.follower or axial):
             return drive / self.J_0
-        A, q1, lam = self._terms(theta, omega)
+        A, q1, lam = self._terms(theta, omega, axial)
         return self._branch(A, q1, lam, drive, direction, side)[0]
 
-    def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0) -> float:
-        """P [N, or N m] on the branch ``side``: its sign change is the friction's kink (the side event)."""
+    def side_force(self, theta: float, omega: float, torque: float, direction: float, side: float = 0.0,
+                   axial: float = 0.0) -> float:
+        """P [N, or N m] on the branch ``side``: its sign change is the friction's kink (the side event);
+        ``axial`` [N] the train's force in P."""
         if self.mu == 0.0 or not self.follower:
             return 0.0
-        A, q1, lam = self._terms(theta, omega)
+        if axial:
+            self.refuse_train()
+        A, q1, lam = self._terms(theta, omega, axial)
         return self._branch(A, q1, lam, torque - self.M_f * direction, direction, side)[1]
+
+    def follower_friction_power(self, theta: float, omega: float, drive: float, direction: float, side: float,
+                                axial: float = 0.0) -> float:
+        """The kind's friction power [W] on the branch ``side`` held, mu side P lambda d omega (= mu |P| lambda
+        |omega| while side = sgn(P), d = sgn(omega); smooth through the stop), ``drive`` = T - M_f d [N m]."""
+        if self.mu == 0.0 or not self.follower:
+            return 0.0
+        if axial:
+            self.refuse_train()
+        A, q1, lam = self._terms(theta, omega, axial)
+        P = self._branch(A, q1, lam, drive, direction, side)[1]
+        return self.mu * side * P * lam * direction * omega
 
     def load(self, theta: float, omega: float, omega_dot: float, direction: float, engaged: bool = True,
              axial: float = 0.0) -> KindLoad:
         """Load torque, inertia and motion for a known omega_dot (module doc). ``N`` is the contact's normal force
         [N]: along X on a translating face, P / l on an oscillating face, the pivot torque over L cos(alpha) on a
-        roller arm; alpha the roller arm's pressure angle (0 for a flat face)."""
+        roller arm; alpha the roller arm's pressure angle (0 for a flat face). ``axial`` [N]: the train's force
+        on a translating flat along s, a part of P (so of its friction mu |P| lambda)."""
         if axial:
-            raise ParameterError(f"the follower train does not run with follower_type {self.kind.follower_type!r}")
+            self.refuse_train()
         q, q1, q2, s = self.coordinate(theta)
         s1, s2 = q1 / self._scale, q2 / self._scale
         I_f, kind = self.I_f, self.kind
-        P = I_f * (q2 * omega * omega + q1 * omega_dot) + self.potential_slope(q)
+        P = I_f * (q2 * omega * omega + q1 * omega_dot) + self.potential_slope(q) + axial
         lam = self.lever(q, q1, s) if self.mu else 0.0
         friction = self.mu * abs(P) * lam  # N m on the cam, against its turn
         M = self.M_f * direction + P * q1 + friction * direction

@@ -61,7 +61,8 @@ def simulate_reference(
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
     m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_INTEGRALS
     (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py; with a
-    follower of its own, reference/train_flight.py).
+    follower of its own, reference/train_flight.py); a translating flat on the cam runs the same references with
+    physics.kind_drive.KindDriveModel (its P carries F_train), an arm's train is refused naming follower_type.
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
     'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the
@@ -74,13 +75,14 @@ def simulate_reference(
     elif not named.default and named != follower:
         raise ParameterError(f"follower={follower!r} and the parameters' kind {named!r} differ: give one of them")
     if not follower.default:
-        if train is not None and train.active:
-            raise ParameterError(f"the follower train does not run with follower_type {follower.follower_type!r} "
-                                 f"(only with the translating roller so far)")
-        model = KindDriveModel(params, follower)
-        return kind_reference(model, output_grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"]),
-                              omega_ref or constant(INPUT_STARTS["omega_ref"]),
-                              {"rtol": rtol, "atol": atol, "energy": energy, "method": method})
+        model = KindDriveModel(params, follower)  # refuses an arm's train (parameters) by its follower_type
+        grid, u = output_grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"])
+        omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
+        options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
+        train = model.train if train is None else train
+        if train.active:
+            return _kind_train(model, grid, u, omega_ref, train, options)
+        return kind_reference(model, grid, u, omega_ref, options)
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
@@ -288,6 +290,27 @@ def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Si
     if model.free_follower:  # the train on the follower's own state (docs/model.md 14.6)
         return train_follower_reference(model, grid, u, options, train)
     return voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
+
+
+def _kind_train(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
+                options: dict) -> dict[str, np.ndarray]:
+    """The train on a translating flat follower on the cam (docs/model.md 14.6, 16): the roller's train references
+    with the flat's model, whose P (and so its friction mu |P| lambda) carries F_train; psi, psi_dot are 0."""
+    model.refuse_train()
+    if model.free_follower:
+        raise ParameterError(f"the follower train with follower_type {model.kind.follower_type!r} runs with the "
+                             f"follower on the cam only: parameter 'closure' = {model.closure!r} must be "
+                             f"'kinematic' (a follower of its own with a train is not modelled yet)")
+    name = formulation_name(model)
+    if name == "consistent":
+        result = voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
+    elif name == "speed":
+        result = speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
+    else:
+        raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
+                             f"(parameter 'formulation' = {model.formulation!r})")
+    result["psi"], result["psi_dot"] = np.zeros_like(result["theta"]), np.zeros_like(result["theta"])
+    return result
 
 
 # The reference with a follower train, by formulation (docs/model.md 14.6; the paper's scheme has none).

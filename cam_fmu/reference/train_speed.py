@@ -7,7 +7,7 @@ E_train_damp), with the work the follower does on the train W_train = int F_trai
 E_train_damp = int d_train (v - v_e)^2 dt. DOP853 at the reference's tolerances, stopping at every input break, where
 omega_ref crosses 0 and at every profile breakpoint (s'' and s''' jump there). The rigid drive's outputs come from
 ``speed_drive_outputs`` with the train's force on the follower (``axial``), so the load torque, current and voltage
-carry F_train s'.
+carry F_train s' (a translating flat's KindDriveModel: in its P, so in its friction too).
 """
 from __future__ import annotations
 

@@ -3,10 +3,11 @@ together by scipy, with the shaft's and the guide's Coulomb friction.
 
 y = (theta, omega, i, x_e, v_e, W_train, E_train_damp, E_in, E_copper, E_shaft, E_guide): the rigid drive's
 equation (5.1) with the train's force F_train on the follower (``DriveModel.omega_dot``'s ``axial``: it enters the
-axial force, so the guide's side force N_r and its friction f), i a state with L > 0 (held, and quasi-static,
-with L = 0), the end mass's two states and six energy integrals: W_train = int F_train v dt, E_train_damp =
-int d_train (v - v_e)^2 dt, E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt, E_guide =
-int f |v| dt. The run is reference/hybrid.py's loop with the consistent drive's modes (physics/formulations/
+axial force, so the guide's side force N_r and its friction f; a translating flat's KindDriveModel takes it into its P,
+whose sign is then the side event and mu |P| (r_b + s) the friction, E_guide its loss), i a state with L > 0 (held,
+and quasi-static, with L = 0), the end mass's two states and six energy integrals: W_train = int F_train v dt,
+E_train_damp = int d_train (v - v_e)^2 dt, E_in = int u i dt, E_copper = int R i^2 dt, E_shaft = int M_f |omega| dt,
+E_guide = int f |v| dt. The run is reference/hybrid.py's loop with the consistent drive's modes (physics/formulations/
 consistent.py, section 10): turning one way (friction against it, the guide's friction on the branch of N_r's
 sign) or stuck (omega = 0 while the torque on the held cam, F_train's included, stays within static friction: the
 end mass rings on and the current runs). Events: the stop (omega reaches 0: stuck, or on the other way by the
@@ -125,11 +126,9 @@ class _VoltageTrain(VoltageRun):
 
     def _side_force(self, y, u_t: float, mode: _Mode, side: float) -> float:
         """N_r [N] on the branch ``side`` (0: the one that holds), the train's force in the axial force."""
-        model, omega = self.model, y[OMEGA]
+        omega = y[OMEGA]
         F, _ = self._force(y, omega)
-        drive = self._torque(y, u_t, omega) - model.M_f * mode.direction
-        g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
-        return g.n0 + g.sigma * g.kappa * g.f
+        return self.model.side_force(y[THETA], omega, self._torque(y, u_t, omega), mode.direction, side, F)
 
     def _margin(self, y, u_t: float) -> float:
         """> 0 when the held shaft would start [rad/s2]: the larger acceleration either way, friction against it."""
@@ -161,8 +160,7 @@ class _VoltageTrain(VoltageRun):
             rates[e_shaft] = model.M_f * mode.direction * omega
             if self.guide:
                 drive = torque - model.M_f * mode.direction
-                g = model.guide_terms(y[THETA], omega, drive, mode.direction, side, F)
-                rates[e_guide] = g.sigma * g.f * v
+                rates[e_guide] = model.follower_friction_power(y[THETA], omega, drive, mode.direction, side, F)
         return rates
 
     # ------------------------------------------------------------ the hybrid run's parts

@@ -159,6 +159,14 @@ def test_what_is_not_built_is_refused_by_name(change, named):
         DriveSimulator(dict(defaults(), **arm, **change))
 
 
+def test_the_control_maps_refuse_the_flat_s_train_instead_of_dropping_it():
+    """reflect's map and bode's linear model of another kind have no end mass: a flat's train is refused by name."""
+    p = dict(defaults(), follower_type="translating_flat", k_train=2e4, d_train=2.0, m_end=0.2)
+    for run in (lambda: reflected_map(p, 200.0), lambda: linear_model(p, 1.0)):
+        with pytest.raises(ParameterError, match="k_train"):
+            run()
+
+
 def test_the_reference_and_the_control_maps_refuse_the_arm_s_train_instead_of_dropping_it():
     """The scipy reference, cam-fmu reflect's map and bode's linear model do not carry an arm's train yet: each says
     so, naming the parameter (a map without the train would be a wrong answer)."""

@@ -160,9 +160,12 @@ def test_kind_where_the_reference_cannot_run_it_is_refused(scene, kind, word):
         simulate_reference(scene, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS[kind])
 
 
-def test_train_with_another_kind_is_refused():
-    with pytest.raises(ParameterError, match="train"):
-        simulate_reference(SCENE, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS["translating_flat"],
+@pytest.mark.parametrize("kind", ["oscillating_roller", "oscillating_flat"])
+def test_train_on_an_arm_is_refused(kind):
+    """An arm's train would be torsional (not built); the translating flat's runs (tests/engine/
+    test_engine_train_flat_reference.py)."""
+    with pytest.raises(ParameterError, match="train.*follower_type"):
+        simulate_reference(SCENE, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS[kind],
                            train=Train(k_train=1e6, m_end=1.0))
 
 
