@@ -69,9 +69,11 @@ def kind_view(params: Mapping[str, Any] | None) -> KindView | None:
         raise ParameterError(f"parameter 'J_cam' = {p['J_cam']!r} [kg.m2]: a compliant shaft (k_shaft = {k_shaft!r} "
                              f"N.m/rad) needs the inertia of its cam side; allowed with k_shaft > 0: J_cam in "
                              f"(0, 100] kg.m2")
-    if p["k_train"] > 0.0:   # the view's maps and linear model have no end mass: refused, not dropped
-        raise ParameterError(f"parameter 'k_train' = {p['k_train']!r} N/m with follower_type {kind.follower_type!r}: "
-                             f"cam-fmu reflect and bode carry the follower train on the translating roller only so "
-                             f"far (the engine runs it: docs/model.md 14.6); allowed here: k_train = 0")
+    for name, unit in (("k_train", "N/m"), ("k_train_arm", "N.m/rad")):   # no end mass here: refused, not dropped
+        if p[name] > 0.0:
+            raise ParameterError(f"parameter {name!r} = {p[name]!r} {unit} with follower_type {kind.follower_type!r}: "
+                                 f"cam-fmu reflect and bode carry the follower train on the translating roller only "
+                                 f"so far (the engine and the reference run it: docs/model.md 14.6); allowed here: "
+                                 f"{name} = 0")
     model = KindDriveModel(dict(p, k_shaft=0.0), kind)
     return KindView(model, k_shaft, float(p["d_shaft"]), float(p["J_m"]), float(p["J_cam"]))

@@ -22,8 +22,10 @@ torque on the arm); oscillating roller: the roller rolls, the pivot carries a Co
 turn, lambda = |psi'|. The friction's power mu |P| lambda |omega| is the loss. Lagrange's equation with
 J(theta) = J_0 + I_f q'^2 gives omega_dot; |P| depends on omega_dot, solved exactly on the branch sgn(P) (held between
 the side events of the reference, as the guide's N_r). A translating flat carries the follower train's force F_train
-(``axial`` [N], docs/model.md 14.6) along s: it adds to P, so to the friction mu |P| lambda; an arm's train
-(torsional) is refused naming follower_type. Plain functions of floats, as physics/drive.py.
+(``axial`` [N], docs/model.md 14.6) along s: it adds to P, so to the friction mu |P| lambda; an arm's train is
+torsional (k_train_arm, d_train_arm, J_end), carried in the law's lift units along s as the engine does (k_train =
+k_train_arm scale^2, ..., its force along s over scale the torque joining the arm's P); k_train on an arm is refused
+naming follower_type. Plain functions of floats, as physics/drive.py.
 """
 from __future__ import annotations
 
@@ -35,6 +37,7 @@ from ..kinematics.follower_checks import refuse_unbuildable
 from ..kinematics.follower_types import make_cam
 from .drive import DriveModel, LoadState, effective_clearance, follower_mass, sign
 from .follower_kind import FollowerKind
+from .train import Train
 from .parameters import KGF, ParameterError, mounting_component, resolve
 
 __all__ = ["KindDriveModel", "KindLoad"]
@@ -80,6 +83,9 @@ class KindDriveModel(DriveModel):
             self._scale = 1.0
             self.I_f = m
             self.W = 0.0
+        if p.get("k_train_arm", 0.0) > 0.0:   # an arm's torsional train in the law's lift units along s (14.6)
+            k2 = self._scale * self._scale
+            self.train = Train(p["k_train_arm"] * k2, p["d_train_arm"] * k2, p["J_end"] * k2)
         self.follower = self.I_f != 0.0 or self.F_gx != 0.0 or self.W != 0.0 or self.mu != 0.0
         if kind.follower_type == "oscillating_flat":
             self._delta0 = math.asin(min(1.0, self.r_b / kind.pivot_distance))
@@ -97,8 +103,7 @@ class KindDriveModel(DriveModel):
         kind = self.kind.follower_type
         refused = [name for name, on in (("'c' (clearance)", effective_clearance(p) != 0.0 and not self.free_follower),
                                          ("'k_shaft' (compliant shaft)", self.compliant),
-                                         ("'k_train_arm' (an arm's torsional train)",
-                                          p.get("k_train_arm", 0.0) > 0.0)) if on]
+                                         ) if on]
         if p.get("k_train", 0.0) > 0.0:
             self.refuse_train()
         if refused:
@@ -111,11 +116,12 @@ class KindDriveModel(DriveModel):
                                  f"(the arm's angle to gravity is its psi_0): leave it at 0")
 
     def refuse_train(self) -> None:
-        """Refuse the follower train on an arm: its train would be torsional, about the pivot, not built."""
+        """Refuse the follower train along X (k_train) on an arm: an arm's is torsional (k_train_arm, ...)."""
         if self.kind.oscillating:
             raise ParameterError(f"the follower train ('k_train' > 0) does not run with follower_type "
-                                 f"{self.kind.follower_type!r} (an arm's torsional train is not built): allowed "
-                                 f"follower_type 'translating_roller' or 'translating_flat'")
+                                 f"{self.kind.follower_type!r}: an arm's train is torsional (k_train_arm, "
+                                 f"d_train_arm, J_end); allowed follower_type 'translating_roller' or "
+                                 f"'translating_flat'")
 
     # ----------------------------------------------------------- the kind's terms
     def coordinate(self, theta: float) -> tuple[float, float, float, float]:
@@ -172,7 +178,7 @@ class KindDriveModel(DriveModel):
     def _terms(self, theta: float, omega: float, axial: float = 0.0) -> tuple[float, float, float]:
         """(A, q', lambda): P = A + I_f q' omega_dot; ``axial`` [N]: the train's force along q, in A."""
         q, q1, q2, s = self.coordinate(theta)
-        A = self.I_f * q2 * omega * omega + self.potential_slope(q) + axial
+        A = self.I_f * q2 * omega * omega + self.potential_slope(q) + axial / self._scale
         return A, q1, self.lever(q, q1, s) if self.mu else 0.0
 
     def _branch(self, A: float, q1: float, lam: float, drive: float, direction: float,
@@ -194,8 +200,6 @@ class KindDriveModel(DriveModel):
         """Angular acceleration [rad/s2]: J(theta) omega_dot = c_m i - M_f d - (A + mu |P| lambda d) ... solved on
         the branch of sgn(P) (module doc); ``side`` fixes that branch (+1/-1), 0 chooses it. ``axial`` [N]: the
         follower train's force on a translating flat along s (docs/model.md 14.6), a part of P."""
-        if axial:
-            self.refuse_train()
         drive = torque - self.M_f * direction
         if not (self.follower or axial):
             return drive / self.J_0
@@ -208,8 +212,6 @@ class KindDriveModel(DriveModel):
         ``axial`` [N] the train's force in P."""
         if self.mu == 0.0 or not self.follower:
             return 0.0
-        if axial:
-            self.refuse_train()
         A, q1, lam = self._terms(theta, omega, axial)
         return self._branch(A, q1, lam, torque - self.M_f * direction, direction, side)[1]
 
@@ -219,8 +221,6 @@ class KindDriveModel(DriveModel):
         |omega| while side = sgn(P), d = sgn(omega); smooth through the stop), ``drive`` = T - M_f d [N m]."""
         if self.mu == 0.0 or not self.follower:
             return 0.0
-        if axial:
-            self.refuse_train()
         A, q1, lam = self._terms(theta, omega, axial)
         P = self._branch(A, q1, lam, drive, direction, side)[1]
         return self.mu * side * P * lam * direction * omega
@@ -231,12 +231,10 @@ class KindDriveModel(DriveModel):
         [N]: along X on a translating face, P / l on an oscillating face, the pivot torque over L cos(alpha) on a
         roller arm; alpha the roller arm's pressure angle (0 for a flat face). ``axial`` [N]: the train's force
         on a translating flat along s, a part of P (so of its friction mu |P| lambda)."""
-        if axial:
-            self.refuse_train()
         q, q1, q2, s = self.coordinate(theta)
         s1, s2 = q1 / self._scale, q2 / self._scale
         I_f, kind = self.I_f, self.kind
-        P = I_f * (q2 * omega * omega + q1 * omega_dot) + self.potential_slope(q) + axial
+        P = I_f * (q2 * omega * omega + q1 * omega_dot) + self.potential_slope(q) + axial / self._scale
         lam = self.lever(q, q1, s) if self.mu else 0.0
         friction = self.mu * abs(P) * lam  # N m on the cam, against its turn
         M = self.M_f * direction + P * q1 + friction * direction

@@ -56,8 +56,9 @@ class Train:
 
 
 def end_weight(train: Train, params: Mapping[str, Any]) -> float:
-    """F_ex [N]: the end mass's weight along X, m_end g_n sin(gamma) cos(beta) with gravity on, else 0."""
-    if not params["gravity"]:
+    """F_ex [N]: the end mass's weight along X, m_end g_n sin(gamma) cos(beta) with gravity on, else 0 (and 0 for
+    an arm's torsional train, whose end inertia turns about its own centre)."""
+    if not params["gravity"] or str(params.get("follower_type", "")).startswith("oscillating"):
         return 0.0
     gamma, beta = params["gamma"], params["beta"]
     along = mounting_component(math.sin(gamma), gamma) * mounting_component(math.cos(beta), beta)

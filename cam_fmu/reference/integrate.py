@@ -75,7 +75,7 @@ def simulate_reference(
     elif not named.default and named != follower:
         raise ParameterError(f"follower={follower!r} and the parameters' kind {named!r} differ: give one of them")
     if not follower.default:
-        model = KindDriveModel(params, follower)  # refuses an arm's train (parameters) by its follower_type
+        model = KindDriveModel(params, follower)  # refuses k_train on an arm by its follower_type
         grid, u = output_grid(stop_time, output_interval), u or constant(INPUT_STARTS["u"])
         omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])
         options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
@@ -294,22 +294,27 @@ def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Si
 
 def _kind_train(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
                 options: dict) -> dict[str, np.ndarray]:
-    """The train on a translating flat follower on the cam (docs/model.md 14.6, 16): the roller's train references
-    with the flat's model, whose P (and so its friction mu |P| lambda) carries F_train; psi, psi_dot are 0."""
-    model.refuse_train()
+    """The train on another kind on the cam (docs/model.md 14.6, 16): the roller's train references with the kind's
+    model, whose P (and so its friction mu |P| lambda) carries F_train (an arm's torsional train in the law's lift
+    units, its torque F_train / scale); psi, psi_dot the arm's (0 for the flat). A Train given to an arm beside its
+    parameters is refused: an arm's train is torsional, its parameters k_train_arm, d_train_arm, J_end."""
+    if model.kind.oscillating and train is not model.train:
+        raise ParameterError(f"a follower train given along X does not run with follower_type "
+                             f"{model.kind.follower_type!r}: an arm's train is torsional, set by the parameters "
+                             f"'k_train_arm', 'd_train_arm', 'J_end'")
     if model.free_follower:
         raise ParameterError(f"the follower train with follower_type {model.kind.follower_type!r} runs with the "
                              f"follower on the cam only: parameter 'closure' = {model.closure!r} must be "
                              f"'kinematic' (a follower of its own with a train is not modelled yet)")
-    name = formulation_name(model)
-    if name == "consistent":
-        result = voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
-    elif name == "speed":
-        result = speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
-    else:
+    run = TRAIN_REFERENCES.get(formulation_name(model))   # the roller's, on the cam (the follower's own refused)
+    if run is None:
         raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
                              f"(parameter 'formulation' = {model.formulation!r})")
-    result["psi"], result["psi_dot"] = np.zeros_like(result["theta"]), np.zeros_like(result["theta"])
+    result = run(model, grid, u, omega_ref, train, options)
+    q = [model.coordinate(theta) for theta in result["theta"]] if model.kind.oscillating else None
+    zeros = np.zeros_like(result["theta"])
+    result["psi"] = np.array([c[0] for c in q]) if q else zeros
+    result["psi_dot"] = np.array([c[1] for c in q]) * result["omega"] if q else zeros
     return result
 
 

@@ -1,7 +1,8 @@
 """The follower train on a translating flat follower WITH its friction (docs/model.md 14.6, 16.3): the engine's
 flat (kind.c, the train's force F_train along s in P, so in the face's friction mu |P| (r_b + s)) against the scipy
 reference's flat (physics/kind_drive.py's KindDriveModel with ``axial`` through reference/train_voltage.py and
-train_speed.py, written apart from the C); an arm's train is refused by the reference naming follower_type."""
+train_speed.py, written apart from the C); a train along X on an arm is refused by the reference naming follower_type
+(an arm's is torsional: tests/engine/test_engine_train_arm.py)."""
 from __future__ import annotations
 
 import numpy as np

@@ -162,8 +162,8 @@ def test_kind_where_the_reference_cannot_run_it_is_refused(scene, kind, word):
 
 @pytest.mark.parametrize("kind", ["oscillating_roller", "oscillating_flat"])
 def test_train_on_an_arm_is_refused(kind):
-    """An arm's train would be torsional (not built); the translating flat's runs (tests/engine/
-    test_engine_train_flat_reference.py)."""
+    """An arm's train is torsional, set by its own parameters (tests/engine/test_engine_train_arm.py): a train given
+    along X is refused; the translating flat's runs (tests/engine/test_engine_train_flat_reference.py)."""
     with pytest.raises(ParameterError, match="train.*follower_type"):
         simulate_reference(SCENE, 0.1, 0.01, omega_ref=constant(OMEGA), follower=KINDS[kind],
                            train=Train(k_train=1e6, m_end=1.0))
