@@ -310,7 +310,6 @@ void cam_exchange_enter_continuous(CamExchange *e)
     e->requested = 0;
     e->iterations = 0;
     e->broke_away = 0;
-    e->step_time = d->time;
     cam_exchange_sync(e);
     if (!d->have_budget) {
         cam_energy_init(&d->budget, &d->model, cam_drive_outputs(d));
@@ -342,21 +341,10 @@ static void book(CamExchange *e, CamEnergy *budget, const double out[])
 int cam_exchange_completed_step(CamExchange *e, int *enter_event)
 {
     CamDrive *d = e->drive;
-    double z[CAM_EXCHANGE_NZ], excess, tolerance, out[CAM_N_OUTPUTS], h;
+    double z[CAM_EXCHANGE_NZ], excess, tolerance, out[CAM_N_OUTPUTS];
     int codes[CAM_MAX_EVENTS], n, k, verdict;
     *enter_event = 0;
-    e->warning = 0;
     cam_exchange_sync(e);
-    h = d->time - e->step_time;
-    if (d->model.train && !e->train_warned && d->model.train_rate * h > CAM_EXCHANGE_TRAIN_PHASE) {
-        e->train_warned = e->warning = 1;
-        cam_error(cam_instance_error(e->instance), CAM_OK, "the host's step of %g s before t = %g s spans %.3g rad of "
-                  "the follower train's ringing (%s = %.4g 1/s): a fixed-step method aliases or grows it (rk4 needs "
-                  "steps below about %.3g s, explicit Euler far less); reduce the host's step, or let an adaptive "
-                  "solver choose it (said once)", h, d->time, d->model.train_rate * h, cam_train_names(&d->model),
-                  d->model.train_rate, 0.37 / d->model.train_rate);
-    }
-    e->step_time = d->time;
     memcpy(out, cam_drive_outputs(d), sizeof out);
     verdict = cam_publishable(&d->model, out, NULL, d->u, 0.0);
     if (verdict == CAM_PUBLISH_NOT_FINITE) {

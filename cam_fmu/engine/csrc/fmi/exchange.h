@@ -36,7 +36,6 @@ typedef char cam_exchange_indicator_count[CAM_N_EVENT_INDICATORS == CAM_EXCHANGE
 #define CAM_EXCHANGE_IDLE 1.0            /* an unused indicator slot */
 #define CAM_EXCHANGE_MAX_ITERATIONS 32   /* transitions at one event instant at most */
 #define CAM_EXCHANGE_PROBE 1e-9          /* s: how far ahead an indicator at exactly 0 is looked at */
-#define CAM_EXCHANGE_TRAIN_PHASE 1.0     /* rad of the train's ringing in one host step: rk4 errs 5 % a period there */
 
 typedef struct {
     CamInstance *instance;      /* not owned */
@@ -46,9 +45,6 @@ typedef struct {
     int requested;              /* a completed step asked for event mode, not entered since */
     int iterations;             /* event updates at this event instant */
     int broke_away;             /* the break-away's transition was applied at this event instant */
-    double step_time;           /* s: the host's last completed step (or the entry into continuous time) */
-    int train_warned;           /* the host's step was said to span too much of the train's ringing (once) */
-    int warning;                /* this completed step's warning is the instance's message (status OK) */
 } CamExchange;
 
 /* A transition applied by an event update (code -1: none), for the host's log. */
@@ -78,9 +74,6 @@ int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx);
 void cam_exchange_enter_event_mode(CamExchange *e);
 int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *values_changed, int *needed);
 void cam_exchange_enter_continuous(CamExchange *e);
-/* A host's step spanning more than CAM_EXCHANGE_TRAIN_PHASE rad of a follower train's ringing is said once, as a
- * warning (e->warning; the host's method is its own: an adaptive one may take such a step where the ringing has
- * died out, a fixed-step one aliases or grows it; docs/model.md 14.7). */
 int cam_exchange_completed_step(CamExchange *e, int *enter_event);
 
 /* cam_instance_save with the energy bound booked up to the drive's time (the live books unchanged). */
