@@ -31,6 +31,22 @@ def engine_run(params: dict, stop: float = STOP, step: float = STEP) -> dict[str
     return {name: np.array([r[name] for r in rows]) for name in rows[0]}
 
 
+# V: 12 V, then -6 V, then 0 V: the cam runs, reverses, stops and is broken away again by a ringing train
+REVERSING = Signal((0.0, 0.3, 0.3, 0.63, 0.63), (12.0, 12.0, -6.0, -6.0, 0.0))
+
+
+def voltage_run(params: dict, u: Signal) -> tuple[DriveSimulator, dict[str, np.ndarray]]:
+    """The voltage drive stepped over the test's grid under u (its value at each step's start): the simulator and its
+    outputs as columns."""
+    sim = DriveSimulator(params)
+    sim.set_inputs(u.value(0.0), 0.0)
+    rows = [sim.outputs()]
+    for k in range(int(round(STOP / STEP))):
+        sim.do_step(k * STEP, STEP, u=u.value(k * STEP))
+        rows.append(sim.outputs())
+    return sim, {name: np.array([r[name] for r in rows]) for name in rows[0]}
+
+
 def speed_run(params: dict, omega_ref: Signal) -> dict[str, np.ndarray]:
     """The speed drive stepped over the test's grid under omega_ref (its value and slope at each step's start)."""
     sim = DriveSimulator(params)
@@ -80,16 +96,9 @@ def test_with_friction_the_cam_stops_sticks_and_breaks_away_under_the_ringing_tr
     """Shaft and guide friction under gravity, 12 V then -6 V then 0 V: the cam reverses, stops and is broken away
     again by the train's ringing alone (a break-away event while it is held), as in the reference; measured 1.2e-8 ..
     5e-7 of each output's largest value (the compliant shaft's, the rotor's too: 2.5e-8)."""
-    u = Signal((0.0, 0.3, 0.3, 0.63, 0.63), (12.0, 12.0, -6.0, -6.0, 0.0))
     params = dict(defaults(), **dict(TRAIN, M_f=0.012, mu=0.1), gamma=0.5, inductance=inductance, **shaft)
-    sim = DriveSimulator(params)
-    sim.set_inputs(u.value(0.0), 0.0)
-    rows = [sim.outputs()]
-    for k in range(int(round(STOP / STEP))):
-        sim.do_step(k * STEP, STEP, u=u.value(k * STEP))
-        rows.append(sim.outputs())
-    engine = {name: np.array([r[name] for r in rows]) for name in rows[0]}
-    reference = simulate_reference(params, STOP, STEP, u=u)
+    sim, engine = voltage_run(params, REVERSING)
+    reference = simulate_reference(params, STOP, STEP, u=REVERSING)
     for name in NAMES + (("omega_m", "M_shaft") if shaft else ()):
         assert worst(engine, reference, name) < 2e-6, (name, worst(engine, reference, name))
     names = [e["name"] for e in sim.events()]

@@ -5,15 +5,13 @@ train_speed.py, written apart from the C); a train along X on an arm is refused 
 (an arm's is torsional: tests/engine/test_engine_train_arm.py)."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
-from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.physics.parameters import ParameterError, defaults
 from cam_fmu.physics.signals import Signal
 from cam_fmu.physics.train import Train
 from cam_fmu.reference.integrate import simulate_reference
-from tests.engine.test_engine_train import STEP, STOP, TRAIN, speed_run, worst
+from tests.engine.test_engine_train import REVERSING, STEP, STOP, TRAIN, speed_run, voltage_run, worst
 
 # the face's and the shaft's friction, gravity tilted out of the plane and along the path
 FLAT = dict(TRAIN, mu=0.03, M_f=0.01, gamma=1.0, beta=0.3, follower_type="translating_flat")
@@ -25,16 +23,9 @@ def test_the_flat_s_train_with_friction_runs_as_the_flat_reference_in_the_voltag
     break-aways, 46 stops, 47 sign changes of P); measured 1.7e-10 (theta) .. 1.2e-8 (a_end) of each output's largest
     value (rk45 at the engine's default rtol 1e-10 against the reference at rtol 1e-12, which lies within 1.2e-10 of
     itself at 1e-13; at 1e-10 the reference is 1.1e-2 off itself, a stop decided the other way)."""
-    u = Signal((0.0, 0.3, 0.3, 0.63, 0.63), (12.0, 12.0, -6.0, -6.0, 0.0))
     params = dict(defaults(), **FLAT)
-    sim = DriveSimulator(params)
-    sim.set_inputs(u.value(0.0), 0.0)
-    rows = [sim.outputs()]
-    for k in range(int(round(STOP / STEP))):
-        sim.do_step(k * STEP, STEP, u=u.value(k * STEP))
-        rows.append(sim.outputs())
-    engine = {name: np.array([r[name] for r in rows]) for name in rows[0]}
-    reference = simulate_reference(params, STOP, STEP, u=u)
+    sim, engine = voltage_run(params, REVERSING)
+    reference = simulate_reference(params, STOP, STEP, u=REVERSING)
     for name in NAMES:
         assert worst(engine, reference, name) < 1e-7, (name, worst(engine, reference, name))
     names = [e["name"] for e in sim.events()]
