@@ -61,8 +61,9 @@ def simulate_reference(
     ``train``: the follower train (physics.train.Train, docs/model.md 14.6; None: the parameters' k_train, d_train,
     m_end); k_train = 0 is the rigid drive, bit for bit. With one the outputs add reference.train_speed.TRAIN_INTEGRALS
     (the speed drive; the voltage drive, with its friction and a compliant shaft, reference/train_voltage.py; with a
-    follower of its own, reference/train_flight.py); a translating flat on the cam runs the same references with
-    physics.kind_drive.KindDriveModel (its P carries F_train), an arm's train is refused naming follower_type.
+    follower of its own, reference/train_flight.py); a translating flat or an arm on the cam runs the same references
+    with physics.kind_drive.KindDriveModel (its P carries F_train; an arm's torsional train from its parameters
+    k_train_arm, d_train_arm, J_end, in lift units); a Train given along X to an arm is refused naming follower_type.
 
     ``follower``: the follower's kind (physics.follower_kind.FollowerKind, docs/model.md 16); None or
     'translating_roller' is today's drive, bit for bit. Another kind runs in the consistent formulation and the
