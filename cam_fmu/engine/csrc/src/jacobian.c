@@ -72,7 +72,7 @@ static double omega_dot_tangent(const CamModel *m, const CamMode *mode, const do
 
 double cam_train_tangent(const CamModel *m, double ds, double dv, const double seed[CAM_NX])
 {
-    return m->train ? m->k_train * (ds - seed[CAM_X_END]) + m->d_train * (dv - seed[CAM_V_END]) : 0.0;
+    return m->train ? cam_train_pull(m, ds, dv, seed[CAM_X_END], seed[CAM_V_END]) : 0.0;
 }
 
 void cam_train_rows(const CamModel *m, const double seed[CAM_NX], double dF_rate, double dF_out, double ddx[CAM_NX],

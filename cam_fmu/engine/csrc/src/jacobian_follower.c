@@ -117,7 +117,7 @@ void cam_vf_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const doubl
     dv = p[2] * dtheta * y[1] + p[1] * domega;
     if (contact) {
         if (m->train) {   /* on a stuck flank the rates take the follower at rest */
-            F_t = m->k_train * (y[3] - y[Y_XE]) + m->d_train * ((stuck ? 0.0 : y[4]) - y[Y_VE]);
+            F_t = cam_train_pull(m, y[3], stuck ? 0.0 : y[4], y[Y_XE], y[Y_VE]);
             dF_t = cam_train_tangent(m, ds, stuck ? 0.0 : dv, seed);
         }
         dF = m->k_spring * p[1] * dtheta + dF_t;   /* the closing force at s = s_cam - contact c, a train's */

@@ -268,7 +268,6 @@ void cam_kind_init(CamModel *m)
         m->d_train = v[CAM_P_D_TRAIN_ARM] * k2;
         m->m_end = v[CAM_P_J_END] * k2;
         m->F_ex = 0.0;   /* the end inertia turns about its own centre: no weight's torque */
-        m->train_rate = sqrt(m->k_train / m->m_end) + m->d_train / m->m_end;
     }
     if (m->kind == CAM_CHOICE_FOLLOWER_TYPE_OSCILLATING_ROLLER) {   /* cam_kind_check refuses the arm out of reach */
         if (fabs(d - L) < r_b && r_b < d + L)
@@ -316,7 +315,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
     if (m->train) {   /* the train (docs/model.md 14.6): its force along s at the follower, its torque along an arm's q */
-        force += (m->k_train * (qf / k - x[CAM_X_END]) + m->d_train * (q[1] * w / k - x[CAM_V_END])) / k;
+        force += cam_train_pull(m, qf / k, q[1] * w / k, x[CAM_X_END], x[CAM_V_END]) / k;
         dF = cam_train_tangent(m, q[1] * dtheta / k, (q[2] * dtheta * w + q[1] * dw) / k, seed);
     }
     dJ = 2.0 * m->I_f * q[1] * q[2] * dtheta;

@@ -120,7 +120,7 @@ double cam_train_force(const CamModel *m, double theta, double omega, double x_e
     if (!m->train)
         return 0.0;
     cam_profile_eval(&m->profile, theta, d);
-    return m->k_train * (d[0] - x_e) + m->d_train * (d[1] * omega - v_e);
+    return cam_train_pull(m, d[0], d[1] * omega, x_e, v_e);
 }
 
 double cam_train_force_at(const CamModel *m, const double x[CAM_NX], double omega)
@@ -377,8 +377,8 @@ int cam_model_init(CamModel *model, const CamParams *params, CamError *err)
     model->m_end = model->train ? v[CAM_P_M_END] : 0.0;
     model->F_ex = v[CAM_P_GRAVITY] != 0.0 ? model->m_end * CAM_G_N * mounting(sin(v[CAM_P_GAMMA]), v[CAM_P_GAMMA])
                                              * mounting(cos(v[CAM_P_BETA]), v[CAM_P_BETA]) : 0.0;   /* N: its weight */
+    cam_kind_init(model);   /* the follower's type (kind.c, docs/model.md 16; an arm's torsional train) */
     model->train_rate = model->train ? sqrt(model->k_train / model->m_end) + model->d_train / model->m_end : 0.0;
-    cam_kind_init(model);   /* the follower's type (kind.c, docs/model.md 16) */
     model->follower = model->I_f != 0.0 || model->F_gx != 0.0 || model->W != 0.0 || model->mu != 0.0 || model->train;
     model->has_current = model->L > 0.0;
     model->backlash = model->c > 0.0;

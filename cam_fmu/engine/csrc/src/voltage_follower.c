@@ -42,7 +42,7 @@
  * without a train). */
 static double train_force(const CamModel *m, const double y[NY], double q, double q_dot)
 {
-    return m->train ? m->k_train * (q / m->q_scale - y[Y_XE]) + m->d_train * (q_dot / m->q_scale - y[Y_VE]) : 0.0;
+    return m->train ? cam_train_pull(m, q / m->q_scale, q_dot / m->q_scale, y[Y_XE], y[Y_VE]) : 0.0;
 }
 
 /* N (an arm: N m): what closes the follower onto its +1 flank at q, q_dot: the return spring and gravity, and a
