@@ -59,6 +59,12 @@ def kind_reference(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref
     result = run(model, grid, u, omega_ref, options)
     if model.free_follower:  # the follower's own psi, psi_dot are in its rows
         return result
+    return with_arm_angle(model, result)
+
+
+def with_arm_angle(model: KindDriveModel, result: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``result`` with the columns psi [rad] and psi_dot [rad/s] of a follower on the cam: an arm's angle and rate at
+    the result's theta and omega, 0 for a translating follower."""
     if model.kind.oscillating:
         psi, psi1 = model.cam.arm.derivatives(np.asarray(result["theta"], dtype=float))[:2]
         result["psi"], result["psi_dot"] = psi, psi1 * result["omega"]

@@ -34,7 +34,7 @@ from ..physics.parameters import ParameterError, resolve
 from ..physics.train import Train
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
-from .follower_kind import kind_reference
+from .follower_kind import kind_reference, with_arm_angle
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .train_flight import train_follower_reference, train_speed_follower_reference
 from .train_speed import speed_train_reference
@@ -311,12 +311,7 @@ def _kind_train(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: S
     if run is None:
         raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
                              f"(parameter 'formulation' = {model.formulation!r})")
-    result = run(model, grid, u, omega_ref, train, options)
-    q = [model.coordinate(theta) for theta in result["theta"]] if model.kind.oscillating else None
-    zeros = np.zeros_like(result["theta"])
-    result["psi"] = np.array([c[0] for c in q]) if q else zeros
-    result["psi_dot"] = np.array([c[1] for c in q]) * result["omega"] if q else zeros
-    return result
+    return with_arm_angle(model, run(model, grid, u, omega_ref, train, options))
 
 
 # The reference with a follower train, by formulation (docs/model.md 14.6; the paper's scheme has none).
