@@ -85,7 +85,7 @@ class KindDriveModel(DriveModel):
             self.W = 0.0
         if p.get("k_train_arm", 0.0) > 0.0:   # an arm's torsional train in the law's lift units along s (14.6)
             k2 = self._scale * self._scale
-            self.train = Train(p["k_train_arm"] * k2, p["d_train_arm"] * k2, p["J_end"] * k2)
+            self.train = Train(p["k_train_arm"] * k2, p["d_train_arm"] * k2, p["J_end"] * k2, torsional=True)
         self.follower = self.I_f != 0.0 or self.F_gx != 0.0 or self.W != 0.0 or self.mu != 0.0
         if kind.follower_type == "oscillating_flat":
             self._delta0 = math.asin(min(1.0, self.r_b / kind.pivot_distance))

@@ -26,15 +26,19 @@ G_N = KGF  # m/s2, standard gravity (the weight of the end mass; the follower's 
 @dataclass(frozen=True)
 class Train:
     """The follower train: stiffness ``k_train`` [N/m] (0: no train, the rigid drive), damping ``d_train`` [N.s/m]
-    and end mass ``m_end`` [kg]."""
+    and end mass ``m_end`` [kg]. ``torsional``: an arm's train (k_train_arm, d_train_arm, J_end, checked as those
+    parameters) carried in the law's lift units, its three scaled by (lift_angle / lift)^2: the ranges along X do not
+    apply, and its end inertia turns about its own centre (no weight along X, end_weight)."""
 
     k_train: float = 0.0
     d_train: float = 0.0
     m_end: float = 0.0
+    torsional: bool = False
 
     def __post_init__(self) -> None:
         for name, low, high in (("k_train", 0.0, 1e12), ("d_train", 0.0, 1e9), ("m_end", 0.0, 1e4)):
             value = getattr(self, name)
+            high = math.inf if self.torsional else high
             if not (isinstance(value, (int, float)) and math.isfinite(value) and low <= value <= high):
                 raise ParameterError(f"train parameter '{name}' = {value!r}: allowed {low:g} .. {high:g}")
         if self.k_train > 0.0 and self.m_end <= 0.0:
@@ -58,7 +62,7 @@ class Train:
 def end_weight(train: Train, params: Mapping[str, Any]) -> float:
     """F_ex [N]: the end mass's weight along X, m_end g_n sin(gamma) cos(beta) with gravity on, else 0 (and 0 for
     an arm's torsional train, whose end inertia turns about its own centre)."""
-    if not params["gravity"] or str(params.get("follower_type", "")).startswith("oscillating"):
+    if not params["gravity"] or train.torsional:
         return 0.0
     gamma, beta = params["gamma"], params["beta"]
     along = mounting_component(math.sin(gamma), gamma) * mounting_component(math.cos(beta), beta)
