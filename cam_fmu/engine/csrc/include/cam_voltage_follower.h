@@ -13,8 +13,9 @@
 #define Y_ROTOR 6
 #define Y_SIGMA 7               /* y[7]: the flying follower's direction sgn(v) over the step (0: held), rate 0 */
 #define Y_DIR 8                 /* y[8]: the shaft's direction, sgn(omega) or the break-away's at omega = 0; 0: stuck;
-                                 * held over a step (a stop ends it): a Runge-Kutta stage past omega = 0 with sgn(omega)
-                                 * would turn the friction inside the step and misplace the stop (3.3e-6 rad at 7e-4 s) */
+                                 * held over a step (a stop ends it): a Runge-Kutta stage past omega = 0 with
+                                 * sgn(omega) would turn the friction inside the step and misplace the stop (3.3e-6 rad
+                                 * at steps of 7e-4 s) */
 #define Y_XE 9                  /* y[9], y[10]: a follower train's end mass [m, m/s] (docs/model.md 14.6; 0 without) */
 #define Y_VE 10
 

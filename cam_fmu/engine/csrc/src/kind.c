@@ -314,7 +314,7 @@ int cam_kind_tangent(const CamModel *m, const CamMode *mode, const double x[CAM_
         omega_dot = 0.0;
     w = moving ? x[CAM_OMEGA] : 0.0;
     dw = moving ? domega : 0.0;
-    if (m->train) {   /* the train (docs/model.md 14.6): its force along s at the follower, its torque along an arm's q */
+    if (m->train) {   /* the train (docs/model.md 14.6): its force along s at the follower, over k along an arm's q */
         force += cam_train_pull(m, qf / k, q[1] * w / k, x[CAM_X_END], x[CAM_V_END]) / k;
         dF = cam_train_tangent(m, q[1] * dtheta / k, (q[2] * dtheta * w + q[1] * dw) / k, seed);
     }

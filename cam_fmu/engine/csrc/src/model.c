@@ -149,7 +149,7 @@ void cam_rhs(const CamModel *m, const CamMode *mode, const double x[CAM_NX], dou
         cam_vf_rhs(m, mode, x, u, dx);
         return;
     }
-    drive = cam_drive_torque(m, x, omega, u);   /* the motor's, or a compliant shaft's (x[CAM_OMEGA] is 0 while stuck) */
+    drive = cam_drive_torque(m, x, omega, u);   /* the motor's or a compliant shaft's (x[CAM_OMEGA] 0 while stuck) */
     F = cam_train_force_at(m, x, mode->stuck ? 0.0 : omega);
     if (mode->stuck) {
         dx[CAM_THETA] = 0.0;

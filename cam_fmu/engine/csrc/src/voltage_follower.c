@@ -198,8 +198,8 @@ void cam_vf_rates(const CamModel *m, double u, int contact, const double y[NY], 
         end_mass_rates(m, y, d[0] - contact * cam_follower_clearance(m), dy[3], dy);
         return;
     }
-    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : (m->prescribed ? u : cam_vf_torque_toward(m, y, u, y[Y_DIR]) / m->J_0);   /* the cam stuck: the follower
-                                                                                      * flies alone */
+    /* the cam stuck: the follower flies alone */
+    dy[1] = y[Y_DIR] == 0.0 ? 0.0 : (m->prescribed ? u : cam_vf_torque_toward(m, y, u, y[Y_DIR]) / m->J_0);
     dy[3] = y[4];
     dy[4] = flight_acceleration(m, y);
     end_mass_rates(m, y, y[3], y[4], dy);
