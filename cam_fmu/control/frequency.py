@@ -24,6 +24,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..physics.drive import DriveModel
+from ..physics.train import Train
 from .kind_view import KindView, kind_view
 
 SETTLE_TIME_CONSTANTS = 8.0  # time constants of the slowest pole of the linear model, at least
@@ -89,11 +90,12 @@ def _end_weight(model: DriveModel) -> float:
     return end_weight(model.train, model.params) if model.train.active else 0.0
 
 
-def _with_train(model: DriveModel, s1: float, J_c: float, A: list, C: list) -> tuple[list, list]:
+def _with_train(train: Train, s1: float, J_c: float, A: list, C: list) -> tuple[list, list]:
     """A and C with a train's end mass (docs/model.md 14.6) appended as two states, its deviation from the static
-    deflection and its velocity: dF = k_train (s' dtheta - x_e) + d_train (s' omega - v_e) pulls the cam (row 1, its
-    speed) by -s' dF / J_c and drives the end mass, m_end v_e' = dF."""
-    k, d, m_e = model.train.k_train, model.train.d_train, model.train.m_end
+    deflection and its velocity, in the law's lift units along s (an arm's torsional train scaled, control.kind_view):
+    dF = k_train (s' dtheta - x_e) + d_train (s' omega - v_e) pulls the cam (row 1, its speed) by -s' dF / J_c and
+    drives the end mass, m_end v_e' = dF."""
+    k, d, m_e = train.k_train, train.d_train, train.m_end
     n = len(A)
     A = [row + [0.0, 0.0] for row in A] + [[0.0] * (n + 2) for _ in range(2)]
     A[1][0] -= s1 * k * s1 / J_c
@@ -108,7 +110,8 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
     """(A, B, C) of the drive linearised at rest at theta0 [rad] without friction (docs/model.md 12.3): states
     (theta - theta0, omega, phi, omega_m[, i][, x_e, v_e]); input u [V]; outputs (omega_m, omega) [rad/s]. A rigid
     shaft is the one-mass limit: states (theta - theta0, omega[, i][, x_e, v_e]), both outputs omega. A follower
-    train (k_train > 0) adds its end mass's deviation and velocity, and its weight to gravity's stiffness."""
+    train (k_train > 0, k_train_arm > 0 on an arm) adds its end mass's deviation and velocity (in the law's lift units
+    along s), and its weight to gravity's stiffness."""
     p = dict(params or {}, **FROZEN_OFF)
     view = kind_view(p)
     if view is None:
@@ -117,9 +120,11 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
         J_c = model.J_0 + model.m * s1 * s1
         k_g = -(model.F_gx + _end_weight(model)) * s2
         compliant, k, d, J_m = model.compliant, model.k_shaft, model.d_shaft, model.J_m
-    else:  # another follower type: its J_c(theta0) and gravity's stiffness (control.kind_view), no train
+        train = model.train if model.train.active else None
+    else:  # another follower type: its J_c(theta0), gravity's stiffness and its train (control.kind_view)
         model = view.model
         J_c, k_g = view.cam_side(theta0), view.gravity_stiffness(theta0)
+        s1, train = model.program.derivatives(theta0)[1], view.train
         compliant, k, d, J_m = view.compliant, view.k_shaft, view.d_shaft, view.J_m
     R, L, c_e, c_m = model.R, model.L, model.c_e, model.c_m
     damping = 0.0 if L > 0.0 else c_m * c_e / R  # L = 0: the back-EMF's torque -c_m c_e omega_m / R
@@ -145,8 +150,8 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
         A[n][n] = -R / L
         B = B + [1.0 / L]
         C = [row + [0.0] for row in C]
-    if view is None and model.train.active:
-        A, C = _with_train(model, s1, J_c, A, C)
+    if train is not None:
+        A, C = _with_train(train, s1, J_c, A, C)
         B = B + [0.0, 0.0]
     return np.array(A), np.array(B), np.array(C)
 

@@ -12,6 +12,10 @@ The maps and linear models of control/ are analysis, not runs: they take a compl
 follower type, the two-mass system of docs/model.md 12.3 with the kind's J_c(theta), although the engines run the
 other types with a rigid shaft only so far (physics/rules.py). The kind's model is built with a rigid shaft; the
 shaft's k_shaft, d_shaft, J_m and J_cam are kept beside it.
+
+A follower train (k_train on a translating flat, k_train_arm on an arm; docs/model.md 14.6) is carried as the engine
+carries it, in the law's lift units along s: its force F_train pulls the cam by F_train s' on every kind, and its end
+mass m_end (J_end (lift_angle / lift)^2 for an arm) moves along s. Its weight F_ex along s (a flat's) joins gravity.
 """
 from __future__ import annotations
 
@@ -21,6 +25,7 @@ from typing import Any, Mapping
 from ..physics.follower_kind import FollowerKind
 from ..physics.kind_drive import KindDriveModel
 from ..physics.parameters import ParameterError, resolve
+from ..physics.train import Train, end_weight
 
 __all__ = ["KindView", "kind_view"]
 
@@ -45,15 +50,39 @@ class KindView:
         q1 = self.model.coordinate(theta)[1]
         return (self.J_cam if self.compliant else self.model.J_0) + self.model.I_f * q1 * q1
 
+    def low_frequency_inertia(self, theta: float) -> float:
+        """J_c + m_end s'^2 [kg m2] at theta [rad]: the cam side with a train's end mass carried along (its
+        low-frequency limit; J_end psi'^2 for an arm's), J_c without a train."""
+        train = self.train
+        if train is None:
+            return self.cam_side(theta)
+        s1 = self.model.program.derivatives(theta)[1]
+        return self.cam_side(theta) + train.m_end * s1 * s1
+
     def gravity_torque(self, theta: float) -> float:
-        """M_g = V'(q) q' [N m] at theta [rad]: the follower's weight as a torque on the cam."""
+        """M_g = V'(q) q' - F_ex s' [N m] at theta [rad]: the follower's weight, and a train's end mass's (held by
+        the train's spring), as a torque on the cam."""
         q, q1, _, _ = self.model.coordinate(theta)
-        return self.model.potential_slope(q) * q1
+        s1 = self.model.program.derivatives(theta)[1]
+        return self.model.potential_slope(q) * q1 - self.end_weight() * s1
 
     def gravity_stiffness(self, theta: float) -> float:
-        """k_g = V''(q) q'^2 + V'(q) q'' [N m/rad] at theta [rad]: d M_g / d theta."""
+        """k_g = V''(q) q'^2 + V'(q) q'' - F_ex s'' [N m/rad] at theta [rad]: d M_g / d theta."""
         q, q1, q2, _ = self.model.coordinate(theta)
-        return self.model.potential_curvature(q) * q1 * q1 + self.model.potential_slope(q) * q2
+        s2 = self.model.program.derivatives(theta)[2]
+        return self.model.potential_curvature(q) * q1 * q1 + self.model.potential_slope(q) * q2 \
+            - self.end_weight() * s2
+
+    @property
+    def train(self) -> Train | None:
+        """The follower train in the law's lift units along s (an arm's torsional one scaled by (lift_angle /
+        lift)^2, physics.kind_drive), None without one: its force F pulls the cam by F s' whatever the kind."""
+        return self.model.train if self.model.train.active else None
+
+    def end_weight(self) -> float:
+        """F_ex [N]: the train's end mass's weight along s (a translating flat's; 0 for an arm's torsional train and
+        without a train, physics.train.end_weight)."""
+        return end_weight(self.model.train, self.model.params) if self.train else 0.0
 
 
 def kind_view(params: Mapping[str, Any] | None) -> KindView | None:
@@ -69,11 +98,5 @@ def kind_view(params: Mapping[str, Any] | None) -> KindView | None:
         raise ParameterError(f"parameter 'J_cam' = {p['J_cam']!r} [kg.m2]: a compliant shaft (k_shaft = {k_shaft!r} "
                              f"N.m/rad) needs the inertia of its cam side; allowed with k_shaft > 0: J_cam in "
                              f"(0, 100] kg.m2")
-    for name, unit in (("k_train", "N/m"), ("k_train_arm", "N.m/rad")):   # no end mass here: refused, not dropped
-        if p[name] > 0.0:
-            raise ParameterError(f"parameter {name!r} = {p[name]!r} {unit} with follower_type {kind.follower_type!r}: "
-                                 f"cam-fmu reflect and bode carry the follower train on the translating roller only "
-                                 f"so far (the engine and the reference run it: docs/model.md 14.6); allowed here: "
-                                 f"{name} = 0")
     model = KindDriveModel(dict(p, k_shaft=0.0), kind)
     return KindView(model, k_shaft, float(p["d_shaft"]), float(p["J_m"]), float(p["J_cam"]))

@@ -24,6 +24,8 @@ the arrays.
 
 Another follower type (a translating flat face, an arm; docs/model.md 16.2): the kind's own terms (control.kind_view,
 physics.kind_drive), J = [J_m +] J_0 + I_f q'^2 and M's parts with q = s or psi; the follower's friction in M_guide.
+Its train (k_train on a flat, k_train_arm on an arm) enters as the roller's does, in the law's lift units along s: an
+arm's J_end psi'^2 = m_end s'^2 with m_end = J_end (lift_angle / lift)^2, and f_r_train, f_a_train the same formulas.
 """
 from __future__ import annotations
 
@@ -65,6 +67,14 @@ def two_mass_frequencies(k: float, J_m: float, J_c: float) -> tuple[float, float
     return (math.sqrt(k * (J_m + J_c) / (J_m * J_c)) / (2.0 * math.pi), math.sqrt(k / J_c) / (2.0 * math.pi))
 
 
+def train_frequencies(k_train: float, m_end: float, J_c: float, s1: float) -> tuple[float, float]:
+    """(f_r_train, f_a_train) [Hz] of a train k_train [N/m] with end mass m_end [kg] on a cam side J_c [kg m2] at
+    s' [m/rad] (all in the law's lift units along s): the cam, a mass J_c / s'^2 along s, and the end mass on the
+    spring between them; the end mass alone on the spring, the cam held (module doc)."""
+    return (math.sqrt(k_train * (1.0 / m_end + s1 * s1 / J_c)) / (2.0 * math.pi),
+            math.sqrt(k_train / m_end) / (2.0 * math.pi))
+
+
 def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 3600) -> dict[str, np.ndarray]:
     """J(theta) and M(theta) with its parts at ``points`` angles over one turn, at ``rpm`` [1/min] of the cam."""
     if not (math.isfinite(rpm) and rpm != 0.0 and abs(rpm) <= 1e6):
@@ -103,8 +113,7 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
         if model.compliant:
             out["f_r"][k], out["f_a"][k] = two_mass_frequencies(model.k_shaft, model.J_m, J_c)
         elif train:
-            out["f_r_train"][k] = math.sqrt(train.k_train * (1.0 / m_end + s1 * s1 / J_c)) / (2.0 * math.pi)
-            out["f_a_train"][k] = math.sqrt(train.k_train / m_end) / (2.0 * math.pi)
+            out["f_r_train"][k], out["f_a_train"][k] = train_frequencies(train.k_train, m_end, J_c, s1)
         out["M_inertial"][k] = (model.m + m_end) * s2 * omega * omega * s1
         out["M_gravity"][k] = -(model.F_gx + F_ex) * s1
         out["M_guide"][k] = sigma * f * s1
@@ -117,24 +126,33 @@ def _kind_map(view: KindView, omega: float, direction: float, thetas: np.ndarray
     """The map of a follower of another kind (control.kind_view; physics.kind_drive): with q = s or psi and
     I_f = m or J_arm + m L^2, J = [J_m +] J_c(theta), M_inertial = I_f q'' omega^2 q', M_gravity = V'(q) q', the
     follower's friction mu |P| lambda sgn(omega) (P = I_f q'' omega^2 + V'(q): a flat face's sliding, an arm's pivot)
-    in M_guide, M_shaft = M_f sgn(omega); with a compliant shaft f_r, f_a of the rotor J_m and J_c(theta)."""
-    model = view.model
-    columns = COLUMNS + (FREQUENCIES if view.compliant else ())
+    in M_guide, M_shaft = M_f sgn(omega); with a compliant shaft f_r, f_a of the rotor J_m and J_c(theta). A train
+    (in the law's lift units along s, control.kind_view) is carried as on the roller: J adds m_end s'^2, M_inertial
+    m_end s'' omega^2 s', M_gravity -F_ex s', and that force joins P; with a rigid shaft f_r_train, f_a_train."""
+    model, train = view.model, view.train
+    m_end = train.m_end if train else 0.0
+    F_ex = view.end_weight()
+    columns = COLUMNS + (FREQUENCIES if view.compliant else ()) + (TRAIN_FREQUENCIES if train and not
+                                                                    view.compliant else ())
     out = {name: np.empty(len(thetas)) for name in columns}
     rotor = view.J_m if view.compliant else 0.0
     for k, theta in enumerate(thetas):
         q, q1, q2, s = model.coordinate(float(theta))
-        P = model.I_f * q2 * omega * omega + model.potential_slope(q)
+        _, s1, s2, _ = model.program.derivatives(float(theta))
+        carried = m_end * s2 * omega * omega - F_ex  # N along s: the end mass carried along, on the follower
+        load = model.load(float(theta), omega, 0.0, direction, axial=carried)
         J_c = view.cam_side(float(theta))
         out["theta"][k] = theta
-        out["J"][k] = rotor + J_c
+        out["J"][k] = rotor + J_c + m_end * s1 * s1
         if view.compliant:
             out["f_r"][k], out["f_a"][k] = two_mass_frequencies(view.k_shaft, view.J_m, J_c)
-        out["M_inertial"][k] = model.I_f * q2 * omega * omega * q1
-        out["M_gravity"][k] = model.potential_slope(q) * q1
-        out["M_guide"][k] = model.mu * abs(P) * (model.lever(q, q1, s) if model.mu else 0.0) * direction
+        elif train:
+            out["f_r_train"][k], out["f_a_train"][k] = train_frequencies(train.k_train, m_end, J_c, s1)
+        out["M_inertial"][k] = model.I_f * q2 * omega * omega * q1 + m_end * s2 * omega * omega * s1
+        out["M_gravity"][k] = model.potential_slope(q) * q1 - F_ex * s1
+        out["M_guide"][k] = model.mu * abs(load.P) * load.lever * direction
         out["M_shaft"][k] = model.M_f * direction
-        out["M"][k] = model.load(float(theta), omega, 0.0, direction).M
+        out["M"][k] = load.M
     return out
 
 
@@ -155,5 +173,5 @@ def summary(result: Mapping[str, np.ndarray], rpm: float) -> dict[str, Any]:
     return out
 
 
-__all__ = ["COLUMNS", "FREQUENCIES", "TRAIN_FREQUENCIES", "PARTS", "FreeFollowerError", "RESONANCE_KEYS", "UNITS", "reflected_map", "summary",
-           "two_mass_frequencies"]
+__all__ = ["COLUMNS", "FREQUENCIES", "TRAIN_FREQUENCIES", "PARTS", "FreeFollowerError", "RESONANCE_KEYS", "UNITS",
+           "reflected_map", "summary", "train_frequencies", "two_mass_frequencies"]

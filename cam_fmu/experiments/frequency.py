@@ -158,11 +158,12 @@ def operating_point(params: Mapping[str, Any] | None, theta0: float | None = Non
     angles = np.linspace(0.0, 2.0 * math.pi, 361)
     if view is None:
         model = DriveModel(p)
-        J_heavy = max(model.J_0 + model.m * model.program.derivatives(t)[1] ** 2
+        carried = model.m + (model.train.m_end if model.train.active else 0.0)  # a train's end mass at low frequency
+        J_heavy = max(model.J_0 + carried * model.program.derivatives(t)[1] ** 2
                       for t in angles) + (model.J_m if model.compliant else 0.0)
     else:  # another follower type: its J(theta) (control.kind_view); the engine runs it on a rigid shaft
         model = view.model
-        J_heavy = max(view.cam_side(float(t)) for t in angles) + (view.J_m if view.compliant else 0.0)
+        J_heavy = max(view.low_frequency_inertia(float(t)) for t in angles) + (view.J_m if view.compliant else 0.0)
     settle = SETTLE_TIME_CONSTANTS * model.R * J_heavy / (model.c_e * model.c_m)  # the slowest mechanical pole
     h = 1e-3
     run = DriveSimulator(p).run(_table(np.full(max(1, math.ceil(settle / h / OUTPUTS_PER_HOLD)), u0), h))

@@ -4,7 +4,8 @@ on the cam or as a body of its own, in both drives. Checked against what the tes
 terms (psi, the end's angle psi_e = s_end lift_angle / lift): the residual vibration's closed form after a cycloidal
 rise, a coasting drive's stored energy (on the cam and through flights), the lift-off the train causes, the rigid arm
 with J_end on it as k_train_arm grows; the scipy reference (the same lift-unit carriage, written apart) in both
-drives with the arm's friction; what is not built is refused by name."""
+drives with the arm's friction; what is not built is refused by name. (reflect and bode with an arm's train:
+tests/physics/test_control_kind_train.py.)"""
 from __future__ import annotations
 
 import math
@@ -12,8 +13,6 @@ import math
 import numpy as np
 import pytest
 
-from cam_fmu.control.frequency import linear_model
-from cam_fmu.control.reflect import reflected_map
 from cam_fmu.engine.simulator import DriveSimulator
 from cam_fmu.experiments.engine_runs import simulate_engine
 from cam_fmu.physics.parameters import ParameterError, defaults
@@ -158,24 +157,6 @@ def test_what_is_not_built_is_refused_by_name(change, named):
     arm = ARM if change["follower_type"].startswith("oscillating") else {}
     with pytest.raises(ParameterError, match=named):
         DriveSimulator(dict(defaults(), **arm, **change))
-
-
-def test_the_control_maps_refuse_the_flat_s_train_instead_of_dropping_it():
-    """reflect's map and bode's linear model of another kind have no end mass: a flat's train is refused by name."""
-    p = dict(defaults(), follower_type="translating_flat", k_train=2e4, d_train=2.0, m_end=0.2)
-    for run in (lambda: reflected_map(p, 200.0), lambda: linear_model(p, 1.0)):
-        with pytest.raises(ParameterError, match="k_train"):
-            run()
-
-
-def test_the_control_maps_refuse_the_arm_s_train_instead_of_dropping_it():
-    """cam-fmu reflect's map and bode's linear model do not carry an arm's train yet: each says so, naming the
-    parameter (a map without the train would be a wrong answer)."""
-    p = dict(defaults(), **ARM, **CYCLOID, follower_type="oscillating_roller", lift_angle=0.3, k_train_arm=500.0,
-             J_end=2e-3)
-    for run in (lambda: reflected_map(p, 200.0), lambda: linear_model(p, 1.0)):
-        with pytest.raises(ParameterError, match="k_train_arm"):
-            run()
 
 
 NAMES = ("theta", "omega", "i", "M", "N_contact", "s", "s_end", "v_end", "a_end", "F_train", "psi", "psi_dot")
