@@ -106,7 +106,7 @@ class KindVoltageFollower(KindFlank, VoltageFollower):
         Q_close(q_f) (``drive`` the cam side's torque less M_f d, d the shaft's direction ``heading``)."""
         q, q1, q2, _ = self.flank(theta, contact)
         d = self.heading if heading is None else heading
-        A = self.m * q2 * omega * omega + self.closing(q)
+        A = self.m * q2 * omega * omega + self.flank_closing(q, q1 * omega)
         lam = self.lever_at(theta)
         k = q1 + self.mu * lam * d * contact
         omega_dot = (drive - A * k) / (self.J_0 + self.m * q1 * k)
@@ -167,7 +167,7 @@ class KindSpeedFollower(KindFlank, SpeedFollower):
         """N or N m, > 0 while the flank ``contact`` holds the follower: contact P, P = I_f (q'' omega^2 + q'
         omega_dot) + Q_close(q_f)."""
         q, q1, q2, _ = self.flank(theta, contact)
-        return contact * (self.m * (q2 * omega * omega + q1 * omega_dot) + self.closing(q))
+        return contact * (self.m * (q2 * omega * omega + q1 * omega_dot) + self.flank_closing(q, q1 * omega))
 
     def outputs(self, theta: float, omega: float, omega_dot: float, s: float, v: float, contact: float,
                 direction: float | None = None) -> dict:
@@ -178,7 +178,7 @@ class KindSpeedFollower(KindFlank, SpeedFollower):
 
         def load(angle: float) -> tuple[float, float]:  # (M [N m], P) with the follower on the flank
             qf, d1, d2, _ = self.flank(angle, contact)
-            P = self.m * (d2 * omega * omega + d1 * omega_dot) + self.closing(qf)
+            P = self.m * (d2 * omega * omega + d1 * omega_dot) + self.flank_closing(qf, d1 * omega)
             return model.M_f * direction + P * d1 + self.mu * abs(P) * self.lever_at(angle) * direction, P
 
         if contact != 0.0:

@@ -26,6 +26,7 @@ class TrainCarrier:
     mass and the train's force in the closing force. ``V``: the follower's v in y; ``X_E``: x_e's, v_e after it."""
 
     V = 4
+    lift_per_q = 1.0   # the law's lift units (the train's) per unit of the body's coordinate: 1 / scale on an arm
 
     def _carry(self, model, train: Train | None) -> None:
         self.train = model.train if train is None else train
@@ -42,10 +43,21 @@ class TrainCarrier:
         """N, F_train with the follower at s [m] moving at v [m/s] and the bound end mass."""
         return self.train.force(s, v, *self._end)
 
+    def along(self, s: float, v: float) -> float:
+        """The train's force along the body's coordinate at s, v in it (the bound end mass): F_train itself on a
+        translating follower, F_train / scale about an arm's pivot (its torque, N m)."""
+        k = self.lift_per_q
+        return self.pull(s * k, v * k) * k
+
     def rest(self, s: float, v: float) -> tuple[float, float]:
-        """(x_e [m], v_e [m/s]): the end mass at rest relative to the follower at s [m], v [m/s], its weight on the
-        train's spring."""
-        return s + self.F_ex / self.train.k_train, v
+        """(x_e [m], v_e [m/s]): the end mass at rest relative to the follower at s, v (the body's coordinate and
+        rate), its weight on the train's spring."""
+        k = self.lift_per_q
+        return s * k + self.F_ex / self.train.k_train, v * k
+
+    def flight_stiffness(self) -> float:
+        """The flying follower's stiffness along its coordinate [N/m]: the return spring's and the train's."""
+        return max(self.k, 0.0) + self.train.k_train
 
     def end_rates(self, F: float, y) -> list[float]:
         """(x_e', v_e') under the train's force F [N] and the end mass's weight."""
@@ -58,11 +70,11 @@ class TrainCarrier:
 
     # ------------------------------------------------------------- the closing force with the train's
     def flank_closing(self, s: float, v: float) -> float:
-        return self.closing(s) + self.pull(s, v)
+        return self.closing(s) + self.along(s, v)
 
     def free_acceleration(self, s: float, sigma: float) -> float:
         """m/s2, the flying follower's acceleration with the train's force (the bound v in its damper)."""
-        net = -self.closing(s) - self.pull(s, self._v)
+        net = -self.closing(s) - self.along(s, self._v)
         if sigma == 0.0:
             if abs(net) <= self.f0:
                 return 0.0
@@ -71,7 +83,7 @@ class TrainCarrier:
 
     def net_at_rest(self, s: float) -> float:
         """N, the force on the flying follower at rest at s [m] (the train's included), against F_close."""
-        return -self.closing(s) - self.pull(s, 0.0)
+        return -self.closing(s) - self.along(s, 0.0)
 
     def direction(self, s: float, v: float) -> float:
         if v != 0.0:
@@ -98,10 +110,11 @@ class TrainSpeedFollower(TrainCarrier, SpeedFollower):
     def train_force(self, y, omega: float, contact: float) -> float:
         """N, F_train at y with the follower on the flank ``contact`` (its s, s' omega; 0: in flight, its own)."""
         self.bind(y)
+        k = self.lift_per_q
         if contact:
             s, s1, _, _ = self.flank(y[0], contact)
-            return self.pull(s, s1 * omega)
-        return self.pull(y[1], y[2])
+            return self.pull(s * k, s1 * omega * k)
+        return self.pull(y[1] * k, y[2] * k)
 
     def outputs_at(self, y, omega: float, omega_dot: float, contact: float, direction: float | None = None) -> dict:
         """Every output at y with the train's (``SpeedFollower.outputs`` with the end mass bound)."""
@@ -132,11 +145,12 @@ class TrainVoltageFollower(TrainCarrier, VoltageFollower):
     def train_force(self, y, contact: float) -> float:
         """N, F_train at y with the follower on the flank ``contact`` (0: in flight)."""
         self.bind(y)
-        return self.pull(*self.motion(y, contact))
+        s, v = self.motion(y, contact)
+        return self.pull(s * self.lift_per_q, v * self.lift_per_q)
 
     def train_damping(self, y, contact: float) -> float:
         """W, the train damper's loss d_train (v - v_e)^2."""
-        slip = self.motion(y, contact)[1] - y[self.X_E + 1]
+        slip = self.motion(y, contact)[1] * self.lift_per_q - y[self.X_E + 1]
         return self.train.d_train * slip * slip
 
     # ------------------------------------------------------------- the base class's entries, bound first
@@ -173,7 +187,7 @@ class TrainVoltageFollower(TrainCarrier, VoltageFollower):
         """J, the drive's stored energy with the end mass's m_end v_e^2 / 2, the train's k_train (s - x_e)^2 / 2 and
         the end mass's weight -F_ex x_e."""
         x_e, v_e = y[self.X_E], y[self.X_E + 1]
-        stretch = y[3] - x_e
+        stretch = y[3] * self.lift_per_q - x_e
         return (super().stored_energy(y) + 0.5 * self.train.m_end * v_e * v_e
                 + 0.5 * self.train.k_train * stretch * stretch - self.F_ex * x_e)
 

@@ -280,16 +280,18 @@ def _speed_rows(model: DriveModel, grid: np.ndarray, omega_ref: Signal) -> list[
 
 
 def _speed_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
-                 options: dict) -> dict[str, np.ndarray]:
+                 options: dict, runner: type | None = None) -> dict[str, np.ndarray]:
+    """The speed drive with a train; a follower of its own runs ``runner`` (None: the roller's)."""
     if model.free_follower:  # the train on the follower's own state (docs/model.md 14.6)
-        return train_speed_follower_reference(model, grid, omega_ref, options, train)
+        return train_speed_follower_reference(model, grid, omega_ref, options, train, runner)
     return speed_train_reference(model, grid, omega_ref, train, options["rtol"], options["atol"])
 
 
 def _voltage_train(model: DriveModel, grid: np.ndarray, u: Signal, omega_ref: Signal, train: Train,
-                   options: dict) -> dict[str, np.ndarray]:
+                   options: dict, runner: type | None = None) -> dict[str, np.ndarray]:
+    """The consistent voltage drive with a train; a follower of its own runs ``runner`` (None: the roller's)."""
     if model.free_follower:  # the train on the follower's own state (docs/model.md 14.6)
-        return train_follower_reference(model, grid, u, options, train)
+        return train_follower_reference(model, grid, u, options, train, runner=runner)
     return voltage_train_reference(model, grid, u, train, options["rtol"], options["atol"], options["method"])
 
 
@@ -303,14 +305,14 @@ def _kind_train(model: KindDriveModel, grid: np.ndarray, u: Signal, omega_ref: S
         raise ParameterError(f"a follower train given along X does not run with follower_type "
                              f"{model.kind.follower_type!r}: an arm's train is torsional, set by the parameters "
                              f"'k_train_arm', 'd_train_arm', 'J_end'")
-    if model.free_follower:
-        raise ParameterError(f"the follower train with follower_type {model.kind.follower_type!r} runs with the "
-                             f"follower on the cam only: parameter 'closure' = {model.closure!r} must be "
-                             f"'kinematic' (a follower of its own with a train is not modelled yet)")
-    run = TRAIN_REFERENCES.get(formulation_name(model))   # the roller's, on the cam (the follower's own refused)
+    run = TRAIN_REFERENCES.get(formulation_name(model))
     if run is None:
         raise ParameterError("the follower train runs in the consistent formulation and the speed drive only "
                              f"(parameter 'formulation' = {model.formulation!r})")
+    if model.free_follower:   # the kind's body of its own carrying the train (its rows hold psi, psi_dot)
+        from .kind_flight import KindTrainFollowerRun, KindTrainSpeedFollowerRun
+        runner = KindTrainFollowerRun if run is _voltage_train else KindTrainSpeedFollowerRun
+        return run(model, grid, u, omega_ref, train, options, runner)
     return with_arm_angle(model, run(model, grid, u, omega_ref, train, options))
 
 

@@ -47,7 +47,7 @@ class TrainFollowerRun(VoltageFollowerRun):
                  train: Train | None = None, end_offset: float = 0.0) -> None:
         super().__init__(model, u, rtol, atol, energy, method)
         if train is not None:   # a train given apart from the parameters' (simulate_reference's ``train``)
-            self.body = TrainVoltageFollower(model, train)
+            self.body = self.BODY(model, train)
         self.end_offset = end_offset
         self.releases: list[float] = []   # s, where a follower halted in flight was started again by the train
 
@@ -107,18 +107,18 @@ class TrainFollowerRun(VoltageFollowerRun):
 
 
 def train_follower_reference(model, grid: np.ndarray, u: Signal, options: dict, train: Train | None = None,
-                             end_offset: float = 0.0) -> dict[str, np.ndarray]:
+                             end_offset: float = 0.0, runner: type | None = None) -> dict[str, np.ndarray]:
     """The consistent voltage drive with a follower of its own (closures 'spring', 'form' with c > 0) carrying
     ``train`` (None: the parameters' k_train, d_train, m_end), on the output grid; ``end_offset`` [m] moves the end
-    mass from its rest at the start."""
-    run = TrainFollowerRun(model, u, options["rtol"], options["atol"], options["energy"], options["method"], train,
+    mass from its rest at the start. ``runner``: the run's class (TrainFollowerRun; another kind's, kind_flight)."""
+    run = (runner or TrainFollowerRun)(model, u, options["rtol"], options["atol"], options["energy"], options["method"], train,
                            end_offset)
     return run.run(grid)
 
 
 def flight_bound(body, options: dict) -> None:
     """Bound a flying step to TRAIN_PHASE of the follower's ringing on the return spring and the train."""
-    rate = math.sqrt((max(body.k, 0.0) + body.train.k_train) / body.m)
+    rate = math.sqrt(body.flight_stiffness() / body.m)
     options["max_step"] = min(options.get("max_step", math.inf), TRAIN_PHASE / rate)
 
 
@@ -185,10 +185,10 @@ class TrainSpeedFollowerRun(FollowerRun):
 
 
 def train_speed_follower_reference(model, grid: np.ndarray, omega_ref: Signal, options: dict,
-                                   train: Train | None = None) -> dict[str, np.ndarray]:
+                                   train: Train | None = None, runner: type | None = None) -> dict[str, np.ndarray]:
     """The speed drive with a follower of its own (closures 'spring', 'form' with c > 0) carrying ``train`` (None:
-    the parameters'), on the output grid [s]."""
-    run = TrainSpeedFollowerRun(model, omega_ref, options["rtol"], options["atol"])
+    the parameters'), on the output grid [s]. ``runner``: the run's class (TrainSpeedFollowerRun; another kind's)."""
+    run = (runner or TrainSpeedFollowerRun)(model, omega_ref, options["rtol"], options["atol"])
     if train is not None:
-        run.body = TrainSpeedFollower(model, train)
+        run.body = run.BODY(model, train)
     return run.run(grid, model.params["theta0"])

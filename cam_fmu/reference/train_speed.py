@@ -55,7 +55,7 @@ def speed_train_reference(model: DriveModel, grid: np.ndarray, omega_ref: Signal
     if model.free_follower or model.c != 0.0:
         raise ParameterError("the follower train runs with the follower on the cam only (closure 'kinematic', or "
                              "'form' without clearance): parameter 'c' must be 0 and 'closure' not 'spring' "
-                             "(a train on a follower of its own is not modelled yet)")
+                             "(a train on a follower of its own runs in reference/train_flight.py)")
     p, program = model.params, model.program
     breakpoints = sorted(set(program.breakpoints()) | {0.0}) + [2.0 * math.pi]
     F_ex = end_weight(train, p)
