@@ -95,6 +95,9 @@ int cam_exchange_attach(CamExchange *e)
     e->requested = 0;
     e->iterations = 0;
     e->broke_away = 0;
+    e->longest_gap = 0.0;
+    e->evaluations = 0;
+    e->last_time = e->step_time = d->time;
     return CAM_OK;
 }
 
@@ -102,6 +105,9 @@ int cam_exchange_set_time(CamExchange *e, double time)
 {
     if (!isfinite(time) || fabs(time) > 1e15)
         return fail(e, CAM_ERR_SIMULATION, "time = %.17g s must be finite within [-1e15, 1e15] s", time);
+    if (time - e->last_time > e->longest_gap)   /* the host's sampling of the drive, forward in time */
+        e->longest_gap = time - e->last_time;
+    e->last_time = time;
     e->drive->time = time;
     return CAM_OK;
 }
@@ -143,6 +149,7 @@ int cam_exchange_derivatives(CamExchange *e, double dx[], size_t nx)
     cam_exchange_sync(e);
     cam_drive_me_states(e->drive, x);
     cam_drive_me_rates(e->drive, x, dx);
+    e->evaluations++;
     return CAM_OK;
 }
 
@@ -310,6 +317,9 @@ void cam_exchange_enter_continuous(CamExchange *e)
     e->requested = 0;
     e->iterations = 0;
     e->broke_away = 0;
+    e->longest_gap = 0.0;
+    e->evaluations = 0;
+    e->last_time = e->step_time = d->time;
     cam_exchange_sync(e);
     if (!d->have_budget) {
         cam_energy_init(&d->budget, &d->model, cam_drive_outputs(d));
@@ -338,12 +348,65 @@ static void book(CamExchange *e, CamEnergy *budget, const double out[])
     cam_energy_book(budget, 0.5 * h * (e->book_u * budget->i + d->u * out[CAM_O_I]), out[CAM_O_THETA_M], out[CAM_O_I]);
 }
 
+/* m: the amplitude of the train's free ringing, its end's motion y = x_e - s about the quasi-static deflection
+ * y_qs = (F_ex / m_end - a) / w^2 that the follower's slow acceleration a holds it at (w^2 = k_train / m_end):
+ * y - y_qs = -(y'' + (d_train / m_end) y') / w^2 with y' = v_e - v, y'' = a_e - a, and its rate y' / w. */
+static double train_ringing(const CamModel *m, const double out[])
+{
+    double w2 = m->k_train / m->m_end, rate = out[CAM_O_V_END] - out[CAM_O_V];
+    double offset = (out[CAM_O_A_END] - out[CAM_O_A] + m->d_train / m->m_end * rate) / w2;
+    return sqrt(offset * offset + rate * rate / w2);
+}
+
+/* The host's integration of a ringing train (docs/model.md 14.7), judged from how it samples the drive, while the
+ * train rings by more than CAM_EXCHANGE_TRAIN_RINGING of the lift (a quiet train may be stepped over: an adaptive
+ * host's long first steps):
+ * - a host that evaluates the derivatives once a step is of the first order (explicit Euler grows the ringing's
+ *   amplitude by exp(w^2 h t / 2), implicit Euler damps it so): the drift w^2 h^2 / 2 summed over its steps past
+ *   CAM_EXCHANGE_TRAIN_DRIFT;
+ * - any other: its longest forward stretch between two settings of the time since the last completed step (its
+ *   step, h / 2 for rk4's stages) past CAM_EXCHANGE_TRAIN_PHASE rad of the ringing (rk4 then errs by percents of
+ *   the train's force; an adaptive host at a loose tolerance steps over the ringing, measured in docs/model.md 14.7).
+ * Said once, as a warning: the host chose its method, and the FMU sees only its samples. */
+static void check_train_sampling(CamExchange *e, const double out[])
+{
+    CamDrive *d = e->drive;
+    const CamModel *m = &d->model;
+    double w = m->train_rate, h = d->time - e->step_time, ringing = train_ringing(m, out);
+    int first_order = e->evaluations == 1;
+    if (first_order && h > 0.0)
+        e->drift += 0.5 * w * w * h * h;
+    if (!e->train_warned && ringing > CAM_EXCHANGE_TRAIN_RINGING * m->lift_scale
+        && (first_order ? e->drift > CAM_EXCHANGE_TRAIN_DRIFT : w * e->longest_gap > CAM_EXCHANGE_TRAIN_PHASE)) {
+        e->train_warned = e->warning = 1;
+        if (first_order)
+            cam_error(cam_instance_error(e->instance), CAM_OK, "the host evaluates the drive once a step (a "
+                      "first-order method) at %g s before t = %g s: it may have changed the follower train's "
+                      "ringing (%s, %.4g 1/s, ringing by %.3g m, %.2g of the lift) by up to %.2g of its amplitude "
+                      "so far (w^2 h t / 2), growing (explicit) or damping (implicit) it without a sign; a first-order "
+                      "step keeps that below 0.01 over T seconds only below 0.02 / (w^2 T) (%.3g s for 1 s): use a "
+                      "higher-order or adaptive solver (said once)", h, d->time, cam_train_names(m), w, ringing,
+                      ringing / m->lift_scale, e->drift, 2.0 * CAM_EXCHANGE_TRAIN_DRIFT / (w * w));
+        else
+            cam_error(cam_instance_error(e->instance), CAM_OK, "the host sampled the drive %g s apart before "
+                      "t = %g s, %.3g rad of the follower train's ringing (%s, %.4g 1/s), while it rings by %.3g m "
+                      "(%.2g of the lift): its method aliases or damps the ringing there without a sign; use steps "
+                      "below about %.3g s (rk4: %.3g s), or a tighter tolerance (said once)", e->longest_gap,
+                      d->time, w * e->longest_gap, cam_train_names(m), w, ringing, ringing / m->lift_scale,
+                      CAM_EXCHANGE_TRAIN_PHASE / w, 2.0 * CAM_EXCHANGE_TRAIN_PHASE / w);
+    }
+    e->longest_gap = 0.0;
+    e->evaluations = 0;
+    e->step_time = d->time;
+}
+
 int cam_exchange_completed_step(CamExchange *e, int *enter_event)
 {
     CamDrive *d = e->drive;
     double z[CAM_EXCHANGE_NZ], excess, tolerance, out[CAM_N_OUTPUTS];
     int codes[CAM_MAX_EVENTS], n, k, verdict;
     *enter_event = 0;
+    e->warning = 0;
     cam_exchange_sync(e);
     memcpy(out, cam_drive_outputs(d), sizeof out);
     verdict = cam_publishable(&d->model, out, NULL, d->u, 0.0);
@@ -382,6 +445,8 @@ int cam_exchange_completed_step(CamExchange *e, int *enter_event)
                         "delivered (tolerance %.3g J): energy was created, the result cannot be trusted; reduce the "
                         "host's step size or tighten its tolerance", d->time, excess, tolerance);
     }
+    if (d->model.train)
+        check_train_sampling(e, out);
     return CAM_OK;
 }
 

@@ -36,6 +36,9 @@ typedef char cam_exchange_indicator_count[CAM_N_EVENT_INDICATORS == CAM_EXCHANGE
 #define CAM_EXCHANGE_IDLE 1.0            /* an unused indicator slot */
 #define CAM_EXCHANGE_MAX_ITERATIONS 32   /* transitions at one event instant at most */
 #define CAM_EXCHANGE_PROBE 1e-9          /* s: how far ahead an indicator at exactly 0 is looked at */
+#define CAM_EXCHANGE_TRAIN_PHASE 0.25    /* rad of a ringing train between a host's samples (exchange.c) */
+#define CAM_EXCHANGE_TRAIN_DRIFT 0.01    /* of its amplitude: a first-order host's change of a ringing train */
+#define CAM_EXCHANGE_TRAIN_RINGING 1e-4  /* of the lift: a train ringing less is quiet enough for a long step */
 
 typedef struct {
     CamInstance *instance;      /* not owned */
@@ -45,6 +48,13 @@ typedef struct {
     int requested;              /* a completed step asked for event mode, not entered since */
     int iterations;             /* event updates at this event instant */
     int broke_away;             /* the break-away's transition was applied at this event instant */
+    double last_time;           /* s: the time the host set last */
+    double longest_gap;         /* s: the longest forward stretch between its settings since the last completed step */
+    double step_time;           /* s: the last completed step (or the entry into continuous time) */
+    int evaluations;            /* the derivatives evaluated since then */
+    double drift;               /* a first-order host's change of the train's ringing amplitude so far, w^2 h t / 2 */
+    int train_warned;           /* a ringing train sampled too sparsely was said once: not again */
+    int warning;                /* this completed step's message is a warning (status OK otherwise) */
 } CamExchange;
 
 /* A transition applied by an event update (code -1: none), for the host's log. */
@@ -74,6 +84,8 @@ int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx);
 void cam_exchange_enter_event_mode(CamExchange *e);
 int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *values_changed, int *needed);
 void cam_exchange_enter_continuous(CamExchange *e);
+/* A follower train ringing by more than CAM_EXCHANGE_TRAIN_RINGING of the lift that the host samples more than
+ * CAM_EXCHANGE_TRAIN_PHASE rad of its ringing apart is said once, as a warning (e->warning; docs/model.md 14.7). */
 int cam_exchange_completed_step(CamExchange *e, int *enter_event);
 
 /* cam_instance_save with the energy bound booked up to the drive's time (the live books unchanged). */

@@ -84,7 +84,7 @@ fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) {
 fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     const char *call = "fmi2CompletedIntegratorStep";
-    int enter = 0;
+    int enter = 0, status;
     Glue *g;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (enterEventMode) *enterEventMode = fmi2False;
@@ -94,12 +94,17 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
     if (!enterEventMode || !terminateSimulation)
         return (fmi2Status)glue_fail(g, call, "enterEventMode and terminateSimulation must not be NULL");
     if (!allowed(g, GLUE_CONTINUOUS_TIME_MODE, 1, call)) return fmi2Error;
-    if (g->model->exchange->completed_step(g->m, &enter) != MODEL_OK) {
+    status = g->model->exchange->completed_step(g->m, &enter);
+    if (status != MODEL_OK && status != MODEL_WARNING) {
         *terminateSimulation = fmi2True;
         return model_error(g, call);
     }
     g->last_successful_time = g->model->time(g->m);
     *enterEventMode = enter ? fmi2True : fmi2False;
+    if (status == MODEL_WARNING) {
+        glue_log(g, GLUE_WARNING, "logStatusWarning", "%s: %s", call, g->model->message(g->m));
+        return fmi2Warning;
+    }
     return fmi2OK;
 }
 

@@ -105,7 +105,7 @@ fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance c) {
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
     const char *call = "fmi3CompletedIntegratorStep";
-    int enter = 0;
+    int enter = 0, status;
     Glue *g;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (enterEventMode) *enterEventMode = fmi3False;
@@ -115,12 +115,17 @@ fmi3Status fmi3CompletedIntegratorStep(fmi3Instance c, fmi3Boolean noSetFMUState
     if (!enterEventMode || !terminateSimulation)
         return STATUS(glue_fail(g, call, "enterEventMode and terminateSimulation must not be NULL"));
     if (!allowed(g, GLUE_CONTINUOUS_TIME_MODE, 1, call)) return fmi3Error;
-    if (g->model->exchange->completed_step(g->m, &enter) != MODEL_OK) {
+    status = g->model->exchange->completed_step(g->m, &enter);
+    if (status != MODEL_OK && status != MODEL_WARNING) {
         *terminateSimulation = fmi3True;
         return model_error(g, call);
     }
     g->last_successful_time = g->model->time(g->m);
     *enterEventMode = enter ? fmi3True : fmi3False;
+    if (status == MODEL_WARNING) {
+        glue_log(g, GLUE_WARNING, "logStatusWarning", "%s: %s", call, g->model->message(g->m));
+        return fmi3Warning;
+    }
     return fmi3OK;
 }
 

@@ -19,7 +19,7 @@
 
 #include <stddef.h>
 
-typedef enum { MODEL_OK = 0, MODEL_DISCARD = 1, MODEL_ERROR = 2 } ModelStatus;
+typedef enum { MODEL_OK = 0, MODEL_DISCARD = 1, MODEL_ERROR = 2, MODEL_WARNING = 3 } ModelStatus;   /* WARNING: done, message() says what to heed */
 typedef enum { MODEL_REAL = 0, MODEL_BOOLEAN = 1, MODEL_STRING = 2 } ModelKind;
 
 /* Model Exchange's reads (fmi2_me.c). */

@@ -186,7 +186,9 @@ static void me_enter_continuous(void *m) { cam_exchange_enter_continuous(&((CamF
 
 static int me_completed_step(void *m, int *enter_event)
 {
-    return status_of(cam_exchange_completed_step(&((CamFmuModel *)m)->me, enter_event));
+    CamExchange *e = &((CamFmuModel *)m)->me;
+    int status = status_of(cam_exchange_completed_step(e, enter_event));
+    return status == MODEL_OK && e->warning ? MODEL_WARNING : status;
 }
 
 static int me_save(void *m, unsigned char *buffer, size_t size)
