@@ -39,6 +39,12 @@ OUTPUTS: tuple[tuple[str, str, str], ...] = (
     ("psi", "rad", "an oscillating follower's arm angle about its pivot, lift_angle s / lift (docs/model.md 16; 0 for "
      "a translating follower)"),
     ("psi_dot", "rad/s", "the arm's rate psi' omega (0 for a translating follower)"),
+    ("psi_end", "rad", "an arm's torsional train: its end inertia's angle, lift_angle s_end / lift (docs/model.md "
+     "14.6; without a train: psi; 0 for a translating follower)"),
+    ("psi_dot_end", "rad/s", "an arm's train: its end inertia's rate, lift_angle v_end / lift (without a train: "
+     "psi_dot; 0 for a translating follower)"),
+    ("M_train", "N.m", "an arm's train: its torque k_train_arm (psi - psi_end) + d_train_arm (psi_dot - "
+     "psi_dot_end) on the end inertia, F_train lift / lift_angle (0 without a train and for a translating follower)"),
 )
 # The columns the reference adds for the follower as a body of its own (closures 'form' and 'spring', docs/model.md
 # section 13): the engine computes the contact and the count too but publishes neither (not FMU variables).
@@ -62,9 +68,11 @@ FOLLOWER_UNITS: dict[str, str] = {row[0]: row[1] for row in FOLLOWER_COLUMNS}
 
 def output_record(**values: Any) -> dict[str, float]:
     """Every output, in table order, from keyword values (a missing one is a KeyError; without a train the end mass's
-    columns are the follower's s, v, a and F_train = 0, a translating follower's psi and psi_dot 0, unless given)."""
-    rigid = {"s_end": values["s"], "v_end": values["v"], "a_end": values["a"], "F_train": 0.0, "psi": 0.0,
-             "psi_dot": 0.0}
+    columns are the follower's s, v, a and F_train = 0 (an arm's psi_end, psi_dot_end its psi, psi_dot, M_train 0), a
+    translating follower's psi and psi_dot 0, unless given)."""
+    psi, psi_dot = values.get("psi", 0.0), values.get("psi_dot", 0.0)
+    rigid = {"s_end": values["s"], "v_end": values["v"], "a_end": values["a"], "F_train": 0.0, "psi": psi,
+             "psi_dot": psi_dot, "psi_end": psi, "psi_dot_end": psi_dot, "M_train": 0.0}
     return {name: values[name] if name in values else rigid[name] for name in OUTPUT_NAMES}
 
 # Model Exchange's states: the engine's x[CAM_NX] (engine/contract.py X_SLOTS, in order), whose last two are a free
@@ -136,6 +144,9 @@ DEPENDENCIES: dict[str, tuple[str, ...]] = {
     "F_train": ("x_theta", "x_omega") + _TRAIN + _GAP,
     "psi": ("x_theta", "x_gap"),   # an arm's angle (docs/model.md 16, 16.3; 0 for a translating follower)
     "psi_dot": ("x_theta", "x_omega", "x_gap_rate"),
+    "psi_end": ("x_theta", "x_end", "x_gap"),   # an arm's end: its s_end's
+    "psi_dot_end": ("x_theta", "x_omega", "x_v_end", "x_gap_rate"),
+    "M_train": ("x_theta", "x_omega") + _TRAIN + _GAP,
 }
 # Model Exchange's event indicators: the CAM_MAX_EVENTS slots of the mode's event functions, then the
 # next profile breakpoint (cam_fmu/engine/csrc/fmi/exchange.h; the C build checks the count).

@@ -71,3 +71,18 @@ def with_arm_angle(model: KindDriveModel, result: dict[str, np.ndarray]) -> dict
     else:
         result["psi"], result["psi_dot"] = np.zeros_like(result["theta"]), np.zeros_like(result["theta"])
     return result
+
+
+def with_arm_end(model: KindDriveModel, result: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``result`` with an arm's train end in its own units (docs/model.md 14.6): psi_end = k s_end, psi_dot_end =
+    k v_end [rad, rad/s] and its torque M_train = F_train / k [N m], k = lift_angle / lift (without a train the end
+    is the arm: its psi, psi_dot); 0 for a translating follower."""
+    zero = np.zeros_like(np.asarray(result["theta"], dtype=float))
+    if not model.kind.oscillating:
+        result["psi_end"], result["psi_dot_end"], result["M_train"] = zero, zero.copy(), zero.copy()
+        return result
+    k = model.kind.lift_angle / model.program.lift
+    result["psi_end"] = k * np.asarray(result["s_end"], dtype=float)
+    result["psi_dot_end"] = k * np.asarray(result["v_end"], dtype=float)
+    result["M_train"] = np.asarray(result["F_train"], dtype=float) / k
+    return result

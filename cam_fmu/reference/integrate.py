@@ -34,7 +34,7 @@ from ..physics.parameters import ParameterError, resolve
 from ..physics.train import Train
 from ..physics.variables import INPUT_STARTS, OUTPUTS
 from .flight import follower_speed_reference, speed_motion
-from .follower_kind import kind_reference, with_arm_angle
+from .follower_kind import kind_reference, with_arm_angle, with_arm_end
 from .hybrid import ENERGY, VoltageRun, collect, event, next_breakpoint, piece_input
 from .train_flight import train_follower_reference, train_speed_follower_reference
 from .train_speed import speed_train_reference
@@ -82,8 +82,8 @@ def simulate_reference(
         options = {"rtol": rtol, "atol": atol, "energy": energy, "method": method}
         train = model.train if train is None else train
         if train.active:
-            return _kind_train(model, grid, u, omega_ref, train, options)
-        return kind_reference(model, grid, u, omega_ref, options)
+            return with_arm_end(model, _kind_train(model, grid, u, omega_ref, train, options))
+        return with_arm_end(model, kind_reference(model, grid, u, omega_ref, options))
     model = DriveModel(params)
     u = u or constant(INPUT_STARTS["u"])
     omega_ref = omega_ref or constant(INPUT_STARTS["omega_ref"])

@@ -120,8 +120,9 @@ def test_every_shipped_scene_is_recorded_with_every_solver_and_formulation():
 ADDED_OUTPUTS = {"theta_m", "omega_m", "M_shaft", "N_contact"}
 # The follower train's outputs came after every record (without a train: s, v, a and 0; test_engine_train.py)
 TRAIN_OUTPUTS = {"s_end", "v_end", "a_end", "F_train"}
-# An arm's angle and rate came after every record (a translating follower's: 0; test_engine_follower_kinds.py)
-KIND_OUTPUTS = {"psi", "psi_dot"}
+# An arm's angle and rate, and its train's end in its own units, came after every record (a translating follower's:
+# 0; test_engine_follower_kinds.py, test_engine_train_arm.py)
+KIND_OUTPUTS = {"psi", "psi_dot", "psi_end", "psi_dot_end", "M_train"}
 
 
 @pytest.mark.parametrize("name", ["paper_fig6", "backlash", "inductance"])

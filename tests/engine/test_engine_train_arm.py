@@ -29,9 +29,13 @@ TYPES = {"oscillating_roller": 0.3, "oscillating_flat": 0.15}   # follower_type:
 
 
 def end_angle(p: dict, out: dict) -> tuple[np.ndarray, np.ndarray]:
-    """rad, rad/s: the end inertia's angle and rate from the outputs s_end, v_end (the law's lift units, as s)."""
+    """rad, rad/s: the end inertia's angle and rate, the outputs psi_end, psi_dot_end; they are the outputs s_end,
+    v_end (the law's lift units, as s) times lift_angle / lift."""
     q = p["lift_angle"] / p["lift"]
-    return np.asarray(out["s_end"]) * q, np.asarray(out["v_end"]) * q
+    psi_e, rate_e = np.asarray(out["psi_end"]), np.asarray(out["psi_dot_end"])
+    assert np.allclose(psi_e, np.asarray(out["s_end"]) * q, rtol=1e-14, atol=0.0)
+    assert np.allclose(rate_e, np.asarray(out["v_end"]) * q, rtol=1e-14, atol=1e-300)
+    return psi_e, rate_e
 
 
 @pytest.mark.parametrize("follower_type", list(TYPES))
@@ -70,7 +74,8 @@ def test_a_coasting_drive_keeps_its_energy_with_the_arm_s_train(follower_type):
               + 0.5 * p["J_end"] * rate_e ** 2 + 0.5 * p["k_train_arm"] * twist ** 2)
     assert np.ptp(p["k_train_arm"] * twist) > 1.0   # N m: the train rings
     assert np.max(np.abs(energy - energy[0])) < 2e-9 * energy[0]
-    torque = p["k_train_arm"] * twist   # undamped: F_train is the torque in the law's lift units, times lift_angle/lift
+    torque = p["k_train_arm"] * twist   # undamped: M_train; F_train is it in the law's lift units, times lift_angle/lift
+    assert np.max(np.abs(out["M_train"] - torque)) < 1e-9 * np.max(np.abs(torque))
     assert np.max(np.abs(out["F_train"] - torque * p["lift_angle"] / p["lift"])) < 1e-9 * np.max(np.abs(torque))
 
 
@@ -159,7 +164,8 @@ def test_what_is_not_built_is_refused_by_name(change, named):
         DriveSimulator(dict(defaults(), **arm, **change))
 
 
-NAMES = ("theta", "omega", "i", "M", "N_contact", "s", "s_end", "v_end", "a_end", "F_train", "psi", "psi_dot")
+NAMES = ("theta", "omega", "i", "M", "N_contact", "s", "s_end", "v_end", "a_end", "F_train", "psi", "psi_dot",
+         "psi_end", "psi_dot_end", "M_train")
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.03], ids=["frictionless", "friction"])

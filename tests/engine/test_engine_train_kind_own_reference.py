@@ -15,7 +15,7 @@ from test_engine_follower_kinds import KINDS, NAMES, OWN, SCENE, SPEED, STEP, ST
 TRAINS = {"translating_flat": dict(k_train=5e3, d_train=0.5, m_end=0.1),
           "oscillating_roller": dict(k_train_arm=60.0, d_train_arm=0.005, J_end=1e-3),
           "oscillating_flat": dict(k_train_arm=60.0, d_train_arm=0.005, J_end=1e-3)}
-TRAIN_NAMES = NAMES + ("s_end", "v_end", "a_end", "F_train")
+TRAIN_NAMES = NAMES + ("s_end", "v_end", "a_end", "F_train", "psi_end", "psi_dot_end", "M_train")
 # Every output's largest difference relative to its largest value, measured: the voltage drive 2.1e-9 .. 4.1e-7 (the
 # oscillating face's psi_dot the largest, as without a train), the speed drive 2.7e-10 .. 2.0e-8.
 BOUNDS = {"voltage": 1e-6, "speed": 5e-8}

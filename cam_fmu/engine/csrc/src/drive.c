@@ -107,6 +107,13 @@ static int refuse(CamDrive *d, int verdict, const double out[], CamError *err)
     }
 }
 
+/* The formulation's outputs, an arm's train end in its own units beside the lift units' (kind.c). */
+static void publish(CamDrive *d, double out[])
+{
+    d->form->outputs(d, out);
+    cam_arm_end_outputs(&d->model, out);
+}
+
 int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_ref, double omega_dot_ref,
                       CamError *err)
 {
@@ -125,7 +132,7 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
         return status;
     if (!d->have_budget && d->form->energy_bounded) {   /* the books open at the first step that is taken */
         if (d->stale) {
-            d->form->outputs(d, d->values);
+            publish(d, d->values);
             d->stale = 0;
         }
         cam_energy_init(&opening, &d->model, d->values);
@@ -137,7 +144,7 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
         d->budget = opening;
         d->have_budget = 1;
     }
-    d->form->outputs(d, out);
+    publish(d, out);
     verdict = cam_publishable(&d->model, out, d->have_budget ? &d->budget : NULL, d->u, h);
     d->last_steps = steps;
     d->steps_taken += steps;
@@ -152,7 +159,7 @@ int cam_drive_do_step(CamDrive *d, double t, double h, double u, double omega_re
 const double *cam_drive_outputs(CamDrive *d)
 {
     if (d->stale) {
-        d->form->outputs(d, d->values);
+        publish(d, d->values);
         d->stale = 0;
     }
     return d->values;
@@ -204,9 +211,10 @@ void cam_drive_me_tangent(const CamDrive *d, const double x[CAM_ME_NX], const do
     int k;
     if (d->form->exchange != NULL) {
         d->form->exchange->tangent(d, x, seed, du, ddx, dout);
-        return;
+    } else {
+        cam_tangent(&d->model, &d->mode, x, d->form_u, seed, du, ddx, dout, NULL);
+        for (k = d->model.slots; k < CAM_ME_NX; k++)   /* the held slots (a rigid shaft's, the follower's gap) */
+            ddx[k] = 0.0;
     }
-    cam_tangent(&d->model, &d->mode, x, d->form_u, seed, du, ddx, dout, NULL);
-    for (k = d->model.slots; k < CAM_ME_NX; k++)   /* the held slots (a rigid shaft's, the follower's gap) */
-        ddx[k] = 0.0;
+    cam_arm_end_outputs(&d->model, dout);
 }

@@ -83,6 +83,13 @@ void cam_kind_outputs(const CamModel *m, double theta, double omega, double out[
     out[CAM_O_PSI_DOT] = q[1] * omega;
 }
 
+void cam_arm_end_outputs(const CamModel *m, double out[])
+{
+    out[CAM_O_PSI_END] = m->arm ? m->q_scale * out[CAM_O_S_END] : 0.0;
+    out[CAM_O_PSI_DOT_END] = m->arm ? m->q_scale * out[CAM_O_V_END] : 0.0;
+    out[CAM_O_M_TRAIN] = m->arm ? out[CAM_O_F_TRAIN] / m->q_scale : 0.0;
+}
+
 void cam_kind_contact_load(const CamModel *m, const double q[4], double P, double direction, CamLoad *out)
 {
     double alpha = 0.0, N, friction;
