@@ -24,8 +24,12 @@ def scene_and_law(name: str, sets: list[str]):
 
 
 def train_of(params) -> tuple[float | None, float | None]:
-    """(natural frequency [Hz], damping ratio) of the scene's train, (None, None) when it has none."""
-    k, m, d = (float(params.get(n, 0.0) or 0.0) for n in ("k_train", "m_end", "d_train"))
+    """(natural frequency [Hz], damping ratio) of the scene's train, (None, None) when it has none (an arm's
+    torsional train: k_train_arm, J_end, d_train_arm)."""
+    names = ("k_train", "m_end", "d_train")
+    if float(params.get("k_train_arm", 0.0) or 0.0) > 0.0:
+        names = ("k_train_arm", "J_end", "d_train_arm")
+    k, m, d = (float(params.get(n, 0.0) or 0.0) for n in names)
     if k > 0.0 and m > 0.0:
         return math.sqrt(k / m) / (2.0 * math.pi), d / (2.0 * math.sqrt(k * m))
     return None, None

@@ -61,8 +61,8 @@ def run(args) -> int:
     scene_hz, scene_zeta = train_of(params)
     f_n = scene_hz if args.train_hz is None else args.train_hz
     if f_n is None:
-        raise ValueError(f"scene {scene.name} has no train (k_train, m_end): give its natural frequency with "
-                         "--train-hz F [Hz]")
+        raise ValueError(f"scene {scene.name} has no train (k_train, m_end; an arm's k_train_arm, J_end): give its "
+                         "natural frequency with --train-hz F [Hz]")
     if not (math.isfinite(f_n) and f_n > 0.0):
         raise ValueError(f"--train-hz {f_n!r}: allowed a frequency > 0 [Hz]")
     if not (math.isfinite(args.rpm) and 0.0 < args.rpm <= 1e6):

@@ -180,13 +180,6 @@ class DriveModel:
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
 
-    def require_translating_roller(self, what: str) -> None:
-        """Refuse, naming ``what`` (a command or map), a follower type other than the translating roller, which
-        this model's formulas are (the other types: physics/kind_drive.py, docs/model.md 16)."""
-        if self.follower_type != "translating_roller":
-            raise ParameterError(f"parameter 'follower_type' = {self.follower_type!r}: {what} computes the "
-                                 f"translating roller only so far (docs/model.md 16); allowed: 'translating_roller'")
-
     # ----------------------------------------------------------- mechanics
     def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float,
                     axial: float = 0.0) -> GuideTerms:

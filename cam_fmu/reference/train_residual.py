@@ -7,7 +7,10 @@ The run: the scene's parameters (its law, lift, rise angle, mounting) in the spe
 runs no follower of its own, and 14.1's residual is that of a follower kept on the cam); a scene without an upper dwell
 gets one (the rest of the turn split between the upper dwell and the return, the rise unchanged). The train: an
 end mass ``m_end`` on k_train = m_end w_n^2, w_n = 2 pi ``train_hz``, damping d_train = 2 zeta sqrt(k_train m_end);
-the cam speed omega = rise_angle / (r T_n), T_n = 1 / train_hz, from theta = 0 (the rise's start).
+the cam speed omega = rise_angle / (r T_n), T_n = 1 / train_hz, from theta = 0 (the rise's start). Every follower
+type: a translating flat carries the same train along s; an arm a torsional one about its pivot (k_train_arm =
+J_end w_n^2, J_end = m_end (lift / lift_angle)^2, so that in the law's lift units, where the drive carries it, it is the
+same train), its residual in psi over lift_angle: the same fraction (psi = lift_angle s / lift; docs/model.md 14.6).
 
 The measurement: in the dwell the follower stands still at s = h and the end mass rings freely about its rest
 x_e = h + F_ex / k_train (its weight's static deflection; physics/train.py). With e = x_e - s - F_ex / k_train,
@@ -27,6 +30,8 @@ from dataclasses import dataclass
 from typing import Any, Callable, Mapping
 
 from ..physics.drive import DriveModel
+from ..physics.follower_kind import FollowerKind
+from ..physics.kind_drive import KindDriveModel
 from ..physics.parameters import ParameterError
 from ..physics.signals import constant
 from ..physics.train import Train, end_weight
@@ -53,9 +58,10 @@ def residual_scene(params: Mapping[str, Any], table_ok: bool = False) -> dict[st
     split with the return when the scene has none). ``table_ok``: a motion table whose rise, lift and upper dwell
     are the parameters' rise_angle, lift and upper_dwell (a polydyne table: vibration/polydyne.py) is measured as
     it is, else refused."""
-    model = DriveModel(params)
-    model.require_translating_roller("the residual through the drive")
-    p = dict(model.params)
+    p = dict(DriveModel(params).params)
+    kind = FollowerKind.from_parameters(p)
+    if not kind.default:
+        KindDriveModel(p, kind)   # the type's geometry, refused as the drive refuses it
     if p.get("motion_table") and not table_ok:
         raise ParameterError("the residual through the drive needs a rise law: parameter 'motion_table' must be empty")
     # The cam's motion imposed (a rigid shaft), the follower on it: no clearance, no return spring, no restitution.
@@ -90,12 +96,18 @@ def drive_residual(params: Mapping[str, Any], r: float, zeta: float = 0.0, train
     p = residual_scene(params, table_ok)
     w_n = 2.0 * math.pi * train_hz
     k = m_end * w_n * w_n
-    train = Train(k_train=k, d_train=2.0 * zeta * math.sqrt(k * m_end), m_end=m_end)
+    train: Train | None = Train(k_train=k, d_train=2.0 * zeta * math.sqrt(k * m_end), m_end=m_end)
+    deflection = end_weight(train, p) / k
+    if FollowerKind.from_parameters(p).oscillating:   # the torsional train that is this one in lift units
+        J_end = m_end * (p["lift"] / p["lift_angle"]) ** 2
+        k_arm = J_end * w_n * w_n
+        p.update(k_train_arm=k_arm, d_train_arm=2.0 * zeta * math.sqrt(k_arm * J_end), J_end=J_end)
+        train, deflection = None, 0.0   # from the parameters; an end inertia has no weight along s
     t_rise = r / train_hz
     omega = p["rise_angle"] / t_rise
     t_measured = t_rise + min(1.0 / train_hz, 0.5 * p["upper_dwell"] / omega)
     out = simulate(p, t_measured, t_rise, omega_ref=constant(omega), rtol=rtol, atol=atol, train=train)
-    lift, deflection = p["lift"], end_weight(train, p) / k
+    lift = p["lift"]
     w_d = w_n * math.sqrt(1.0 - zeta * zeta)
 
     def envelope(j: int) -> float:

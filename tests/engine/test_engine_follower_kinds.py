@@ -219,15 +219,13 @@ def test_the_reference_refuses_the_same_geometry(params):
         simulate_reference(dict(defaults(), **SCENE, **params, drive="speed"), 0.1, 0.01, omega_ref=constant(10.0))
 
 
-@pytest.mark.parametrize("kind", ["translating_flat", "oscillating_roller"])
-def test_the_residual_through_the_drive_refuses_another_type_by_name(kind):
-    """The residual through the drive computes the translating roller's formulas (physics/drive.py): with another
-    follower type it refuses, naming it, rather than compute a roller in its place. (reflect and bode take every type:
-    tests/physics/test_reflect_kinds.py, tests/physics/test_frequency_kinds.py.)"""
+def test_the_residual_through_the_drive_refuses_a_geometry_the_type_cannot_make():
+    """The residual through the drive runs every type (tests/vibration/test_residual_drive.py); a flat face on a base
+    circle that its contour would need a cusp for is refused by name, as the drive refuses it."""
     from cam_fmu.reference.train_residual import residual_scene
 
-    params = dict(KINDS[kind], mu=0.0)
-    with pytest.raises(ParameterError, match=f"'follower_type' = '{kind}'.*translating roller only"):
+    params = dict(SCENE, **KINDS["translating_flat"], r_b=0.02)
+    with pytest.raises(ParameterError, match="follower_type 'translating_flat' with 'r_b' = 0.02 m.*cusp"):
         residual_scene(params)
 
 
