@@ -64,14 +64,14 @@ class KindView:
         the train's spring), as a torque on the cam."""
         q, q1, _, _ = self.model.coordinate(theta)
         s1 = self.model.program.derivatives(theta)[1]
-        return self.model.potential_slope(q) * q1 - self.end_weight() * s1
+        return self.model.potential_slope(q) * q1 - self.train_weight() * s1
 
     def gravity_stiffness(self, theta: float) -> float:
         """k_g = V''(q) q'^2 + V'(q) q'' - F_ex s'' [N m/rad] at theta [rad]: d M_g / d theta."""
         q, q1, q2, _ = self.model.coordinate(theta)
         s2 = self.model.program.derivatives(theta)[2]
         return self.model.potential_curvature(q) * q1 * q1 + self.model.potential_slope(q) * q2 \
-            - self.end_weight() * s2
+            - self.train_weight() * s2
 
     @property
     def train(self) -> Train | None:
@@ -79,7 +79,7 @@ class KindView:
         lift)^2, physics.kind_drive), None without one: its force F pulls the cam by F s' whatever the kind."""
         return self.model.train if self.model.train.active else None
 
-    def end_weight(self) -> float:
+    def train_weight(self) -> float:
         """F_ex [N]: the train's end mass's weight along s (a translating flat's; 0 for an arm's torsional train and
         without a train, physics.train.end_weight)."""
         return end_weight(self.model.train, self.model.params) if self.train else 0.0

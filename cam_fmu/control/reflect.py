@@ -131,7 +131,7 @@ def _kind_map(view: KindView, omega: float, direction: float, thetas: np.ndarray
     m_end s'' omega^2 s', M_gravity -F_ex s', and that force joins P; with a rigid shaft f_r_train, f_a_train."""
     model, train = view.model, view.train
     m_end = train.m_end if train else 0.0
-    F_ex = view.end_weight()
+    F_ex = view.train_weight()
     columns = COLUMNS + (FREQUENCIES if view.compliant else ()) + (TRAIN_FREQUENCIES if train and not
                                                                     view.compliant else ())
     out = {name: np.empty(len(thetas)) for name in columns}

@@ -1,9 +1,9 @@
 """A follower train under a host's own integration in Model Exchange (docs/model.md 14.7, docs/fmu.md, issue 41).
 The FMU cannot refuse a host's method or step before the run (the host declares neither); it judges them from how the
 host samples the drive while the train rings by more than 1e-4 of the lift, and says once, as fmi2Warning /
-fmi3Warning with its reason, where the answer may be aliased, damped or grown: a first-order host (one derivative
-evaluation a step, fmpy's Euler) past a drift w^2 h t / 2 of 1 %, any other past 0.25 rad of the ringing between
-two samples (rk4's stages h / 2 apart; CVode at a loose tolerance). Each warning is checked against what it warns of:
+fmi3Warning with its reason, where the answer may be aliased, damped or grown: explicit Euler (one derivative
+evaluation a step, at its start: fmpy's Euler) past a drift w^2 h t / 2 of 0.01, any other past 0.25 rad of the
+ringing between two samples (rk4's stages h / 2 apart; CVode at a loose tolerance). Each warning is checked against what it warns of:
 the run's F_train against co-simulation's (the engine's rk45 at its tolerance), and a quiet host is right."""
 from __future__ import annotations
 
@@ -92,6 +92,6 @@ def test_a_first_order_host_is_warned_by_the_drift_it_gives_the_ringing(step, ve
     fmu = engine_fmu_path if version == "fmi2" else cam3_fmu_path
     result, warnings, errors = fmpy_run(fmu, solver="Euler", step_size=step)
     assert result is not None and errors == [] and len(warnings) == 1, warnings
-    for part in ("once a step (a first-order method)", "w^2 h t / 2", "k_train", "0.02 / (w^2 T)"):
+    for part in ("once a step, at its start (explicit Euler)", "w^2 h t / 2", "k_train", "0.02 / (w^2 T)"):
         assert part in warnings[0], (part, warnings[0])
     assert off(result, co_simulation) > 0.02

@@ -150,6 +150,7 @@ int cam_exchange_derivatives(CamExchange *e, double dx[], size_t nx)
     cam_drive_me_states(e->drive, x);
     cam_drive_me_rates(e->drive, x, dx);
     e->evaluations++;
+    e->evaluated_at = e->drive->time;
     return CAM_OK;
 }
 
@@ -361,9 +362,9 @@ static double train_ringing(const CamModel *m, const double out[])
 /* The host's integration of a ringing train (docs/model.md 14.7), judged from how it samples the drive, while the
  * train rings by more than CAM_EXCHANGE_TRAIN_RINGING of the lift (a quiet train may be stepped over: an adaptive
  * host's long first steps):
- * - a host that evaluates the derivatives once a step is of the first order (explicit Euler grows the ringing's
- *   amplitude by exp(w^2 h t / 2), implicit Euler damps it so): the drift w^2 h^2 / 2 summed over its steps past
- *   CAM_EXCHANGE_TRAIN_DRIFT;
+ * - a host that evaluates the derivatives once a step, at the step's start, is explicit Euler (it grows the
+ *   ringing's amplitude by exp(w^2 h t / 2)): the drift w^2 h^2 / 2 summed over its steps past
+ *   CAM_EXCHANGE_TRAIN_DRIFT (an adaptive host's one evaluation in an output interval is at its step's end);
  * - any other: its longest forward stretch between two settings of the time since the last completed step (its
  *   step, h / 2 for rk4's stages) past CAM_EXCHANGE_TRAIN_PHASE rad of the ringing (rk4 then errs by percents of
  *   the train's force; an adaptive host at a loose tolerance steps over the ringing, measured in docs/model.md 14.7).
@@ -373,19 +374,18 @@ static void check_train_sampling(CamExchange *e, const double out[])
     CamDrive *d = e->drive;
     const CamModel *m = &d->model;
     double w = m->train_rate, h = d->time - e->step_time, ringing = train_ringing(m, out);
-    int first_order = e->evaluations == 1;
-    if (first_order && h > 0.0)
+    int explicit_euler = e->evaluations == 1 && e->evaluated_at == e->step_time;
+    if (explicit_euler && h > 0.0)
         e->drift += 0.5 * w * w * h * h;
     if (!e->train_warned && ringing > CAM_EXCHANGE_TRAIN_RINGING * m->lift_scale
-        && (first_order ? e->drift > CAM_EXCHANGE_TRAIN_DRIFT : w * e->longest_gap > CAM_EXCHANGE_TRAIN_PHASE)) {
+        && (explicit_euler ? e->drift > CAM_EXCHANGE_TRAIN_DRIFT : w * e->longest_gap > CAM_EXCHANGE_TRAIN_PHASE)) {
         e->train_warned = e->warning = 1;
-        if (first_order)
-            cam_error(cam_instance_error(e->instance), CAM_OK, "the host evaluates the drive once a step (a "
-                      "first-order method) at %g s before t = %g s: it may have changed the follower train's "
+        if (explicit_euler)
+            cam_error(cam_instance_error(e->instance), CAM_OK, "the host evaluates the drive once a step, at "
+                      "its start (explicit Euler), at %g s before t = %g s: it may have grown the follower train's "
                       "ringing (%s, %.4g 1/s, ringing by %.3g m, %.2g of the lift) by up to %.2g of its amplitude "
-                      "so far (w^2 h t / 2), growing (explicit) or damping (implicit) it without a sign; a first-order "
-                      "step keeps that below 0.01 over T seconds only below 0.02 / (w^2 T) (%.3g s for 1 s): use a "
-                      "higher-order or adaptive solver (said once)", h, d->time, cam_train_names(m), w, ringing,
+                      "so far (w^2 h t / 2) without a sign; explicit Euler keeps that below 0.01 over T seconds only "
+                      "below 0.02 / (w^2 T) (%.3g s for 1 s): use a higher-order or adaptive solver (said once)", h, d->time, cam_train_names(m), w, ringing,
                       ringing / m->lift_scale, e->drift, 2.0 * CAM_EXCHANGE_TRAIN_DRIFT / (w * w));
         else
             cam_error(cam_instance_error(e->instance), CAM_OK, "the host sampled the drive %g s apart before "

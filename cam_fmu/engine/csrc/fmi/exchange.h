@@ -52,7 +52,8 @@ typedef struct {
     double longest_gap;         /* s: the longest forward stretch between its settings since the last completed step */
     double step_time;           /* s: the last completed step (or the entry into continuous time) */
     int evaluations;            /* the derivatives evaluated since then */
-    double drift;               /* a first-order host's change of the train's ringing amplitude so far, w^2 h t / 2 */
+    double evaluated_at;        /* s: the time of the last of them */
+    double drift;               /* explicit Euler's growth of the train's ringing amplitude so far, w^2 h t / 2 */
     int train_warned;           /* a ringing train sampled too sparsely was said once: not again */
     int warning;                /* this completed step's message is a warning (status OK otherwise) */
 } CamExchange;
