@@ -56,7 +56,7 @@ def frozen_parameters(params: Mapping[str, Any] | None, theta0: float) -> tuple[
         p["gravity"] = False
         model = DriveModel(p)
     _, s1, s2, _ = model.program.derivatives(theta0)
-    F_x = model.F_gx + _end_weight(model)  # N: gravity along X on the follower, and on a train's end mass
+    F_x = model.F_gx + model.train_weight()  # N: gravity along X on the follower, and on a train's end mass
     k_g = -F_x * s2
     if k_g < -1e-12:  # N m/rad: a rounding remainder of a horizontal mounting (F_gx ~ 1e-16 G) is no stiffness
         raise ValueError(f"theta0 = {theta0!r} rad: gravity's stiffness there is k_g = -F_x s'' = {k_g:.4g} N m/rad "
@@ -81,13 +81,6 @@ def _kind_frozen(p: dict[str, Any], view: KindView, theta0: float) -> tuple[dict
     if model.L > 0.0:
         p["i0"] = u0 / model.R
     return p, u0
-
-
-def _end_weight(model: DriveModel) -> float:
-    """F_ex [N]: a train's end mass's weight along X (0 without a train; physics/train.py)."""
-    from ..physics.train import end_weight
-
-    return end_weight(model.train, model.params) if model.train.active else 0.0
 
 
 def _with_train(train: Train, s1: float, J_c: float, A: list, C: list) -> tuple[list, list]:
@@ -118,7 +111,7 @@ def linear_model(params: Mapping[str, Any] | None, theta0: float) -> tuple[np.nd
         model = DriveModel(p)
         _, s1, s2, _ = model.program.derivatives(theta0)
         J_c = model.J_0 + model.m * s1 * s1
-        k_g = -(model.F_gx + _end_weight(model)) * s2
+        k_g = -(model.F_gx + model.train_weight()) * s2
         compliant, k, d, J_m = model.compliant, model.k_shaft, model.d_shaft, model.J_m
         train = model.train if model.train.active else None
     else:  # another follower type: its J_c(theta0), gravity's stiffness and its train (control.kind_view)

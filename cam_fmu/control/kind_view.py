@@ -25,7 +25,7 @@ from typing import Any, Mapping
 from ..physics.follower_kind import FollowerKind
 from ..physics.kind_drive import KindDriveModel
 from ..physics.parameters import ParameterError, resolve
-from ..physics.train import Train, end_weight
+from ..physics.train import Train
 
 __all__ = ["KindView", "kind_view"]
 
@@ -81,8 +81,8 @@ class KindView:
 
     def train_weight(self) -> float:
         """F_ex [N]: the train's end mass's weight along s (a translating flat's; 0 for an arm's torsional train and
-        without a train, physics.train.end_weight)."""
-        return end_weight(self.model.train, self.model.params) if self.train else 0.0
+        without a train: DriveModel.train_weight)."""
+        return self.model.train_weight()
 
 
 def kind_view(params: Mapping[str, Any] | None) -> KindView | None:

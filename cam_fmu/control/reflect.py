@@ -36,7 +36,6 @@ import numpy as np
 
 from ..physics.drive import DriveModel, own_follower, sign, solve_guide_friction
 from ..physics.parameters import resolve
-from ..physics.train import end_weight
 from .kind_view import KindView, kind_view
 
 PARTS = ("M_inertial", "M_gravity", "M_guide", "M_shaft")
@@ -94,7 +93,7 @@ def reflected_map(params: Mapping[str, Any] | None, rpm: float, points: int = 36
         raise FreeFollowerError(model.closure)
     train = model.train if model.train.active else None
     m_end = train.m_end if train else 0.0
-    F_ex = end_weight(train, model.params) if train else 0.0
+    F_ex = model.train_weight()
     columns = COLUMNS + (FREQUENCIES if model.compliant else ()) + (TRAIN_FREQUENCIES if train and not
                                                                      model.compliant else ())
     out = {name: np.empty(points) for name in columns}

@@ -21,7 +21,7 @@ from ..kinematics.motion_table import program_from_table_text
 from .motor import Motor
 from .parameters import ParameterError, law_spec, mounting_component, resolve
 from .rules import OWN_FOLLOWER, check_rules
-from .train import Train
+from .train import Train, end_weight
 
 
 def sign(x: float) -> float:
@@ -179,6 +179,11 @@ class DriveModel:
         self.free_follower = own_follower(p)
         if self.mu > 0.0:
             check_self_locking(self.program, self.mu, self.r_b)
+
+    def train_weight(self) -> float:
+        """F_ex [N]: the follower train's end mass's weight along X (physics.train.end_weight; 0 without a train,
+        and for an arm's torsional train)."""
+        return end_weight(self.train, self.params) if self.train.active else 0.0
 
     # ----------------------------------------------------------- mechanics
     def guide_terms(self, theta: float, omega: float, drive: float, direction: float, side: float,

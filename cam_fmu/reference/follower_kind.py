@@ -81,7 +81,7 @@ def with_arm_end(model: KindDriveModel, result: dict[str, np.ndarray]) -> dict[s
     if not model.kind.oscillating:
         result["psi_end"], result["psi_dot_end"], result["M_train"] = zero, zero.copy(), zero.copy()
         return result
-    k = model.kind.lift_angle / model.program.lift
+    k = model._scale   # lift_angle / lift, the kind's (physics.kind_drive; KindFlank reads it too)
     result["psi_end"] = k * np.asarray(result["s_end"], dtype=float)
     result["psi_dot_end"] = k * np.asarray(result["v_end"], dtype=float)
     result["M_train"] = np.asarray(result["F_train"], dtype=float) / k

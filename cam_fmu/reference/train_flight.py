@@ -111,8 +111,8 @@ def train_follower_reference(model, grid: np.ndarray, u: Signal, options: dict, 
     """The consistent voltage drive with a follower of its own (closures 'spring', 'form' with c > 0) carrying
     ``train`` (None: the parameters' k_train, d_train, m_end), on the output grid; ``end_offset`` [m] moves the end
     mass from its rest at the start. ``runner``: the run's class (TrainFollowerRun; another kind's, kind_flight)."""
-    run = (runner or TrainFollowerRun)(model, u, options["rtol"], options["atol"], options["energy"], options["method"], train,
-                           end_offset)
+    run = (runner or TrainFollowerRun)(model, u, options["rtol"], options["atol"], options["energy"],
+                                       options["method"], train, end_offset)
     return run.run(grid)
 
 

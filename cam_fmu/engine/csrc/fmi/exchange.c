@@ -385,8 +385,9 @@ static void check_train_sampling(CamExchange *e, const double out[])
                       "its start (explicit Euler), at %g s before t = %g s: it may have grown the follower train's "
                       "ringing (%s, %.4g 1/s, ringing by %.3g m, %.2g of the lift) by up to %.2g of its amplitude "
                       "so far (w^2 h t / 2) without a sign; explicit Euler keeps that below 0.01 over T seconds only "
-                      "below 0.02 / (w^2 T) (%.3g s for 1 s): use a higher-order or adaptive solver (said once)", h, d->time, cam_train_names(m), w, ringing,
-                      ringing / m->lift_scale, e->drift, 2.0 * CAM_EXCHANGE_TRAIN_DRIFT / (w * w));
+                      "below 0.02 / (w^2 T) (%.3g s for 1 s): use a higher-order or adaptive solver (said once)", h,
+                      d->time, cam_train_names(m), w, ringing, ringing / m->lift_scale, e->drift,
+                      2.0 * CAM_EXCHANGE_TRAIN_DRIFT / (w * w));
         else
             cam_error(cam_instance_error(e->instance), CAM_OK, "the host sampled the drive %g s apart before "
                       "t = %g s, %.3g rad of the follower train's ringing (%s, %.4g 1/s), while it rings by %.3g m "

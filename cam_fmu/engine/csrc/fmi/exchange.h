@@ -37,7 +37,7 @@ typedef char cam_exchange_indicator_count[CAM_N_EVENT_INDICATORS == CAM_EXCHANGE
 #define CAM_EXCHANGE_MAX_ITERATIONS 32   /* transitions at one event instant at most */
 #define CAM_EXCHANGE_PROBE 1e-9          /* s: how far ahead an indicator at exactly 0 is looked at */
 #define CAM_EXCHANGE_TRAIN_PHASE 0.25    /* rad of a ringing train between a host's samples (exchange.c) */
-#define CAM_EXCHANGE_TRAIN_DRIFT 0.01    /* of its amplitude: a first-order host's change of a ringing train */
+#define CAM_EXCHANGE_TRAIN_DRIFT 0.01    /* of its amplitude: explicit Euler's growth of a ringing train */
 #define CAM_EXCHANGE_TRAIN_RINGING 1e-4  /* of the lift: a train ringing less is quiet enough for a long step */
 
 typedef struct {
@@ -85,8 +85,9 @@ int cam_exchange_nominals(CamExchange *e, double nominal[], size_t nx);
 void cam_exchange_enter_event_mode(CamExchange *e);
 int cam_exchange_event_update(CamExchange *e, CamExchangeEvent *fired, int *values_changed, int *needed);
 void cam_exchange_enter_continuous(CamExchange *e);
-/* A follower train ringing by more than CAM_EXCHANGE_TRAIN_RINGING of the lift that the host samples more than
- * CAM_EXCHANGE_TRAIN_PHASE rad of its ringing apart is said once, as a warning (e->warning; docs/model.md 14.7). */
+/* A follower train ringing by more than CAM_EXCHANGE_TRAIN_RINGING of the lift that explicit Euler has grown past
+ * CAM_EXCHANGE_TRAIN_DRIFT, or that another host samples more than CAM_EXCHANGE_TRAIN_PHASE rad of its ringing apart,
+ * is said once, as a warning (e->warning; exchange.c's check_train_sampling, docs/model.md 14.7). */
 int cam_exchange_completed_step(CamExchange *e, int *enter_event);
 
 /* cam_instance_save with the energy bound booked up to the drive's time (the live books unchanged). */
